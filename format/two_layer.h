@@ -1,0 +1,85 @@
+#pragma once
+
+// The paper's two-layer panorama (Sec. 3 and 4.4.3): an equirectangular grid
+// (see equirect.h) in which each pixel holds up to two nodes, front (layer 0)
+// and back (layer 1). Each node has a colour, a depth, a normal, a label (F or
+// B) and links to nodes of its 4 neighbours. spec/ is the normative text.
+
+#include <cstdint>
+#include <vector>
+
+#include "format/equirect.h"
+#include "format/status.h"
+
+namespace casual3d {
+
+enum Layer : int { kFront = 0, kBack = 1 };
+constexpr int kNumLayers = 2;
+
+// Neighbour directions. Right/left wrap around the +-180 degree seam.
+enum Direction : int { kRight = 0, kDown = 1, kLeft = 2, kUp = 3 };
+constexpr int kNumDirections = 4;
+inline Direction Opposite(Direction d) { return static_cast<Direction>((d + 2) & 3); }
+
+// Node label (Sec. 4.4.3): F nodes come from the front stitch, B nodes from the
+// back stitch or were relabelled B by colour fringe removal.
+enum class NodeLabel : uint8_t { kF = 0, kB = 1 };
+
+// A link names which node of the neighbouring pixel a node connects to.
+enum class Link : uint8_t { kNone = 0, kFront = 1, kBack = 2 };
+
+// Packs the 4 links of a node into one byte: bits 2d..2d+1 hold direction d.
+inline Link GetLink(uint8_t links, Direction d) {
+  return static_cast<Link>((links >> (2 * d)) & 3);
+}
+inline uint8_t SetLink(uint8_t links, Direction d, Link l) {
+  return static_cast<uint8_t>((links & ~(3u << (2 * d))) | (static_cast<unsigned>(l) << (2 * d)));
+}
+
+// Arrays of one layer, each width*height long (times 3 for rgb and normal),
+// row-major. A pixel without a node of this layer has present 0 and all its
+// other fields zero.
+struct LayerData {
+  std::vector<uint8_t> present;  // 1 if the node exists.
+  std::vector<uint8_t> rgb;      // sRGB colour, 8 bits per channel.
+  std::vector<float> depth_m;    // Distance from the frame centre along the ray, > 0, finite.
+  std::vector<float> normal;     // Unit normal in the panorama frame, or (0,0,0): unlit (sky).
+  std::vector<uint8_t> label;    // NodeLabel.
+  std::vector<uint8_t> links;    // 4 Links packed as above.
+};
+
+class TwoLayerPanorama {
+ public:
+  TwoLayerPanorama() = default;
+  // All nodes absent. Precondition: width, height > 0 (see Validate for limits).
+  TwoLayerPanorama(int width, int height);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  size_t index(int x, int y) const { return static_cast<size_t>(y) * width_ + x; }
+
+  LayerData& layer(int l) { return layers_[l]; }
+  const LayerData& layer(int l) const { return layers_[l]; }
+
+  bool present(int l, int x, int y) const { return layers_[l].present[index(x, y)] != 0; }
+
+  // The pixel next to (x, y) in direction d; false past the top or bottom row.
+  bool Neighbour(int x, int y, Direction d, int* nx, int* ny) const;
+
+  PanoramaFrame& frame() { return frame_; }
+  const PanoramaFrame& frame() const { return frame_; }
+
+  // Checks sizes, value ranges, and that every link is mutual and points at an
+  // existing node. Returns the first problem found, naming layer and pixel.
+  Status Validate() const;
+
+  bool operator==(const TwoLayerPanorama& o) const;
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  LayerData layers_[kNumLayers];
+  PanoramaFrame frame_;
+};
+
+}  // namespace casual3d
