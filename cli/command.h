@@ -16,4 +16,34 @@ struct GlobalOptions {
 };
 const GlobalOptions& Globals();
 
+// `casual3d view <package> [--port N]` (cli/view_command.cc).
+void AddViewCommand(CLI::App& app);
+
+// `casual3d sparse <photos-or-workspace> -o <out>` (cli/sparse_command.cc).
+void AddSparseCommand(CLI::App& app);
+
+// `casual3d dense <workspace> -o <out>` (cli/dense_command.cc).
+void AddDenseCommand(CLI::App& app);
+
+// `casual3d synth [--rig partial|sphere] [-o DIR] ...` (cli/synth_command.cc).
+void AddSynthCommand(CLI::App& app);
+
+// `casual3d panorama <workspace> -o <out>` (cli/panorama_command.cc).
+void AddPanoramaCommand(CLI::App& app);
+
+// `casual3d reconstruct <photos> -o <out>` (cli/reconstruct_command.cc).
+void AddReconstructCommand(CLI::App& app);
+
+// `casual3d encode <master.exr> -o <package>` (cli/encode_command.cc).
+void AddEncodeCommand(CLI::App& app);
+
+// `casual3d info <package>` (cli/info_command.cc).
+void AddInfoCommand(CLI::App& app);
+
+// `casual3d validate <package>` (cli/validate_command.cc).
+void AddValidateCommand(CLI::App& app);
+
+// `casual3d export <package> --glb out.glb [--draco]` (cli/export_command.cc).
+void AddExportCommand(CLI::App& app);
+
 }  // namespace casual3d::cli

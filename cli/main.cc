@@ -26,6 +26,17 @@ int main(int argc, char** argv) {
   app.add_flag("--verbose,-v", g_options.verbose, "More detail on stderr");
   app.add_flag("--json", g_options.json, "Log as JSON lines on stderr");
 
+  casual3d::cli::AddSynthCommand(app);
+  casual3d::cli::AddReconstructCommand(app);
+  casual3d::cli::AddPanoramaCommand(app);
+  casual3d::cli::AddViewCommand(app);
+  casual3d::cli::AddSparseCommand(app);
+  casual3d::cli::AddDenseCommand(app);
+  casual3d::cli::AddEncodeCommand(app);
+  casual3d::cli::AddInfoCommand(app);
+  casual3d::cli::AddValidateCommand(app);
+  casual3d::cli::AddExportCommand(app);
+
   app.parse_complete_callback([&] {
     casual3d::util::SetLogOptions({g_options.verbose, g_options.json});
   });

@@ -65,6 +65,15 @@ class ModelError : public std::runtime_error {
 SparseModel ReadModel(const std::string& dir);
 SparseModel ReadModelText(const std::string& dir);
 SparseModel ReadModelBinary(const std::string& dir);
+
+// Single-file readers, for folders that hold only part of a model (for
+// example a cameras.bin of intrinsics). Same error conventions as above.
+std::map<int, Camera> ReadCamerasText(const std::string& path);
+std::map<int, ModelImage> ReadImagesText(const std::string& path);
+std::map<uint64_t, Point3D> ReadPoints3DText(const std::string& path);
+std::map<int, Camera> ReadCamerasBinary(const std::string& path);
+std::map<int, ModelImage> ReadImagesBinary(const std::string& path);
+std::map<uint64_t, Point3D> ReadPoints3DBinary(const std::string& path);
 // Writers create `dir` if needed and write each file atomically (temporary name, rename).
 void WriteModelText(const SparseModel& model, const std::string& dir);
 void WriteModelBinary(const SparseModel& model, const std::string& dir);

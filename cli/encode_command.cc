@@ -1,0 +1,92 @@
+// `casual3d encode <master.exr> -o <package> [--quality Q] [--tile-size N]
+// [--levels N] [--single-file out.c3d]`: turns a master file into a web package
+// (spec/package.md), optionally also as one .c3d file.
+
+#include <chrono>
+#include <stdexcept>
+#include <string>
+
+#include "cli/command.h"
+#include "cli/viewer_assets.h"
+#include "encoder/master_file.h"
+#include "encoder/package_writer.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::cli {
+namespace {
+
+struct EncodeCommandOptions {
+  std::string master;        // Input master file (OpenEXR).
+  std::string output;        // Output package folder.
+  std::string single_file;   // Optional .c3d output.
+  bool viewer = true;        // Add index.html and the viewer to the folder.
+  encoder::PackageOptions package;
+};
+
+void RunEncode(const EncodeCommandOptions& o) {
+  if (o.output.empty() && o.single_file.empty())
+    throw std::runtime_error("encode: give an output folder with -o (and/or --single-file)");
+  Status check = o.package.Check();
+  if (!check.ok()) throw std::runtime_error("encode: " + check.message());
+  const auto start = std::chrono::steady_clock::now();
+  StatusOr<TwoLayerPanorama> pano = encoder::ReadMasterFile(o.master);
+  if (!pano.ok()) throw std::runtime_error(pano.status().message());
+  const auto read = std::chrono::steady_clock::now();
+  encoder::PackageStats stats;
+  StatusOr<encoder::PackageFiles> files = encoder::EncodePackage(*pano, o.package, &stats);
+  if (!files.ok()) throw std::runtime_error(o.master + ": " + files.status().message());
+  const auto encoded = std::chrono::steady_clock::now();
+  if (!o.output.empty()) {
+    Status s = encoder::WritePackageFolder(*files, o.output);
+    if (!s.ok()) throw std::runtime_error(s.message());
+    if (o.viewer) {
+      try {
+        WriteViewerPage(o.output);
+      } catch (const std::exception& e) {
+        util::LogWarning(std::string("package written without index.html: ") + e.what());
+      }
+    }
+  }
+  if (!o.single_file.empty()) {
+    Status s = encoder::WritePackageSingleFile(*files, o.single_file);
+    if (!s.ok()) throw std::runtime_error(s.message());
+  }
+  auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  std::string levels;
+  for (size_t l = 0; l < stats.level_bytes.size(); ++l)
+    levels += (l ? ", " : "") + std::to_string(stats.level_bytes[l] / 1024) + " KB";
+  util::LogInfo("encoded " + std::to_string(pano->width()) + "x" + std::to_string(pano->height()) +
+                " in " + util::FormatDuration(seconds(read, encoded)) + " (read " +
+                util::FormatDuration(seconds(start, read)) + "): " +
+                std::to_string(stats.num_files) + " files, " +
+                std::to_string(stats.total_bytes / 1024) + " KB; levels " + levels);
+}
+
+}  // namespace
+
+void AddEncodeCommand(CLI::App& app) {
+  auto options = std::make_shared<EncodeCommandOptions>();
+  CLI::App* cmd = app.add_subcommand("encode", "Encode a master file (.exr) as a web package");
+  cmd->add_option("master", options->master, "Master file (two-layer panorama, OpenEXR)")
+      ->required();
+  cmd->add_option("-o,--output", options->output, "Output package folder");
+  cmd->add_option("--single-file", options->single_file, "Also write the package as one .c3d file");
+  cmd->add_option("--quality", options->package.color_quality,
+                  "Colour WebP quality, 0..100 (default 90)");
+  cmd->add_option("--tile-size", options->package.tile_size,
+                  "Tile side in pixels, 16..4096 (default 512)");
+  cmd->add_option("--levels", options->package.levels,
+                  "Levels of detail, 1..8; 0 = automatic (default)");
+  cmd->add_option("--depth-bits", options->package.depth_bits,
+                  "Bits of the log-depth code, 8..16 (default 12)");
+  cmd->add_option("--normal-bits", options->package.normal_bits,
+                  "Bits per octahedral normal coordinate, 4..8 (default 8)");
+  cmd->add_option("--threads", options->package.num_threads, "Encoding threads; 0 = all cores");
+  cmd->add_flag("!--no-viewer", options->viewer, "Do not add index.html and the viewer");
+  cmd->callback([options] {
+    options->package.generator = "casual3d 0.1.0";
+    RunEncode(*options);
+  });
+}
+
+}  // namespace casual3d::cli

@@ -1,0 +1,269 @@
+// `casual3d export <input> --glb out.glb [--draco] [--max-triangles N] ...`:
+// writes a 3D photo as a binary glTF file (encoder/gltf_export.h): the mesh of
+// the two-layer panorama, simplified to a triangle budget (format/
+// mesh_simplify.h), with its colour atlas as texture.
+//
+// The input is a package folder (holding manifest.json), a single-file package
+// (.c3d) or a master file (OpenEXR), recognised by content, not by name.
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli/command.h"
+#include "encoder/gltf_export.h"
+#include "encoder/master_file.h"
+#include "encoder/webp_codec.h"
+#include "format/file_source.h"
+#include "format/mesh_builder.h"
+#include "format/mesh_simplify.h"
+#include "format/package_reader.h"
+#include "format/single_file.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::cli {
+namespace fs = std::filesystem;
+namespace {
+
+// The largest single-file package read into memory.
+constexpr uint64_t kMaxSingleFileBytes = uint64_t{4} << 30;
+
+struct ExportOptions {
+  std::string input;      // Package folder, single-file package or master file.
+  std::string glb;        // Output .glb path.
+  int level = 0;          // Package level of detail (0 = full resolution).
+  bool no_simplify = false;  // true: the full mesh of BuildMesh.
+  MeshSimplifyOptions simplify_options;
+  std::string texture = "jpeg";  // "jpeg" or "png".
+  encoder::GltfExportOptions gltf;
+  bool lit = false;       // Use a lit (PBR) material instead of KHR_materials_unlit.
+  bool no_normals = false;
+  int num_threads = 0;    // Tile decoding threads; 0 = all cores.
+};
+
+[[noreturn]] void Fail(const std::string& message) { throw std::runtime_error(message); }
+
+std::string Megabytes(size_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.2f MB", bytes / 1e6);
+  return buf;
+}
+
+std::string Number(double value) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", value);
+  return buf;
+}
+
+// Reads the panorama from whatever `input` is.
+TwoLayerPanorama LoadPanorama(const ExportOptions& opts) {
+  const std::string& input = opts.input;
+  std::error_code ec;
+  const fs::file_status st = fs::status(input, ec);
+  if (ec || !fs::exists(st)) Fail(input + ": no such file or folder");
+
+  ReadOptions read;
+  read.level = opts.level;
+  read.num_threads = opts.num_threads > 0
+                         ? opts.num_threads
+                         : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (read.num_threads > 256) read.num_threads = 256;
+  const encoder::WebpImageDecoder decoder;
+
+  auto read_package = [&](const FileSource& source) {
+    Manifest manifest;
+    auto pano = ReadPackage(source, decoder, read, &manifest);
+    if (!pano.ok()) Fail(input + ": " + pano.status().ToString());
+    return std::move(pano).value();
+  };
+
+  if (fs::is_directory(st)) {
+    if (!fs::exists(fs::path(input) / "manifest.json")) {
+      Fail(input + ": not a package folder (no manifest.json); pass a package folder, a .c3d "
+                   "file or a master .exr file");
+    }
+    return read_package(FolderFileSource(input));
+  }
+
+  // A file: look at its first bytes.
+  std::ifstream in(input, std::ios::binary);
+  if (!in) Fail(input + ": cannot open (" + std::strerror(errno) + ")");
+  unsigned char magic[8] = {};
+  in.read(reinterpret_cast<char*>(magic), sizeof(magic));
+  const std::streamsize got = in.gcount();
+  static const unsigned char kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
+  if (got >= 4 && std::memcmp(magic, kExrMagic, 4) == 0) {
+    if (opts.level != 0) Fail(input + ": a master file has one level only; drop --level");
+    auto pano = encoder::ReadMasterFile(input);
+    if (!pano.ok()) Fail(input + ": " + pano.status().ToString());
+    return std::move(pano).value();
+  }
+  if (got == 8 && std::memcmp(magic, kSingleFileMagic, 8) == 0) {
+    const uint64_t size = fs::file_size(input, ec);
+    if (ec) Fail(input + ": cannot read its size (" + ec.message() + ")");
+    if (size > kMaxSingleFileBytes) {
+      Fail(input + ": " + std::to_string(size) + " bytes, more than the 4 GiB a single-file "
+                   "package may have here; unpack it into a folder");
+    }
+    std::vector<uint8_t> bytes(static_cast<size_t>(size));
+    in.seekg(0);
+    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
+    if (in.gcount() != static_cast<std::streamsize>(size)) Fail(input + ": read failed");
+    auto source = SingleFileSource::Create(std::move(bytes));
+    if (!source.ok()) Fail(input + ": " + source.status().ToString());
+    return read_package(**source);
+  }
+  Fail(input + ": neither a package folder, a single-file package (.c3d) nor a master file "
+               "(.exr)");
+}
+
+void RunExport(ExportOptions& opts) {
+  const auto start = std::chrono::steady_clock::now();
+  opts.gltf.texture_format =
+      opts.texture == "png" ? encoder::TextureFormat::kPng : encoder::TextureFormat::kJpeg;
+  opts.gltf.unlit = !opts.lit;
+  opts.gltf.normals = !opts.no_normals;
+  // Options first, so that a bad value fails before any work.
+  if (Status s = opts.gltf.Check(); !s.ok()) Fail(s.message());
+  if (Status s = opts.simplify_options.Check(); !s.ok()) Fail(s.message());
+  const fs::path out_dir = fs::absolute(opts.glb).parent_path();
+  if (!fs::is_directory(out_dir)) {
+    Fail(opts.glb + ": the folder " + out_dir.string() + " does not exist; create it first");
+  }
+
+  auto since = [](std::chrono::steady_clock::time_point t) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), " (%.2f s)",
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
+    return std::string(buf);
+  };
+  const TwoLayerPanorama pano = LoadPanorama(opts);
+  util::LogInfo("read " + opts.input + ": " + std::to_string(pano.width()) + "x" +
+                std::to_string(pano.height()) + " panorama" + since(start));
+  const auto mesh_start = std::chrono::steady_clock::now();
+
+  Mesh mesh;
+  if (!opts.no_simplify) {
+    opts.simplify_options.max_pixels =
+        std::max<int64_t>(opts.simplify_options.max_pixels,
+                          static_cast<int64_t>(pano.width()) * pano.height());
+    opts.simplify_options.validate_input = false;  // The readers validated it.
+    auto simplified = BuildSimplifiedMesh(pano, opts.simplify_options);
+    if (!simplified.ok()) Fail(opts.input + ": " + simplified.status().ToString());
+    if (!simplified->budget_met) {
+      util::LogWarning("the mesh keeps " + std::to_string(simplified->mesh.num_triangles()) +
+                       " triangles, over --max-triangles " +
+                       std::to_string(opts.simplify_options.max_triangles) +
+                       ", because --max-error " + Number(opts.simplify_options.max_relative_error) +
+                       " allows no coarser mesh");
+    }
+    util::LogInfo("simplified " + std::to_string(simplified->full_triangles) + " to " +
+                  std::to_string(simplified->mesh.num_triangles()) +
+                  " triangles, relative depth error at most " +
+                  Number(simplified->error_bound) + since(mesh_start));
+    mesh = std::move(simplified->mesh);
+  } else {
+    MeshBuildOptions build;
+    build.max_pixels = std::max<int64_t>(build.max_pixels,
+                                         static_cast<int64_t>(pano.width()) * pano.height());
+    build.validate_input = false;
+    auto full = BuildMesh(pano, build);
+    if (!full.ok()) Fail(opts.input + ": " + full.status().ToString());
+    mesh = std::move(full).value();
+  }
+  if (mesh.num_triangles() == 0) Fail(opts.input + ": the 3D photo has no triangles to export");
+
+  encoder::GltfExportStats stats;
+  const auto write_start = std::chrono::steady_clock::now();
+  const Status written =
+      encoder::ExportGlb(mesh, encoder::BuildColourAtlas(pano), opts.gltf, opts.glb, &stats);
+  util::LogInfo("encoded and wrote the GLB" + since(write_start));
+  if (!written.ok()) Fail(written.message());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "wrote %s: %zu vertices, %zu triangles, %dx%d %s texture (%s), mesh %s%s, "
+                "%s in total, %.2f s",
+                opts.glb.c_str(), stats.num_vertices, stats.num_triangles, stats.texture_width,
+                stats.texture_height, opts.texture == "png" ? "PNG" : "JPEG",
+                Megabytes(stats.texture_bytes).c_str(), Megabytes(stats.mesh_bytes).c_str(),
+                opts.gltf.draco ? " (Draco)" : "", Megabytes(stats.file_bytes).c_str(), seconds);
+  if (util::GetLogOptions().json) {
+    util::LogInfo(line);
+  } else {
+    std::printf("%s\n", line);
+  }
+}
+
+}  // namespace
+
+void AddExportCommand(CLI::App& app) {
+  auto opts = std::make_shared<ExportOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "export", "Write a 3D photo as a binary glTF (GLB) file: mesh, normals and colour texture");
+  cmd->add_option("input", opts->input,
+                  "Package folder, single-file package (.c3d) or master file (.exr)")
+      ->required();
+  cmd->add_option("--glb", opts->glb, "Output GLB file (written atomically)")->required();
+  cmd->add_flag("--draco", opts->gltf.draco,
+                "Compress the mesh with Draco (KHR_draco_mesh_compression)");
+  cmd->add_option("--max-triangles", opts->simplify_options.max_triangles,
+                  "Triangle budget of the simplified mesh (0: only --max-error limits it)")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 31));
+  cmd->add_option("--max-error", opts->simplify_options.max_relative_error,
+                  "Largest relative depth error of the simplification (0.01 = 1%)")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-6, 0.5));
+  cmd->add_flag("--no-simplify", opts->no_simplify,
+                "Export the full mesh, one vertex per node");
+  cmd->add_option("--level", opts->level, "Package level of detail to read (0 = full resolution)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
+  cmd->add_option("--texture", opts->texture, "Texture format")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"jpeg", "png"}));
+  cmd->add_option("--jpeg-quality", opts->gltf.jpeg_quality, "JPEG quality (1..100)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  cmd->add_option("--max-texture-size", opts->gltf.max_texture_size,
+                  "Longest texture side in pixels; larger atlases are shrunk (16..16384)")
+      ->capture_default_str()
+      ->check(CLI::Range(16, 16384));
+  cmd->add_flag("--no-normals", opts->no_normals, "Leave out the NORMAL attribute");
+  cmd->add_flag("--lit", opts->lit,
+                "Lit PBR material instead of KHR_materials_unlit (the photo's colours already "
+                "hold the scene's lighting)");
+  cmd->add_flag("--double-sided", opts->gltf.double_sided, "Render both sides of triangles");
+  cmd->add_option("--draco-position-bits", opts->gltf.draco_position_bits,
+                  "Draco position quantization bits (1..30)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 30));
+  cmd->add_option("--draco-normal-bits", opts->gltf.draco_normal_bits,
+                  "Draco normal quantization bits (1..30)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 30));
+  cmd->add_option("--draco-texcoord-bits", opts->gltf.draco_texcoord_bits,
+                  "Draco texture coordinate quantization bits (1..30)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 30));
+  cmd->add_option("--draco-level", opts->gltf.draco_compression_level,
+                  "Draco compression level, 0 (fast) .. 10 (small)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10));
+  cmd->add_option("--threads", opts->num_threads, "Tile decoding threads (0 = all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 256));
+  cmd->callback([opts]() { RunExport(*opts); });
+}
+
+}  // namespace casual3d::cli

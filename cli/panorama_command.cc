@@ -1,0 +1,66 @@
+// `casual3d panorama <workspace> -o <out> [--depth <dense-out>]`: warp, stitch,
+// fuse and normals (Sec. 4.4 and 5) into a master file, from a workspace of
+// undistorted photos with their depth maps.
+
+#include <cstdio>
+#include <string>
+
+#include "cli/command.h"
+#include "reconstruct/pipeline/panorama_stage.h"
+
+namespace casual3d::cli {
+
+void AddPanoramaCommand(CLI::App& app) {
+  struct Args {
+    std::string workspace;
+    std::string depth_dir;
+    std::string output;
+    pipeline::PanoramaStageOptions options;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "panorama",
+      "Warp, stitch and fuse the photos' depth maps into a two-layer panorama with normals "
+      "(master.exr and previews)");
+  cmd->add_option("workspace", args->workspace,
+                  "Workspace with images/ and sparse/ (sparse stage output or a synthetic capture)")
+      ->required();
+  cmd->add_option("--depth", args->depth_dir,
+                  "Folder holding depth/<photo>.exr (dense stage output); default: the workspace "
+                  "itself (ground-truth depth of a synthetic capture)");
+  cmd->add_option("-o,--output", args->output, "Output folder")->required();
+  cmd->add_option("--pano-width", args->options.pano_width,
+                  "Panorama width in pixels (height = width / 2)")
+      ->capture_default_str();
+  cmd->add_option("--solve-width", args->options.stitch.solve_width,
+                  "Width at which the stitching MRF is solved (height = width / 2)")
+      ->capture_default_str();
+  cmd->add_flag("--front-only", "Front layer only (no back layer)")
+      ->each([args](const std::string&) { args->options.back_layer = false; });
+  cmd->add_flag("--no-gc", "Stitch without the geometric-consistency cost")
+      ->each([args](const std::string&) { args->options.stitch.lambda_gc = 0.0; });
+  cmd->add_option("--sky-depth", args->options.sky_depth_m,
+                  "Depth for pixels without depth (sky), metres; 0 = automatic")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->options.num_threads, "Worker threads; 0 = all cores")
+      ->capture_default_str();
+  cmd->callback([args] {
+    pipeline::PanoramaStageOptions options = args->options;
+    options.stitch.solve_height = options.stitch.solve_width / 2;
+    const std::string depth_dir = args->depth_dir.empty() ? args->workspace : args->depth_dir;
+    pipeline::PanoramaStageReport r;
+    pipeline::RunPanoramaStage(args->workspace, depth_dir, args->output, options, &r);
+    std::printf(
+        "panorama: %d photos -> %dx%d, front coverage %.3f, back nodes %ld (+%ld hallucinated), "
+        "sky nodes %ld\n"
+        "seconds: load %.2f, warp %.2f, stitch front %.2f, back %.2f, fuse %.2f, normals %.2f, "
+        "write %.2f, total %.2f\n",
+        r.num_photos, r.width, r.height, r.front_coverage,
+        r.fuse.back_nodes_in - r.fuse.back_nodes_redundant, r.fuse.back_nodes_hallucinated,
+        r.normals.sky_nodes, r.seconds_load, r.seconds_warp, r.seconds_stitch_front,
+        r.seconds_stitch_back, r.seconds_fuse, r.seconds_normals, r.seconds_write,
+        r.seconds_total);
+  });
+}
+
+}  // namespace casual3d::cli

@@ -1,0 +1,92 @@
+// `casual3d reconstruct <photos> -o <out>`: the whole pipeline.
+
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "cli/command.h"
+#include "cli/viewer_assets.h"
+#include "reconstruct/pipeline/pipeline.h"
+
+namespace casual3d::cli {
+
+void AddReconstructCommand(CLI::App& app) {
+  struct Args {
+    std::string input;
+    std::string output;
+    std::string from = "sparse";
+    std::string to = "encode";
+    pipeline::PipelineOptions options;
+    double working_megapixels = 1.2;
+    int pano_width = 4096;
+    bool no_near_envelope = false;
+    bool no_gc_filter = false;
+    bool front_only = false;
+    bool debug = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "reconstruct",
+      "Turn a folder of photos (or a COLMAP workspace) into a web-ready 3D photo: sparse, dense, "
+      "panorama (warp, stitch, fuse, normals) and encode stages, resumable");
+  cmd->add_option("input", args->input, "Folder of photos (JPEG, PNG) or a COLMAP workspace")
+      ->required();
+  cmd->add_option("-o,--output", args->output,
+                  "Output folder: web/ (deployable package with index.html), photo.c3d, "
+                  "master.exr, preview/, report.json, work/ (stage caches)")
+      ->required();
+  cmd->add_option("--from", args->from, "First stage to run: sparse, dense, panorama, encode")
+      ->capture_default_str();
+  cmd->add_option("--to", args->to, "Last stage to run: sparse, dense, panorama, encode")
+      ->capture_default_str();
+  cmd->add_flag("--force", args->options.force, "Recompute the selected stages even if cached");
+  cmd->add_option("--pano-width", args->pano_width,
+                  "Panorama width in pixels (height = width / 2), even, 64..16384")
+      ->capture_default_str();
+  cmd->add_option("--working-megapixels", args->working_megapixels,
+                  "Photos are downscaled to about this size before matching and depth")
+      ->capture_default_str();
+  cmd->add_flag("--no-near-envelope", args->no_near_envelope,
+                "Ablation: dense stage without the near envelope prior (Sec. 4.3.2)");
+  cmd->add_flag("--no-gc-filter", args->no_gc_filter,
+                "Ablation: without the geometric-consistency filter and stitching cost");
+  cmd->add_flag("--front-only", args->front_only, "Ablation: front layer only, no back layer");
+  cmd->add_flag("--debug", args->debug, "Write colour-mapped PNGs of the dense intermediates");
+  cmd->add_option("--quality", args->options.color_quality, "WebP quality of colour tiles, 0..100")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->options.num_threads, "Worker threads; 0 = all cores")
+      ->capture_default_str();
+  cmd->callback([args] {
+    pipeline::PipelineOptions options = args->options;
+    if (!pipeline::StageFromName(args->from, &options.from)) {
+      throw std::invalid_argument("--from " + args->from +
+                                  ": not a stage (sparse, dense, panorama, encode)");
+    }
+    if (!pipeline::StageFromName(args->to, &options.to)) {
+      throw std::invalid_argument("--to " + args->to +
+                                  ": not a stage (sparse, dense, panorama, encode)");
+    }
+    options.sparse.import.working_megapixels = args->working_megapixels;
+    options.sparse.input_type = sfm::SparseInputType::kAuto;
+    options.dense.use_near_envelope = !args->no_near_envelope;
+    options.dense.use_gc_filter = !args->no_gc_filter;
+    options.dense.debug = args->debug;
+    options.panorama.pano_width = args->pano_width;
+    options.panorama.back_layer = !args->front_only;
+    if (args->no_gc_filter) options.panorama.stitch.lambda_gc = 0.0;
+    options.finish_web_package = [](const std::string& web_dir) { WriteViewerPage(web_dir); };
+    const pipeline::PipelineReport report =
+        pipeline::RunPipeline(args->input, args->output, options);
+    for (const pipeline::StageRun& run : report.stages) {
+      std::printf("%-9s %s\n", run.stage.c_str(),
+                  run.ran ? (std::to_string(run.seconds).substr(0, 6) + " s").c_str()
+                          : (run.cached ? "cached" : "skipped"));
+    }
+    if (!report.web_dir.empty()) {
+      std::printf("wrote the 3D photo to %s (total %.1f s)\nview it with: casual3d view %s\n",
+                  report.web_dir.c_str(), report.seconds_total, report.web_dir.c_str());
+    }
+  });
+}
+
+}  // namespace casual3d::cli

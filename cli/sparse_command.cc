@@ -1,0 +1,105 @@
+// `casual3d sparse <photos-or-colmap-workspace> -o <out> [options]`: the sparse
+// stage (reconstruct/sfm/sparse_stage.h). Parses options, runs the stage and
+// prints a short summary; the stage's output layout is spec/stage-sparse.md.
+
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "cli/command.h"
+#include "reconstruct/sfm/sparse_stage.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::cli {
+namespace {
+
+struct SparseCommandOptions {
+  std::string input;
+  std::string output;
+  std::string input_type = "auto";
+  std::string matcher = "auto";
+  bool camera_per_photo = false;
+  sfm::SparseStageOptions stage;
+};
+
+void RunSparse(SparseCommandOptions options) {
+  static const std::map<std::string, sfm::SparseInputType> kInputTypes = {
+      {"auto", sfm::SparseInputType::kAuto},
+      {"photos", sfm::SparseInputType::kPhotos},
+      {"workspace", sfm::SparseInputType::kWorkspace}};
+  static const std::map<std::string, sfm::MatcherType> kMatchers = {
+      {"auto", sfm::MatcherType::kAuto},
+      {"exhaustive", sfm::MatcherType::kExhaustive},
+      {"sequential", sfm::MatcherType::kSequential}};
+  options.stage.input_type = kInputTypes.at(options.input_type);
+  options.stage.matcher = kMatchers.at(options.matcher);
+  options.stage.shared_camera = !options.camera_per_photo;
+  const Status status = options.stage.Check();
+  if (!status.ok()) throw std::invalid_argument(status.message());
+
+  const sfm::SparseStageResult r = sfm::RunSparseStage(options.input, options.output, options.stage);
+  std::string timings;
+  for (const auto& [step, s] : r.timings_s) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%s%s %.1f s", timings.empty() ? "" : ", ", step.c_str(), s);
+    timings += buf;
+  }
+  std::printf("%s: %d of %d photos registered, %d points, %.2f px mean reprojection error\n",
+              options.output.c_str(), r.num_registered, r.num_photos, r.num_points,
+              r.mean_reprojection_error_px);
+  std::printf("frame: %s capture, rig radius %.3g; timings: %s\n",
+              r.frame.full_capture ? "full 360-degree" : "partial", r.frame.rig_radius,
+              timings.c_str());
+}
+
+}  // namespace
+
+void AddSparseCommand(CLI::App& app) {
+  auto options = std::make_shared<SparseCommandOptions>();
+  sfm::SparseStageOptions& s = options->stage;
+  CLI::App* cmd = app.add_subcommand(
+      "sparse",
+      "Calibrate the cameras of a folder of photos (or an existing COLMAP workspace) with COLMAP "
+      "and write undistorted photos, the sparse model, the 3D photo's frame and depth ranges");
+  cmd->add_option("input", options->input, "Folder of photos (JPEG, PNG) or COLMAP workspace")
+      ->required();
+  cmd->add_option("-o,--output", options->output, "Output folder (must not exist)")->required();
+  cmd->add_option("--input-type", options->input_type, "auto, photos or workspace")
+      ->check(CLI::IsMember({"auto", "photos", "workspace"}))
+      ->capture_default_str();
+  cmd->add_option("--working-megapixels", s.import.working_megapixels,
+                  "Downsample photos to about this many megapixels before matching [0.05, 100]")
+      ->capture_default_str();
+  cmd->add_option("--focal-px", s.import.focal_px,
+                  "Focal length prior in pixels at the photos' original size (default: EXIF)");
+  cmd->add_flag("--skip-unreadable", s.import.skip_unreadable,
+                "Skip unreadable or corrupt photos instead of stopping");
+  cmd->add_flag("--mixed-cameras", s.import.allow_mixed_devices,
+                "Accept photos from different cameras (one calibration per camera)");
+  cmd->add_option("--camera-model", s.camera_model,
+                  "COLMAP camera model: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV")
+      ->check(CLI::IsMember({"SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV"}))
+      ->capture_default_str();
+  cmd->add_flag("--camera-per-photo", options->camera_per_photo,
+                "Calibrate every photo separately (zooming or unknown cameras)");
+  cmd->add_option("--matcher", options->matcher, "auto, exhaustive or sequential")
+      ->check(CLI::IsMember({"auto", "exhaustive", "sequential"}))
+      ->capture_default_str();
+  cmd->add_option("--max-features", s.max_features, "SIFT features per photo [500, 100000]")
+      ->capture_default_str();
+  cmd->add_option("--threads", s.num_threads, "Threads for COLMAP (0: all cores)")
+      ->capture_default_str();
+  cmd->add_option("--min-registered", s.min_registered_fraction,
+                  "Fail if fewer than this fraction of the photos register [0, 1]")
+      ->capture_default_str();
+  cmd->add_flag("--robust-centre", s.frame.robust_centre,
+                "Centre the 3D photo at the geometric median of the cameras, not their mean");
+  cmd->add_option("--colmap", s.colmap_path, "Path of the colmap program (default: PATH)");
+  cmd->add_flag("--overwrite", s.overwrite, "Replace an existing output folder when done");
+  cmd->add_flag("--keep-work", s.keep_work, "Keep COLMAP's database and raw models in OUT/work");
+  cmd->callback([options] { RunSparse(*options); });
+}
+
+}  // namespace casual3d::cli

@@ -1,0 +1,139 @@
+#include "cli/viewer_assets.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+#include <vector>
+
+namespace casual3d::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+// The file whose presence marks a folder as holding the built viewer.
+constexpr const char* kViewerEntry = "casual3d-viewer.js";
+
+bool HoldsViewer(const fs::path& dir) {
+  std::error_code ec;
+  return fs::is_regular_file(dir / kViewerEntry, ec);
+}
+
+fs::path ExecutableDir() {
+  std::vector<char> buffer(4096);
+  const ssize_t n = readlink("/proc/self/exe", buffer.data(), buffer.size() - 1);
+  if (n <= 0) return {};
+  return fs::path(std::string(buffer.data(), static_cast<size_t>(n))).parent_path();
+}
+
+std::string TempSuffix() {
+  std::random_device rd;
+  return ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(rd() % 1000000);
+}
+
+// Writes `bytes` to `path` through a temporary file in the same folder.
+void WriteFileAtomically(const fs::path& path, const std::string& bytes) {
+  const fs::path tmp = path.string() + TempSuffix();
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      fs::remove(tmp, ignored);
+      throw std::runtime_error(path.string() + ": cannot write (check the folder exists and is writable)");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error(path.string() + ": cannot rename the temporary file into place");
+  }
+}
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot read the viewer file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string HtmlEscape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+fs::path FindViewerDir() {
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("CASUAL3D_VIEWER_DIR"); env && *env) candidates.emplace_back(env);
+  const fs::path exe_dir = ExecutableDir();
+  if (!exe_dir.empty()) candidates.push_back(exe_dir / ".." / "share" / "casual3d" / "viewer");
+#ifdef CASUAL3D_VIEWER_BUILD_DIR
+  candidates.emplace_back(CASUAL3D_VIEWER_BUILD_DIR);
+#endif
+  std::string searched;
+  for (const fs::path& dir : candidates) {
+    if (HoldsViewer(dir)) return dir.lexically_normal();
+    searched += (searched.empty() ? "" : ", ") + dir.lexically_normal().string();
+  }
+  throw std::runtime_error("the web viewer files (" + std::string(kViewerEntry) +
+                           ") are not in " + searched +
+                           "; build the wasm-viewer target or set CASUAL3D_VIEWER_DIR");
+}
+
+std::string ViewerPageHtml(const std::string& title, const std::string& viewer_url_prefix) {
+  const std::string t = HtmlEscape(title);
+  const std::string p = HtmlEscape(viewer_url_prefix);
+  return "<!DOCTYPE html>\n"
+         "<html lang=\"en\">\n"
+         "<head>\n"
+         "<meta charset=\"utf-8\">\n"
+         "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+         "<title>" + t + "</title>\n"
+         "<script type=\"module\" src=\"" + p + kViewerEntry + "\"></script>\n"
+         "<style>html,body{margin:0;height:100%;background:#000}"
+         "casual3d-viewer{display:block;width:100%;height:100%}</style>\n"
+         "</head>\n"
+         "<body>\n"
+         "<casual3d-viewer src=\"manifest.json\" controls></casual3d-viewer>\n"
+         "</body>\n"
+         "</html>\n";
+}
+
+void WriteViewerPage(const fs::path& package_dir) {
+  std::error_code ec;
+  if (!fs::is_directory(package_dir, ec)) {
+    throw std::runtime_error(package_dir.string() + ": not a folder; write the package first");
+  }
+  const fs::path source = FindViewerDir();
+  const fs::path target = package_dir / kViewerSubdir;
+  fs::create_directories(target, ec);
+  if (ec) throw std::runtime_error(target.string() + ": cannot create the folder: " + ec.message());
+  for (const fs::directory_entry& entry : fs::directory_iterator(source, ec)) {
+    if (!entry.is_regular_file()) continue;
+    WriteFileAtomically(target / entry.path().filename(), ReadFile(entry.path()));
+  }
+  if (ec) throw std::runtime_error(source.string() + ": cannot list the viewer files: " + ec.message());
+  std::string title = fs::absolute(package_dir).lexically_normal().filename().string();
+  if (title.empty()) title = fs::absolute(package_dir).lexically_normal().parent_path().filename().string();
+  WriteFileAtomically(package_dir / "index.html", ViewerPageHtml(title + " - casual3d", "viewer/"));
+}
+
+}  // namespace casual3d::cli

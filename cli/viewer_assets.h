@@ -1,0 +1,35 @@
+#pragma once
+
+// The built web viewer (wasm-viewer/) and the page that embeds it, so that the
+// output folder of `casual3d encode` and `casual3d reconstruct` is deployable to
+// any static host as is, and `casual3d view` can serve it.
+//
+// Where the viewer files are found, first match wins:
+//   1. $CASUAL3D_VIEWER_DIR (a folder holding casual3d-viewer.js and friends);
+//   2. <dir of the casual3d binary>/../share/casual3d/viewer (the install layout);
+//   3. the build tree's <build>/wasm-viewer/dist (compiled in by CMake), so a
+//      freshly built, uninstalled binary works too.
+
+#include <filesystem>
+#include <string>
+
+namespace casual3d::cli {
+
+// Name of the folder inside a package that holds the viewer files.
+constexpr const char* kViewerSubdir = "viewer";
+
+// Returns the folder holding the built viewer files (see above). Throws
+// std::runtime_error naming the places searched when none holds the viewer.
+std::filesystem::path FindViewerDir();
+
+// The index.html of a package folder: one <casual3d-viewer> element showing
+// manifest.json, loading the viewer from `viewer_url_prefix` (e.g. "viewer/").
+std::string ViewerPageHtml(const std::string& title, const std::string& viewer_url_prefix);
+
+// Copies the viewer files into <package_dir>/viewer/ and writes
+// <package_dir>/index.html. Files are written under temporary names and renamed,
+// so an interrupted run never leaves a half-written file. Throws
+// std::runtime_error naming the file on failure (package_dir must exist).
+void WriteViewerPage(const std::filesystem::path& package_dir);
+
+}  // namespace casual3d::cli

@@ -1,0 +1,100 @@
+#include "cli/viewer_assets.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace casual3d::cli {
+namespace {
+namespace fs = std::filesystem;
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void Write(const fs::path& p, const std::string& s) {
+  std::ofstream out(p, std::ios::binary);
+  out << s;
+}
+
+class ViewerAssetsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("casual3d_viewer_assets_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    fs::create_directories(root_ / "viewer");
+    fs::create_directories(root_ / "package");
+    Write(root_ / "viewer" / "casual3d-viewer.js", "export {};\n");
+    Write(root_ / "viewer" / "casual3d-format.wasm", std::string("\0asm\1\0\0\0", 8));
+    setenv("CASUAL3D_VIEWER_DIR", (root_ / "viewer").c_str(), 1);
+  }
+  void TearDown() override {
+    unsetenv("CASUAL3D_VIEWER_DIR");
+    fs::remove_all(root_);
+  }
+  fs::path root_;
+};
+
+TEST_F(ViewerAssetsTest, FindsTheViewerThroughTheEnvironment) {
+  EXPECT_EQ(FindViewerDir(), (root_ / "viewer").lexically_normal());
+}
+
+TEST_F(ViewerAssetsTest, CopiesTheViewerAndWritesTheIndexPage) {
+  WriteViewerPage(root_ / "package");
+  EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-viewer.js"), "export {};\n");
+  EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-format.wasm").size(), 8u);
+  const std::string html = Read(root_ / "package" / "index.html");
+  EXPECT_NE(html.find("<script type=\"module\" src=\"viewer/casual3d-viewer.js\"></script>"), std::string::npos);
+  EXPECT_NE(html.find("<casual3d-viewer src=\"manifest.json\""), std::string::npos);
+  EXPECT_NE(html.find("<title>package - casual3d</title>"), std::string::npos);
+  // No temporary files are left behind.
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(root_ / "package")) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+    files += e.is_regular_file();
+  }
+  EXPECT_EQ(files, 3);
+  // Writing again replaces the files in place.
+  Write(root_ / "viewer" / "casual3d-viewer.js", "export const v = 2;\n");
+  WriteViewerPage(root_ / "package");
+  EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-viewer.js"), "export const v = 2;\n");
+}
+
+TEST_F(ViewerAssetsTest, EscapesTheTitle) {
+  const std::string html = ViewerPageHtml("a<b>&\"c\"", "viewer/");
+  EXPECT_NE(html.find("<title>a&lt;b&gt;&amp;&quot;c&quot;</title>"), std::string::npos);
+}
+
+TEST_F(ViewerAssetsTest, RefusesAMissingPackageFolder) {
+  try {
+    WriteViewerPage(root_ / "nope");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nope: not a folder"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ViewerAssetsTest, NamesThePlacesSearchedWhenTheViewerIsMissing) {
+  setenv("CASUAL3D_VIEWER_DIR", (root_ / "empty").c_str(), 1);
+  try {
+    FindViewerDir();
+    // A built viewer in the build tree may legitimately be found instead.
+    SUCCEED();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find((root_ / "empty").string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("CASUAL3D_VIEWER_DIR"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace casual3d::cli

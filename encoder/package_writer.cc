@@ -1,0 +1,306 @@
+#include "encoder/package_writer.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+#include <system_error>
+#include <thread>
+
+#include "encoder/level_of_detail.h"
+#include "encoder/webp_codec.h"
+#include "format/sha256.h"
+#include "format/single_file.h"
+#include "format/tile_codec.h"
+
+namespace casual3d::encoder {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string TilePath(int level, int row, int column, TileImageKind kind) {
+  return "l" + std::to_string(level) + "/" + std::to_string(row) + "-" + std::to_string(column) +
+         "." + TileImageKindName(kind) + ".webp";
+}
+
+// Number of levels for `options.levels` == 0.
+int AutomaticLevels(int width, int height) {
+  int levels = 1;
+  while (levels < kMaxLevels && (width >> (levels - 1)) > 512 &&
+         ((width >> (levels - 1)) % 2) == 0 && ((height >> (levels - 1)) % 2) == 0)
+    ++levels;
+  return levels;
+}
+
+DepthQuantization DepthRange(const TwoLayerPanorama& pano) {
+  double near_m = 0, far_m = 0;
+  bool any = false;
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& L = pano.layer(l);
+    for (size_t i = 0; i < L.present.size(); ++i) {
+      if (!L.present[i]) continue;
+      const double d = L.depth_m[i];
+      near_m = any ? std::min(near_m, d) : d;
+      far_m = any ? std::max(far_m, d) : d;
+      any = true;
+    }
+  }
+  DepthQuantization q;
+  q.near_m = any ? near_m : 1.0;
+  q.far_m = any ? far_m : 1.0;
+  return q;
+}
+
+std::string UniqueSuffix() {
+  static std::atomic<int> counter{0};
+  return std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+Status WriteBytes(const fs::path& path, const std::vector<uint8_t>& bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (f == nullptr) return IoError(path.string() + ": cannot create the file");
+  const size_t written = bytes.empty() ? 0 : std::fwrite(bytes.data(), 1, bytes.size(), f);
+  const bool closed = std::fclose(f) == 0;
+  if (written != bytes.size() || !closed)
+    return IoError(path.string() + ": write failed (disk full?)");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status PackageOptions::Check() const {
+  if (tile_size < kMinTileSize || tile_size > kMaxTileSize)
+    return InvalidArgument("tile_size " + std::to_string(tile_size) + " is outside [" +
+                           std::to_string(kMinTileSize) + ", " + std::to_string(kMaxTileSize) +
+                           "]");
+  if (levels < 0 || levels > kMaxLevels)
+    return InvalidArgument("levels " + std::to_string(levels) + " is outside [0, " +
+                           std::to_string(kMaxLevels) + "] (0 = automatic)");
+  if (!(color_quality >= 0.0f && color_quality <= 100.0f))
+    return InvalidArgument("color_quality " + std::to_string(color_quality) +
+                           " is outside [0, 100]");
+  if (color_method < 0 || color_method > 6)
+    return InvalidArgument("color_method " + std::to_string(color_method) + " is outside [0, 6]");
+  if (!(lossless_effort >= 0.0f && lossless_effort <= 100.0f))
+    return InvalidArgument("lossless_effort " + std::to_string(lossless_effort) +
+                           " is outside [0, 100]");
+  if (lossless_method < 0 || lossless_method > 6)
+    return InvalidArgument("lossless_method " + std::to_string(lossless_method) +
+                           " is outside [0, 6]");
+  DepthQuantization depth;
+  depth.bits = depth_bits;
+  CASUAL3D_RETURN_IF_ERROR(depth.Check());
+  NormalQuantization normal;
+  normal.bits = normal_bits;
+  CASUAL3D_RETURN_IF_ERROR(normal.Check());
+  if (num_threads < 0 || num_threads > 256)
+    return InvalidArgument("num_threads " + std::to_string(num_threads) +
+                           " is outside [0, 256] (0 = all cores)");
+  return Status::Ok();
+}
+
+StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const PackageOptions& options,
+                                     PackageStats* stats) {
+  CASUAL3D_RETURN_IF_ERROR(options.Check());
+  if (pano.width() > kMaxPackageWidth || pano.height() > kMaxPackageHeight)
+    return InvalidArgument("panorama " + std::to_string(pano.width()) + "x" +
+                           std::to_string(pano.height()) + " exceeds the package limit of " +
+                           std::to_string(kMaxPackageWidth) + "x" +
+                           std::to_string(kMaxPackageHeight));
+  Status valid = pano.Validate();
+  if (!valid.ok()) return InvalidArgument("the panorama is invalid: " + valid.message());
+  const int num_levels =
+      options.levels > 0 ? options.levels : AutomaticLevels(pano.width(), pano.height());
+  const int divisor = 1 << (num_levels - 1);
+  if (pano.width() % divisor != 0 || pano.height() % divisor != 0)
+    return InvalidArgument(std::to_string(num_levels) + " levels need width and height divisible "
+                           "by " + std::to_string(divisor) + ", but the panorama is " +
+                           std::to_string(pano.width()) + "x" + std::to_string(pano.height()) +
+                           "; use fewer levels");
+
+  // Coarser levels by repeated halving.
+  std::vector<TwoLayerPanorama> coarse;
+  std::vector<const TwoLayerPanorama*> level_pano = {&pano};
+  coarse.reserve(num_levels);
+  for (int l = 1; l < num_levels; ++l) {
+    CASUAL3D_ASSIGN_OR_RETURN(TwoLayerPanorama half, HalvePanorama(*level_pano.back()));
+    coarse.push_back(std::move(half));
+    level_pano.push_back(&coarse.back());
+  }
+
+  Manifest manifest;
+  manifest.generator = options.generator;
+  manifest.width = pano.width();
+  manifest.height = pano.height();
+  manifest.frame = pano.frame();
+  manifest.tile_size = options.tile_size;
+  manifest.depth = DepthRange(pano);
+  manifest.depth.bits = options.depth_bits;
+  manifest.normal.bits = options.normal_bits;
+
+  struct Job {
+    int level, tile;
+    TileImageKind kind;
+    std::string path;
+    std::vector<uint8_t> bytes;
+  };
+  std::vector<Job> jobs;
+  for (int l = 0; l < num_levels; ++l) {
+    LevelEntry L;
+    L.width = level_pano[l]->width();
+    L.height = level_pano[l]->height();
+    L.columns = (L.width + options.tile_size - 1) / options.tile_size;
+    L.rows = (L.height + options.tile_size - 1) / options.tile_size;
+    if (L.columns * L.rows > kMaxTilesPerLevel)
+      return InvalidArgument("tile_size " + std::to_string(options.tile_size) + " gives " +
+                             std::to_string(L.columns * L.rows) + " tiles at level " +
+                             std::to_string(l) + ", more than " +
+                             std::to_string(kMaxTilesPerLevel) + "; use larger tiles");
+    L.tiles.resize(static_cast<size_t>(L.columns) * L.rows);
+    for (int t = 0; t < L.columns * L.rows; ++t) {
+      for (int k = 0; k < kNumTileImageKinds; ++k) {
+        const TileImageKind kind = static_cast<TileImageKind>(k);
+        const std::string path = TilePath(l, t / L.columns, t % L.columns, kind);
+        L.tiles[t].files[k] = path;
+        jobs.push_back({l, t, kind, path, {}});
+      }
+    }
+    manifest.levels.push_back(std::move(L));
+  }
+
+  std::atomic<size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex error_mutex;
+  Status first_error;
+  auto work = [&] {
+    while (!failed.load()) {
+      const size_t j = next.fetch_add(1);
+      if (j >= jobs.size()) return;
+      Job& job = jobs[j];
+      int x, y, w, h;
+      manifest.TileRect(job.level, job.tile, &x, &y, &w, &h);
+      const Image8 image =
+          EncodeTileImage(*level_pano[job.level], x, y, w, h, job.kind, manifest.quantization());
+      WebpEncodeOptions webp;
+      webp.lossless = TileImageIsLossless(job.kind);
+      webp.quality = webp.lossless ? options.lossless_effort : options.color_quality;
+      webp.method = webp.lossless ? options.lossless_method : options.color_method;
+      StatusOr<std::vector<uint8_t>> bytes = EncodeWebp(image.view(), webp);
+      if (!bytes.ok()) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!failed.exchange(true))
+          first_error = Status(bytes.status().code(), job.path + ": " + bytes.status().message());
+        return;
+      }
+      job.bytes = std::move(*bytes);
+    }
+  };
+  int threads = options.num_threads > 0 ? options.num_threads
+                                        : static_cast<int>(std::thread::hardware_concurrency());
+  threads = std::max(1, std::min<int>(threads, static_cast<int>(jobs.size())));
+  if (threads == 1) {
+    work();
+  } else {
+    std::vector<std::thread> pool;
+    for (int i = 0; i < threads; ++i) pool.emplace_back(work);
+    for (std::thread& t : pool) t.join();
+  }
+  if (failed.load()) return first_error;
+
+  std::sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.path < b.path; });
+  PackageFiles files;
+  files.reserve(jobs.size() + 1);
+  files.emplace_back(kManifestFileName, std::vector<uint8_t>());
+  PackageStats s;
+  s.level_bytes.assign(num_levels, 0);
+  for (Job& job : jobs) {
+    manifest.files.push_back(
+        {job.path, job.bytes.size(), Sha256Hex(job.bytes.data(), job.bytes.size())});
+    s.level_bytes[job.level] += job.bytes.size();
+    s.total_bytes += job.bytes.size();
+    files.emplace_back(job.path, std::move(job.bytes));
+  }
+  Status manifest_ok = manifest.Validate();
+  if (!manifest_ok.ok()) return InternalError("encoder built an invalid manifest: " +
+                                              manifest_ok.message());
+  const std::string text = SerializeManifest(manifest);
+  files[0].second.assign(text.begin(), text.end());
+  s.manifest_bytes = text.size();
+  s.total_bytes += text.size();
+  s.num_files = static_cast<int>(files.size());
+  if (stats != nullptr) *stats = std::move(s);
+  return files;
+}
+
+Status WritePackageFolder(const PackageFiles& files, const std::string& dir) {
+  if (dir.empty()) return InvalidArgument("the output folder name is empty");
+  std::error_code ec;
+  const fs::path target = fs::path(dir).lexically_normal();
+  const fs::path clean = target.filename().empty() ? target.parent_path() : target;
+  if (fs::exists(clean, ec)) {
+    if (!fs::is_directory(clean, ec))
+      return InvalidArgument(dir + ": exists and is not a folder; choose another output name");
+    const bool is_package = fs::exists(clean / kManifestFileName, ec);
+    if (!is_package && !fs::is_empty(clean, ec))
+      return InvalidArgument(dir + ": exists and is not a casual3d package (no manifest.json); "
+                                   "refusing to replace it, choose another output folder");
+  }
+  const fs::path tmp = clean.string() + ".tmp-" + UniqueSuffix();
+  fs::create_directories(tmp, ec);
+  if (ec) return IoError(tmp.string() + ": cannot create the folder: " + ec.message());
+  auto cleanup = [&] {
+    std::error_code ignored;
+    fs::remove_all(tmp, ignored);
+  };
+  for (const auto& [path, bytes] : files) {
+    if (!IsSafePackagePath(path)) {
+      cleanup();
+      return InternalError("unsafe package path \"" + path + "\"");
+    }
+    const fs::path file = tmp / path;
+    fs::create_directories(file.parent_path(), ec);
+    Status s = ec ? IoError(file.parent_path().string() + ": " + ec.message())
+                  : WriteBytes(file, bytes);
+    if (!s.ok()) {
+      cleanup();
+      return s;
+    }
+  }
+  fs::path old;
+  if (fs::exists(clean, ec)) {
+    old = clean.string() + ".old-" + UniqueSuffix();
+    fs::rename(clean, old, ec);
+    if (ec) {
+      cleanup();
+      return IoError(dir + ": cannot move the previous package aside: " + ec.message());
+    }
+  }
+  fs::rename(tmp, clean, ec);
+  if (ec) {
+    const std::string message = ec.message();
+    if (!old.empty()) fs::rename(old, clean, ec);
+    cleanup();
+    return IoError(dir + ": cannot move the new package into place: " + message);
+  }
+  if (!old.empty()) fs::remove_all(old, ec);
+  return Status::Ok();
+}
+
+Status WritePackageSingleFile(const PackageFiles& files, const std::string& path) {
+  CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> container, BuildSingleFile(files));
+  const fs::path tmp = path + ".tmp-" + UniqueSuffix();
+  Status s = WriteBytes(tmp, container);
+  std::error_code ec;
+  if (s.ok()) {
+    fs::rename(tmp, path, ec);
+    if (ec) s = IoError(path + ": cannot move the finished file into place: " + ec.message());
+  }
+  if (!s.ok()) fs::remove(tmp, ec);
+  return s;
+}
+
+}  // namespace casual3d::encoder

@@ -1,0 +1,72 @@
+#pragma once
+
+// Writes a two-layer panorama as a casual3d web package (spec/package.md): a
+// folder of static files, manifest.json plus per level and tile a lossy colour
+// WebP and lossless depth, normal and graph WebPs; or the same files as one
+// single-file container (.c3d).
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "format/manifest.h"
+#include "format/status.h"
+#include "format/two_layer.h"
+
+namespace casual3d::encoder {
+
+struct PackageOptions {
+  // Tile side, pixels, at every level: [kMinTileSize, kMaxTileSize] (16..4096).
+  int tile_size = 512;
+  // Levels of detail, 1..kMaxLevels; 0 = automatic: halve while the coarsest
+  // level is wider than 512 pixels and its size is even.
+  int levels = 0;
+  // Lossy WebP quality of the colour images, 0..100.
+  float color_quality = 90.0f;
+  // libwebp method (speed/size, 0 fastest .. 6 smallest) for colour images.
+  int color_method = 3;
+  // Lossless WebP effort (0..100) and method (0..6) for depth, normal, graph.
+  float lossless_effort = 25.0f;
+  int lossless_method = 1;
+  // Depth code bits (8..16; spec/package.md, depth_encoding): 12 keeps the
+  // relative depth error below 0.09% for far/near up to 1000.
+  int depth_bits = 12;
+  // Octahedral normal bits per coordinate (4..8): 8 gives at most ~0.9 degrees.
+  int normal_bits = 8;
+  // Threads encoding tiles; 0 = all cores.
+  int num_threads = 0;
+  // Written to the manifest's "generator" member.
+  std::string generator = "casual3d";
+
+  Status Check() const;
+};
+
+// Sizes and timing of an encoded package.
+struct PackageStats {
+  uint64_t total_bytes = 0;               // All files including manifest.json.
+  std::vector<uint64_t> level_bytes;      // Tile files per level (finest first).
+  uint64_t manifest_bytes = 0;
+  int num_files = 0;
+};
+
+// The files of a package in memory: manifest.json first, then the tile files
+// sorted by path.
+using PackageFiles = std::vector<std::pair<std::string, std::vector<uint8_t>>>;
+
+// Encodes `pano` (which must Validate()) into package files. Fails with
+// kInvalidArgument naming the option or the panorama problem (for example a
+// size that cannot be halved `levels - 1` times).
+StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const PackageOptions& options,
+                                     PackageStats* stats = nullptr);
+
+// Writes package files into folder `dir` atomically: everything goes to a
+// temporary folder next to it that then replaces `dir`. An existing `dir` is
+// replaced only if it is empty or holds a package (a manifest.json); anything
+// else is refused, so that no unrelated folder is ever deleted.
+Status WritePackageFolder(const PackageFiles& files, const std::string& dir);
+
+// Writes package files as one single-file container at `path`, atomically.
+Status WritePackageSingleFile(const PackageFiles& files, const std::string& path);
+
+}  // namespace casual3d::encoder

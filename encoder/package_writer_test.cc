@@ -1,0 +1,199 @@
+#include "encoder/package_writer.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "encoder/level_of_detail.h"
+#include "encoder/webp_codec.h"
+#include "format/file_source.h"
+#include "format/package_reader.h"
+#include "format/package_test_scene.h"
+
+namespace casual3d::encoder {
+namespace {
+
+namespace fs = std::filesystem;
+
+class PackageWriterTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("casual3d_package_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    pano_ = casual3d::testing::MakePackageTestPanorama(512, 256);
+    options_.tile_size = 128;
+    options_.levels = 3;
+    options_.num_threads = 2;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  PackageFiles Encode(PackageStats* stats = nullptr) {
+    StatusOr<PackageFiles> files = EncodePackage(pano_, options_, stats);
+    EXPECT_TRUE(files.ok()) << files.status().ToString();
+    return files.ok() ? *files : PackageFiles();
+  }
+
+  fs::path dir_;
+  TwoLayerPanorama pano_;
+  PackageOptions options_;
+  WebpImageDecoder decoder_;
+};
+
+double ColorPsnr(const TwoLayerPanorama& a, const TwoLayerPanorama& b) {
+  double se = 0;
+  size_t n = 0;
+  for (int l = 0; l < kNumLayers; ++l)
+    for (size_t i = 0; i < a.layer(l).present.size(); ++i) {
+      if (!a.layer(l).present[i]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(a.layer(l).rgb[3 * i + c]) - b.layer(l).rgb[3 * i + c];
+        se += d * d;
+        ++n;
+      }
+    }
+  return 10 * std::log10(255.0 * 255.0 / (se / n));
+}
+
+// Graph exact, depth within the encoding's bound, normals within 1 degree.
+void ExpectDecodedMatches(const TwoLayerPanorama& expected, const TwoLayerPanorama& decoded,
+                          const DepthQuantization& q, double min_psnr) {
+  ASSERT_EQ(decoded.width(), expected.width());
+  ASSERT_EQ(decoded.height(), expected.height());
+  const double bound = q.MaxRelativeError() * 1.01 + 1e-7;
+  double worst_depth = 0, worst_angle = 0;
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& E = expected.layer(l);
+    const LayerData& D = decoded.layer(l);
+    ASSERT_EQ(E.present, D.present);
+    ASSERT_EQ(E.label, D.label);
+    ASSERT_EQ(E.links, D.links);
+    for (size_t i = 0; i < E.present.size(); ++i) {
+      if (!E.present[i]) continue;
+      worst_depth = std::max(worst_depth, std::fabs(D.depth_m[i] / E.depth_m[i] - 1.0));
+      double dot = 0, ne = 0;
+      for (int c = 0; c < 3; ++c) {
+        dot += double(E.normal[3 * i + c]) * D.normal[3 * i + c];
+        ne += double(E.normal[3 * i + c]) * E.normal[3 * i + c];
+      }
+      if (ne == 0) {
+        ASSERT_EQ(D.normal[3 * i] + D.normal[3 * i + 1] + D.normal[3 * i + 2], 0.0f);
+        continue;
+      }
+      worst_angle = std::max(worst_angle, std::acos(std::fmin(1.0, dot)) * 180 / M_PI);
+    }
+  }
+  EXPECT_LE(worst_depth, bound);
+  EXPECT_LT(worst_angle, 1.0);
+  EXPECT_GT(ColorPsnr(expected, decoded), min_psnr);
+  for (int i = 0; i < 9; ++i) EXPECT_EQ(decoded.frame().rotation[i], expected.frame().rotation[i]);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(decoded.frame().centre[i], expected.frame().centre[i]);
+}
+
+TEST_F(PackageWriterTest, FolderRoundTripAtEveryLevel) {
+  PackageStats stats;
+  const PackageFiles files = Encode(&stats);
+  ASSERT_EQ(files.front().first, "manifest.json");
+  EXPECT_EQ(stats.level_bytes.size(), 3u);
+  EXPECT_EQ(stats.num_files, 1 + 4 * (4 * 2 + 2 * 1 + 1 * 1));
+  EXPECT_LT(stats.level_bytes[2], stats.level_bytes[0] / 4);
+  const std::string dir = (dir_ / "pkg").string();
+  ASSERT_TRUE(WritePackageFolder(files, dir).ok());
+  FolderFileSource source(dir);
+  TwoLayerPanorama expected = pano_;
+  for (int level = 0; level < 3; ++level) {
+    ReadOptions read;
+    read.level = level;
+    read.num_threads = 2;
+    Manifest manifest;
+    StatusOr<TwoLayerPanorama> decoded = ReadPackage(source, decoder_, read, &manifest);
+    ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+    EXPECT_NEAR(manifest.depth.near_m, 2.0, 0.01);
+    EXPECT_NEAR(manifest.depth.far_m, 100.0, 1e-9);
+    // Coarser levels hold more detail per pixel, which lossy coding keeps less well.
+    const double min_psnr[3] = {37.5, 35.5, 33.5};
+    ExpectDecodedMatches(expected, *decoded, manifest.depth, min_psnr[level]);
+    std::printf("level %d: colour PSNR %.2f dB\n", level, ColorPsnr(expected, *decoded));
+    if (level < 2) expected = *HalvePanorama(expected);
+  }
+  // Rewriting over an existing package replaces it; no temporary folder is left.
+  ASSERT_TRUE(WritePackageFolder(files, dir).ok());
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir_)) entries += 1 + 0 * e.is_directory();
+  EXPECT_EQ(entries, 1);
+}
+
+TEST_F(PackageWriterTest, SingleFileGivesTheSamePanorama) {
+  const PackageFiles files = Encode();
+  const std::string path = (dir_ / "scene.c3d").string();
+  ASSERT_TRUE(WritePackageSingleFile(files, path).ok());
+  ASSERT_TRUE(WritePackageFolder(files, (dir_ / "pkg").string()).ok());
+  std::ifstream in(path, std::ios::binary);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  StatusOr<std::unique_ptr<SingleFileSource>> single = SingleFileSource::Create(bytes);
+  ASSERT_TRUE(single.ok()) << single.status().ToString();
+  StatusOr<TwoLayerPanorama> a = ReadPackage(**single, decoder_);
+  StatusOr<TwoLayerPanorama> b = ReadPackage(FolderFileSource((dir_ / "pkg").string()), decoder_);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_TRUE(*a == *b);
+}
+
+TEST_F(PackageWriterTest, CorruptPackagesGiveClearErrors) {
+  const PackageFiles files = Encode();
+  auto read_with = [&](const std::string& path, const std::vector<uint8_t>* replacement) {
+    MemoryFileSource source;
+    for (const auto& [p, bytes] : files)
+      if (p != path || replacement != nullptr) source.Add(p, p == path ? *replacement : bytes);
+    return ReadPackage(source, decoder_).status();
+  };
+  const std::string tile = files[5].first;
+  // Missing file.
+  Status missing = read_with(tile, nullptr);
+  EXPECT_EQ(missing.code(), StatusCode::kNotFound);
+  EXPECT_NE(missing.message().find(tile), std::string::npos);
+  // Flipped byte: checksum.
+  std::vector<uint8_t> flipped = files[5].second;
+  flipped[flipped.size() / 2] ^= 1;
+  Status corrupt = read_with(tile, &flipped);
+  EXPECT_EQ(corrupt.code(), StatusCode::kInvalidData);
+  EXPECT_NE(corrupt.message().find("SHA-256"), std::string::npos);
+  // Truncated file.
+  std::vector<uint8_t> cut(files[5].second.begin(), files[5].second.end() - 10);
+  EXPECT_EQ(read_with(tile, &cut).code(), StatusCode::kInvalidData);
+  // A manifest path that tries to leave the package.
+  std::string manifest(files[0].second.begin(), files[0].second.end());
+  const size_t at = manifest.find("\"l0/0-0.color.webp\"");
+  ASSERT_NE(at, std::string::npos);
+  manifest.replace(at, 19, "\"../0-0.color.webp\"");
+  std::vector<uint8_t> evil(manifest.begin(), manifest.end());
+  Status escape = read_with("manifest.json", &evil);
+  EXPECT_EQ(escape.code(), StatusCode::kInvalidData);
+  EXPECT_NE(escape.message().find("safe relative path"), std::string::npos) << escape.ToString();
+}
+
+TEST_F(PackageWriterTest, RefusesBadOptionsAndUnrelatedFolders) {
+  options_.tile_size = 8;
+  EXPECT_EQ(EncodePackage(pano_, options_).status().code(), StatusCode::kInvalidArgument);
+  options_.tile_size = 128;
+  options_.levels = 8;  // 520 is not divisible by 128.
+  Status s = EncodePackage(casual3d::testing::MakePackageTestPanorama(520, 260), options_).status();
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("divisible"), std::string::npos);
+  options_.levels = 0;
+  const PackageFiles files = Encode();
+  const fs::path other = dir_ / "photos";
+  fs::create_directories(other);
+  std::ofstream(other / "keep.jpg") << "x";
+  EXPECT_EQ(WritePackageFolder(files, other.string()).code(), StatusCode::kInvalidArgument);
+  EXPECT_TRUE(fs::exists(other / "keep.jpg"));
+}
+
+}  // namespace
+}  // namespace casual3d::encoder

@@ -1,0 +1,103 @@
+#pragma once
+
+// The manifest of a casual3d web package (manifest.json): what the package
+// holds and where each file is. spec/package.md is the normative text; this is
+// its model, parser, serializer and validator. Standard library only, no
+// exceptions; the parser takes untrusted bytes.
+//
+// Versioning: "version" is "major.minor". Readers refuse an unknown major
+// (kUnsupportedVersion) and ignore members they do not know, so a minor
+// version may add optional members.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "format/equirect.h"
+#include "format/status.h"
+#include "format/tile_codec.h"
+
+namespace casual3d {
+
+constexpr const char* kPackageFormatName = "casual3d";
+constexpr int kPackageVersionMajor = 1;
+constexpr int kPackageVersionMinor = 0;
+constexpr const char* kManifestFileName = "manifest.json";
+
+// Limits of spec/package.md, "Limits".
+constexpr int kMaxPackageWidth = 32768;
+constexpr int kMaxPackageHeight = 16384;
+constexpr int kMinTileSize = 16;
+constexpr int kMaxTileSize = 4096;
+constexpr int kMaxLevels = 8;
+constexpr int kMaxTilesPerLevel = 16384;
+constexpr uint64_t kMaxFileBytes = 256ull << 20;     // One tile file.
+constexpr size_t kMaxManifestBytes = 16u << 20;      // manifest.json.
+constexpr size_t kMaxPathBytes = 255;
+
+// One tile of a level: the paths of its images (relative to the package folder).
+struct TileEntry {
+  std::string files[kNumTileImageKinds];  // Indexed by TileImageKind.
+};
+
+// One level of detail. Level 0 is the full resolution; level k has the size
+// (width >> k) x (height >> k). Tiles cover the level in a grid of tile_size
+// squares (the last column and row may be smaller), listed row by row.
+struct LevelEntry {
+  int width = 0;
+  int height = 0;
+  int columns = 0;
+  int rows = 0;
+  std::vector<TileEntry> tiles;  // columns * rows, row-major.
+};
+
+// A file of the package with its size and SHA-256 (lower-case hex).
+struct FileEntry {
+  std::string path;
+  uint64_t bytes = 0;
+  std::string sha256;
+};
+
+struct Manifest {
+  int version_major = kPackageVersionMajor;
+  int version_minor = kPackageVersionMinor;
+  std::string generator;  // Free text naming the writing program (optional).
+  int width = 0;          // Full-resolution panorama size, pixels.
+  int height = 0;
+  PanoramaFrame frame;
+  int tile_size = 512;    // Pixels per tile side at every level.
+  DepthQuantization depth;    // depth_encoding
+  NormalQuantization normal;  // normal_encoding
+  std::vector<LevelEntry> levels;  // Finest first.
+  std::vector<FileEntry> files;
+
+  TileQuantization quantization() const { return {depth, normal}; }
+
+  // The entry of `path`, or nullptr.
+  const FileEntry* FindFile(const std::string& path) const;
+  // Pixel rectangle of tile `tile` of `level` (preconditions: both in range).
+  void TileRect(int level, int tile, int* x, int* y, int* w, int* h) const;
+  // Sum of the sizes of all files of `level` (bytes), not counting the manifest.
+  uint64_t LevelBytes(int level) const;
+
+  // Checks everything a reader relies on: version, limits, the level sizes and
+  // tile grids, that every tile path is a safe relative path listed in
+  // `files` exactly once, sizes and checksums well formed, depth encoding.
+  Status Validate() const;
+};
+
+// True if `path` is a safe package-relative path: 1..255 bytes of
+// [A-Za-z0-9._-] in '/'-separated components, none empty, "." or "..", not
+// starting with '/', so that it cannot escape the package folder.
+bool IsSafePackagePath(std::string_view path);
+
+// Parses and validates manifest.json. Errors name the field ("levels[1].tiles[3]:
+// ...") or the byte offset of a JSON syntax error.
+StatusOr<Manifest> ParseManifest(std::string_view bytes);
+
+// Serializes a manifest as pretty-printed JSON (2-space indent, trailing newline).
+std::string SerializeManifest(const Manifest& manifest);
+
+}  // namespace casual3d

@@ -1,0 +1,121 @@
+#include "format/manifest.h"
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace casual3d {
+namespace {
+
+Manifest SmallManifest() {
+  Manifest m;
+  m.generator = "test";
+  m.width = 64;
+  m.height = 32;
+  m.tile_size = 32;
+  m.frame.centre[0] = 0.1;
+  m.depth.near_m = 0.75;
+  m.depth.far_m = 40.0;
+  m.depth.bits = 12;
+  m.normal.bits = 7;
+  const char* kinds[] = {"color", "depth", "normal", "graph"};
+  const int sizes[][4] = {{64, 32, 2, 1}, {32, 16, 1, 1}};
+  for (int l = 0; l < 2; ++l) {
+    LevelEntry L{sizes[l][0], sizes[l][1], sizes[l][2], sizes[l][3], {}};
+    for (int t = 0; t < L.columns * L.rows; ++t) {
+      TileEntry tile;
+      for (int k = 0; k < 4; ++k) {
+        tile.files[k] = "l" + std::to_string(l) + "/0-" + std::to_string(t) + "." + kinds[k] + ".webp";
+        m.files.push_back({tile.files[k], uint64_t(100 + k), std::string(64, 'a' + k)});
+      }
+      L.tiles.push_back(tile);
+    }
+    m.levels.push_back(L);
+  }
+  std::sort(m.files.begin(), m.files.end(),
+            [](const FileEntry& a, const FileEntry& b) { return a.path < b.path; });
+  return m;
+}
+
+std::string Replace(std::string s, const std::string& from, const std::string& to) {
+  const size_t at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+TEST(ManifestTest, SerializeParseRoundTrip) {
+  const Manifest m = SmallManifest();
+  ASSERT_TRUE(m.Validate().ok()) << m.Validate().ToString();
+  const std::string text = SerializeManifest(m);
+  StatusOr<Manifest> back = ParseManifest(text);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(SerializeManifest(*back), text);
+  EXPECT_EQ(back->depth.bits, 12);
+  EXPECT_EQ(back->normal.bits, 7);
+  EXPECT_EQ(back->frame.centre[0], 0.1);
+  EXPECT_EQ(back->LevelBytes(0), 2u * (100 + 101 + 102 + 103));
+  int x, y, w, h;
+  back->TileRect(0, 1, &x, &y, &w, &h);
+  EXPECT_EQ(x, 32);
+  EXPECT_EQ(w, 32);
+  ASSERT_NE(back->FindFile("l1/0-0.graph.webp"), nullptr);
+  EXPECT_EQ(back->FindFile("l1/0-0.graph.webp")->bytes, 103u);
+  EXPECT_EQ(back->FindFile("l9/0-0.graph.webp"), nullptr);
+}
+
+TEST(ManifestTest, VersioningRules) {
+  const std::string text = SerializeManifest(SmallManifest());
+  // Unknown optional members and a newer minor version are accepted.
+  StatusOr<Manifest> newer = ParseManifest(
+      Replace(Replace(text, "\"version\": \"1.0\"", "\"version\": \"1.7\""), "\"tile_size\"",
+              "\"future\": {\"x\": [1, 2]}, \"tile_size\""));
+  ASSERT_TRUE(newer.ok()) << newer.status().ToString();
+  EXPECT_EQ(newer->version_minor, 7);
+  EXPECT_EQ(ParseManifest(Replace(text, "\"1.0\"", "\"2.0\"")).status().code(),
+            StatusCode::kUnsupportedVersion);
+  EXPECT_EQ(ParseManifest(Replace(text, "\"1.0\"", "\"1\"")).status().code(),
+            StatusCode::kInvalidData);
+}
+
+TEST(ManifestTest, ErrorsNameTheField) {
+  const std::string text = SerializeManifest(SmallManifest());
+  struct Case {
+    std::string text;
+    const char* message;
+  } cases[] = {
+      {Replace(text, "\"casual3d\"", "\"other\""), "format: \"other\" is not supported"},
+      {Replace(text, "\"width\": 64", "\"width\": 65"), "levels[0]: size"},
+      {Replace(text, "\"width\": 64", "\"width\": 99999"), "width: 99999 is outside"},
+      {Replace(text, "\"height\": 32", "\"height\": \"32\""), "height: expected a number"},
+      {Replace(text, "\"tile_size\": 32", "\"tile_size\": 2"), "tile_size: 2 is outside"},
+      {Replace(text, "\"l0/0-1.depth.webp\"", "\"l0/../../etc/passwd\""),
+       "levels[0].tiles[1].depth: \"l0/../../etc/passwd\" is not a safe relative path"},
+      {Replace(text, "\"path\": \"l0/0-0.color.webp\"", "\"path\": \"/abs\""), "files[0].path"},
+      {Replace(text, "\"bits\": 12", "\"bits\": 17"), "depth_encoding.bits: 17 is outside"},
+      {Replace(text, "\"near_m\": 0.75", "\"near_m\": -1"), "depth_encoding: depth near_m"},
+      {Replace(text, std::string(64, 'a'), std::string(63, 'a') + "G"), "sha256"},
+      {Replace(text, "\"columns\": 2", "\"columns\": 3"), "levels[0]: tile grid"},
+      {Replace(text, "\"layers\": [\n    \"front\",", "\"layers\": [\n    \"back\","), "layers"},
+      {text.substr(0, text.size() / 2), "manifest.json: byte"},
+  };
+  for (const Case& c : cases) {
+    StatusOr<Manifest> m = ParseManifest(c.text);
+    ASSERT_FALSE(m.ok()) << c.message;
+    EXPECT_NE(m.status().message().find(c.message), std::string::npos)
+        << "expected \"" << c.message << "\" in: " << m.status().message();
+  }
+}
+
+TEST(ManifestTest, SafePaths) {
+  for (const char* good : {"a", "l0/0-0.color.webp", "x/y/z.webp", "..a", "a..b"})
+    EXPECT_TRUE(IsSafePackagePath(good)) << good;
+  for (const char* bad : {"", "/a", "a/", "a//b", "../a", "a/../b", "./a", "a\\b", "a b", "c:x",
+                          "%2e%2e/a", "a\n"})
+    EXPECT_FALSE(IsSafePackagePath(bad)) << bad;
+  EXPECT_FALSE(IsSafePackagePath(std::string(256, 'a')));
+  EXPECT_TRUE(IsSafePackagePath(std::string(255, 'a')));
+}
+
+}  // namespace
+}  // namespace casual3d

@@ -1,0 +1,106 @@
+#pragma once
+
+// Mesh construction (spec/mesh.md, Sec. 2-4): turns a TwoLayerPanorama into a
+// triangle mesh with triangles exactly where nodes are linked, so that depth
+// edges stay open and back-layer nodes fill disocclusions (paper Sec. 4.4.3).
+//
+// The result depends only on the panorama: vertex order, triangle order and
+// every float are identical natively and in the Emscripten build (positions are
+// computed in double with a polynomial sine/cosine of our own and rounded to
+// float once; the library is compiled without FMA contraction).
+
+#include <cstdint>
+#include <vector>
+
+#include "format/mesh.h"
+#include "format/status.h"
+#include "format/two_layer.h"
+
+namespace casual3d {
+
+// Hard limit on width * height for mesh building: 16384 x 8192 pixels. Keeps
+// node references below 2^31 and vertex indices below 2^32.
+constexpr int64_t kMeshPixelLimit = int64_t{16384} * 8192;
+
+struct MeshBuildOptions {
+  // Largest panorama accepted, in pixels (width * height); larger inputs are
+  // refused with kLimitExceeded. Range [1, kMeshPixelLimit]. The default,
+  // 8192 x 4096, can need about 3 GB for the finished full mesh.
+  int64_t max_pixels = int64_t{8192} * 4096;
+  // false: back-layer nodes are ignored (a front-only mesh, with holes where
+  // the front layer has depth edges).
+  bool include_back_layer = true;
+  // false skips TwoLayerPanorama::Validate() (O(pixels)) when the caller has
+  // just validated the panorama. The builder never reads out of bounds either
+  // way, but on an invalid panorama the mesh is unspecified.
+  bool validate_input = true;
+
+  // InvalidArgument naming the field when a value is out of range.
+  Status Check() const;
+};
+
+// Builds the mesh of spec/mesh.md: one vertex per node used by a triangle (plus
+// seam duplicates), triangles counter-clockwise seen from the centre. Errors:
+// options out of range (kInvalidArgument), panorama larger than
+// options.max_pixels (kLimitExceeded), width below 2 (kInvalidArgument), or
+// an invalid panorama (the status of Validate()).
+StatusOr<Mesh> BuildMesh(const TwoLayerPanorama& pano, const MeshBuildOptions& options = {});
+
+// The input checks of BuildMesh (limit, validation or, without validation,
+// array sizes; width at least 2), shared with the simplifier.
+Status CheckMeshInput(const TwoLayerPanorama& pano, int64_t max_pixels, bool validate);
+
+// A reference to a node used while assembling a mesh: (pixel index * 2 + layer),
+// with bit 31 set for the seam copy of a column-0 node (u = 1 + 0.5 / width).
+using NodeRef = uint32_t;
+constexpr NodeRef kSeamBit = 0x80000000u;
+inline NodeRef MakeNodeRef(const TwoLayerPanorama& p, int x, int y, int layer, bool seam) {
+  return static_cast<NodeRef>(p.index(x, y) * 2 + layer) | (seam ? kSeamBit : 0u);
+}
+
+// Collects triangles over node references and turns them into a Mesh with the
+// vertex rules of spec/mesh.md Sec. 3. Shared by BuildMesh and BuildSimplifiedMesh so
+// that both give identical vertices for the same node. The panorama must
+// outlive the assembler and have at most kMeshPixelLimit pixels.
+class MeshAssembler {
+ public:
+  explicit MeshAssembler(const TwoLayerPanorama& pano) : pano_(pano) {}
+
+  // Appends a triangle; a, b, c must name present nodes, counter-clockwise.
+  void AddTriangle(NodeRef a, NodeRef b, NodeRef c) {
+    refs_.push_back(a);
+    refs_.push_back(b);
+    refs_.push_back(c);
+  }
+  void Reserve(size_t triangles) { refs_.reserve(3 * triangles); }
+  size_t num_triangles() const { return refs_.size() / 3; }
+  // The triangles added so far, 3 references each.
+  const std::vector<NodeRef>& refs() const { return refs_; }
+
+  // Vertices: every referenced regular node in (row, column, layer) order, then
+  // every referenced seam copy in (row, layer) order. Triangles keep the order
+  // in which they were added. Leaves the assembler empty.
+  Mesh Finish();
+
+ private:
+  const TwoLayerPanorama& pano_;
+  std::vector<NodeRef> refs_;
+};
+
+// Appends the triangles of pixel quad (x, y) .. (x + 1, y + 1) (columns wrap)
+// following spec/mesh.md Sec. 4. `use_back` false ignores back-layer nodes.
+// `skip_layers` (bit l set: skip layer l) omits the triangles whose corner
+// node is of a skipped layer; the simplifier uses it for quads inside a merged
+// block, whose only triangles of that layer are the quad's two.
+// Precondition: 0 <= x < width, 0 <= y < height - 1.
+void AddQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back,
+                      unsigned skip_layers, MeshAssembler* out);
+// The number of triangles AddQuadTriangles would add, without adding them.
+int CountQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back,
+                       unsigned skip_layers);
+
+// sin and cos of `angle_rad` in [-4 pi, 4 pi] computed with + and * only, so
+// that native and wasm builds agree bit for bit. Absolute error below 1e-15.
+void DeterministicSinCos(double angle_rad, double* sin_out, double* cos_out);
+
+}  // namespace casual3d

@@ -1,0 +1,309 @@
+#include "format/mesh_builder.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <tuple>
+
+#include "format/equirect.h"
+#include "format/testing/mesh_checksum.h"
+#include "format/testing/test_panoramas.h"
+
+namespace casual3d {
+namespace {
+
+struct NodeId {
+  int x, y, layer;
+  bool seam;
+};
+
+// Recovers the node of a vertex from its atlas uv (spec/mesh.md Sec. 3).
+NodeId NodeOfVertex(const Mesh& m, uint32_t v, int w, int h) {
+  const double u = m.uvs[2 * v] * static_cast<double>(w) - 0.5;
+  const double t = m.uvs[2 * v + 1] * 2.0 * h - 0.5;
+  const int ux = static_cast<int>(std::lround(u));
+  const int row = static_cast<int>(std::lround(t));
+  return {ux % w, row % h, row / h, ux >= w};
+}
+
+// Sets a node with depth d and a normal facing the centre.
+void SetNode(TwoLayerPanorama* p, int l, int x, int y, float d) {
+  const size_t i = p->index(x, y);
+  LayerData& L = p->layer(l);
+  L.present[i] = 1;
+  L.depth_m[i] = d;
+  const Vec3d dir = EquirectPixelToDirection(x + 0.5, y + 0.5, p->width(), p->height());
+  L.normal[3 * i] = static_cast<float>(-dir.x);
+  L.normal[3 * i + 1] = static_cast<float>(-dir.y);
+  L.normal[3 * i + 2] = static_cast<float>(-dir.z);
+  L.label[i] = static_cast<uint8_t>(l);
+  L.rgb[3 * i] = static_cast<uint8_t>(10 * x);
+  L.rgb[3 * i + 1] = static_cast<uint8_t>(10 * y);
+  L.rgb[3 * i + 2] = static_cast<uint8_t>(100 * l);
+}
+
+// A w x h panorama whose front depth is depth(x, y), linked by depth ratio.
+template <typename F>
+TwoLayerPanorama FrontOnly(int w, int h, F depth) {
+  TwoLayerPanorama p(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) SetNode(&p, kFront, x, y, depth(x, y));
+  }
+  testing::LinkByDepthRatio(&p, 0.75f);
+  return p;
+}
+
+bool Linked(const TwoLayerPanorama& p, const NodeId& a, const NodeId& b) {
+  for (int d = 0; d < kNumDirections; ++d) {
+    int nx, ny;
+    if (!p.Neighbour(a.x, a.y, static_cast<Direction>(d), &nx, &ny)) continue;
+    if (nx != b.x || ny != b.y) continue;
+    const Link l = GetLink(p.layer(a.layer).links[p.index(a.x, a.y)], static_cast<Direction>(d));
+    if (l != Link::kNone && (l == Link::kFront ? kFront : kBack) == b.layer) return true;
+  }
+  return false;
+}
+
+// Every triangle: two of its edges are links, the third is the diagonal of a
+// pixel quad; it faces the centre (counter-clockwise seen from the origin).
+void CheckTriangles(const TwoLayerPanorama& p, const Mesh& m) {
+  const int w = p.width(), h = p.height();
+  for (size_t t = 0; t < m.num_triangles(); ++t) {
+    NodeId n[3];
+    for (int k = 0; k < 3; ++k) n[k] = NodeOfVertex(m, m.indices[3 * t + k], w, h);
+    int links = 0;
+    for (int k = 0; k < 3; ++k) links += Linked(p, n[k], n[(k + 1) % 3]);
+    ASSERT_EQ(links, 2) << "triangle " << t;
+    for (int k = 0; k < 3; ++k) {
+      const NodeId& a = n[k];
+      const NodeId& b = n[(k + 1) % 3];
+      if (Linked(p, a, b)) continue;
+      const int dx = std::abs(a.x - b.x);
+      EXPECT_TRUE(dx == 1 || dx == w - 1) << "triangle " << t;
+      EXPECT_EQ(std::abs(a.y - b.y), 1) << "triangle " << t;
+    }
+    const float* p0 = &m.positions[3 * m.indices[3 * t]];
+    const float* p1 = &m.positions[3 * m.indices[3 * t + 1]];
+    const float* p2 = &m.positions[3 * m.indices[3 * t + 2]];
+    const double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    const double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    const double nrm[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                           e1[0] * e2[1] - e1[1] * e2[0]};
+    const double c[3] = {p0[0] + p1[0] + p2[0], p0[1] + p1[1] + p2[1], p0[2] + p1[2] + p2[2]};
+    EXPECT_LT(nrm[0] * c[0] + nrm[1] * c[1] + nrm[2] * c[2], 0.0) << "triangle " << t;
+  }
+}
+
+TEST(MeshBuilderTest, FullyLinkedGridGivesTwoTrianglesPerQuadAndSeamCopies) {
+  const TwoLayerPanorama p = FrontOnly(8, 4, [](int, int) { return 2.0f; });
+  auto mesh = BuildMesh(p);
+  ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
+  EXPECT_EQ(mesh->num_triangles(), 8u * 3 * 2);
+  EXPECT_EQ(mesh->num_vertices(), 32u + 4);  // One per node, one seam copy per row.
+  CheckTriangles(p, *mesh);
+  // Vertex order: (row, column, layer), then seam copies by row.
+  for (uint32_t v = 0; v < 32; ++v) {
+    const NodeId n = NodeOfVertex(*mesh, v, 8, 4);
+    EXPECT_EQ(n.y * 8 + n.x, static_cast<int>(v));
+    EXPECT_FALSE(n.seam);
+  }
+  for (uint32_t v = 32; v < 36; ++v) {
+    const NodeId n = NodeOfVertex(*mesh, v, 8, 4);
+    EXPECT_TRUE(n.seam);
+    EXPECT_EQ(n.x, 0);
+    EXPECT_EQ(n.y, static_cast<int>(v - 32));
+    EXPECT_FLOAT_EQ(mesh->uvs[2 * v], 8.5f / 8);
+    for (int c = 0; c < 3; ++c) {  // Same position as the regular copy.
+      EXPECT_EQ(mesh->positions[3 * v + c], mesh->positions[3 * (8 * n.y) + c]);
+    }
+  }
+  // Quad (0, 0): corner B then corner C triangles, A-D diagonal.
+  EXPECT_EQ(mesh->indices[0], 1u);
+  EXPECT_EQ(mesh->indices[1], 0u);
+  EXPECT_EQ(mesh->indices[2], 9u);
+  EXPECT_EQ(mesh->indices[3], 8u);
+  EXPECT_EQ(mesh->indices[4], 9u);
+  EXPECT_EQ(mesh->indices[5], 0u);
+  // The last quad of row 0 wraps: its B and D are seam copies.
+  EXPECT_EQ(mesh->indices[6 * 7 + 0], 32u);
+  EXPECT_EQ(mesh->indices[6 * 7 + 1], 7u);
+  EXPECT_EQ(mesh->indices[6 * 7 + 2], 33u);
+}
+
+TEST(MeshBuilderTest, VertexAttributesFollowTheSpec) {
+  TwoLayerPanorama p = FrontOnly(16, 8, [](int x, int y) { return 1.0f + 0.01f * (x + y); });
+  auto mesh = BuildMesh(p);
+  ASSERT_TRUE(mesh.ok());
+  for (uint32_t v = 0; v < 16 * 8; ++v) {
+    const int x = v % 16, y = v / 16;
+    const size_t i = p.index(x, y);
+    const double d = p.layer(kFront).depth_m[i];
+    const Vec3d dir = EquirectPixelToDirection(x + 0.5, y + 0.5, 16, 8);
+    EXPECT_NEAR(mesh->positions[3 * v + 0], dir.x * d, 1e-6);
+    EXPECT_NEAR(mesh->positions[3 * v + 1], dir.y * d, 1e-6);
+    EXPECT_NEAR(mesh->positions[3 * v + 2], dir.z * d, 1e-6);
+    EXPECT_EQ(mesh->uvs[2 * v], static_cast<float>((x + 0.5) / 16));
+    EXPECT_EQ(mesh->uvs[2 * v + 1], static_cast<float>((y + 0.5) / 16));
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(mesh->normals[3 * v + c], p.layer(kFront).normal[3 * i + c]);
+      EXPECT_EQ(mesh->colors[3 * v + c], p.layer(kFront).rgb[3 * i + c]);
+    }
+  }
+  // Pole rows are half a pixel from the poles (latitude +-7/16 pi) and are not
+  // joined to each other.
+  EXPECT_NEAR(mesh->positions[1], std::cos(kPi / 16), 1e-6);
+  EXPECT_NEAR(mesh->positions[3 * (7 * 16) + 1],
+              -std::cos(kPi / 16) * p.layer(kFront).depth_m[p.index(0, 7)], 1e-6);
+  CheckTriangles(p, *mesh);
+}
+
+TEST(MeshBuilderTest, DepthEdgesStayOpen) {
+  // Columns 0-3 at 1 m, 4-7 at 4 m: no links across x = 3|4 nor across the seam.
+  const TwoLayerPanorama p = FrontOnly(8, 4, [](int x, int) { return x < 4 ? 1.0f : 4.0f; });
+  auto mesh = BuildMesh(p);
+  ASSERT_TRUE(mesh.ok());
+  EXPECT_EQ(mesh->num_triangles(), 6u * 3 * 2);
+  EXPECT_EQ(mesh->num_vertices(), 32u);  // No seam copy: nothing crosses the seam.
+  CheckTriangles(p, *mesh);
+}
+
+TEST(MeshBuilderTest, ThreeLinkedCornersGiveOneTriangle) {
+  // One quad row; node (5, 1) is far away and linked to nothing.
+  TwoLayerPanorama p = FrontOnly(8, 2, [](int x, int y) { return x == 5 && y == 1 ? 9.0f : 2.0f; });
+  auto mesh = BuildMesh(p);
+  ASSERT_TRUE(mesh.ok());
+  EXPECT_EQ(mesh->num_triangles(), 6u * 2 + 2);
+  EXPECT_EQ(mesh->num_vertices(), 16u - 1 + 2);
+  CheckTriangles(p, *mesh);
+  // Quad 4: corner A's triangle (A, C, B) = (4,0), (4,1), (5,0).
+  // Quad 5: corner B's triangle (B, A, D) = (6,0), (5,0), (6,1).
+  std::set<std::tuple<int, int, int, int, int, int>> tris;
+  for (size_t t = 0; t < mesh->num_triangles(); ++t) {
+    NodeId n[3];
+    for (int k = 0; k < 3; ++k) n[k] = NodeOfVertex(*mesh, mesh->indices[3 * t + k], 8, 2);
+    tris.insert({n[0].x, n[0].y, n[1].x, n[1].y, n[2].x, n[2].y});
+  }
+  EXPECT_TRUE(tris.count({4, 0, 4, 1, 5, 0}));
+  EXPECT_TRUE(tris.count({6, 0, 5, 0, 6, 1}));
+}
+
+// Background at 4 m everywhere; columns 3-4 hold an object at 1 m in front and
+// the background in the back layer.
+TwoLayerPanorama ObjectInFront() {
+  TwoLayerPanorama p(8, 4);
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      const bool object = x == 3 || x == 4;
+      SetNode(&p, kFront, x, y, object ? 1.0f : 4.0f);
+      if (object) SetNode(&p, kBack, x, y, 4.0f);
+    }
+  }
+  testing::LinkByDepthRatio(&p, 0.75f);
+  return p;
+}
+
+TEST(MeshBuilderTest, BackLayerFillsDisocclusion) {
+  const TwoLayerPanorama p = ObjectInFront();
+  ASSERT_TRUE(p.Validate().ok()) << p.Validate().ToString();
+  auto mesh = BuildMesh(p);
+  ASSERT_TRUE(mesh.ok());
+  // The background sheet closes over all 8 x 3 quads; the object adds 1 x 3.
+  EXPECT_EQ(mesh->num_triangles(), 8u * 3 * 2 + 3 * 2);
+  EXPECT_EQ(mesh->num_vertices(), 32u + 8 + 4);
+  CheckTriangles(p, *mesh);
+
+  MeshBuildOptions front_only;
+  front_only.include_back_layer = false;
+  auto front = BuildMesh(p, front_only);
+  ASSERT_TRUE(front.ok());
+  // Quads 2 and 4 straddle the depth edges and stay open.
+  EXPECT_EQ(front->num_triangles(), 5u * 3 * 2 + 3 * 2);
+  EXPECT_EQ(front->num_vertices(), 32u + 4);
+}
+
+TEST(MeshBuilderTest, ProceduralRoomMeshIsConsistentAndDeterministic) {
+  const TwoLayerPanorama p = testing::MakeRoomPanorama(96, 48);
+  auto a = BuildMesh(p);
+  auto b = BuildMesh(p);
+  ASSERT_TRUE(a.ok()) << a.status().ToString();
+  ASSERT_TRUE(b.ok());
+  EXPECT_EQ(a->positions, b->positions);
+  EXPECT_EQ(a->indices, b->indices);
+  EXPECT_EQ(a->uvs, b->uvs);
+  CheckTriangles(p, *a);
+  // Nearly every quad is closed by the front or back sheet; the sphere adds its own.
+  EXPECT_GT(a->num_triangles(), 2u * 96 * 47);
+  EXPECT_LT(a->num_triangles(), 2u * 96 * 47 + 400);
+  // No triangle spans a depth edge: along each edge depths differ by < 25 %,
+  // diagonals included (they join two nodes linked through a third).
+  for (size_t t = 0; t < a->num_triangles(); ++t) {
+    float d[3];
+    for (int k = 0; k < 3; ++k) {
+      const float* q = &a->positions[3 * a->indices[3 * t + k]];
+      d[k] = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+    }
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GT(std::min(d[k], d[(k + 1) % 3]) / std::max(d[k], d[(k + 1) % 3]), 0.56f);
+    }
+  }
+}
+
+TEST(MeshBuilderTest, DeterministicSinCosMatchesLibm) {
+  double max_err = 0;
+  for (int k = -40000; k <= 40000; ++k) {
+    const double a = k * (4.0 * kPi / 40000);
+    double s, c;
+    DeterministicSinCos(a, &s, &c);
+    max_err = std::max(max_err, std::max(std::fabs(s - std::sin(a)), std::fabs(c - std::cos(a))));
+  }
+  EXPECT_LT(max_err, 1e-15);
+}
+
+TEST(MeshBuilderTest, RefusesBadInput) {
+  TwoLayerPanorama p = FrontOnly(8, 4, [](int, int) { return 2.0f; });
+  MeshBuildOptions small;
+  small.max_pixels = 31;
+  auto r = BuildMesh(p, small);
+  EXPECT_EQ(r.status().code(), StatusCode::kLimitExceeded);
+  EXPECT_EQ(r.status().message(),
+            "panorama 8x4 has 32 pixels, more than the mesh builder's limit of 31");
+
+  MeshBuildOptions bad;
+  bad.max_pixels = 0;
+  EXPECT_EQ(BuildMesh(p, bad).status().code(), StatusCode::kInvalidArgument);
+
+  p.layer(kFront).depth_m[3] = -1.0f;
+  EXPECT_EQ(BuildMesh(p).status().code(), StatusCode::kInvalidData);
+
+  EXPECT_EQ(BuildMesh(TwoLayerPanorama(1, 4)).status().code(), StatusCode::kInvalidArgument);
+
+  MeshBuildOptions unchecked;
+  unchecked.validate_input = false;
+  TwoLayerPanorama broken(8, 4);
+  broken.layer(kBack).links.resize(3);
+  EXPECT_EQ(BuildMesh(broken, unchecked).status().code(), StatusCode::kInvalidData);
+}
+
+TEST(MeshBuilderTest, EmptyAndSingleRowPanoramasGiveEmptyMeshes) {
+  auto empty = BuildMesh(TwoLayerPanorama(8, 4));
+  ASSERT_TRUE(empty.ok());
+  EXPECT_EQ(empty->num_vertices(), 0u);
+  EXPECT_EQ(empty->num_triangles(), 0u);
+  auto row = BuildMesh(FrontOnly(8, 1, [](int, int) { return 1.0f; }));
+  ASSERT_TRUE(row.ok());
+  EXPECT_EQ(row->num_triangles(), 0u);
+}
+
+// Pins the exact output (every float bit, every index). The Emscripten build
+// gives the same checksum; a change here is a change of spec/mesh.md's output.
+TEST(MeshBuilderTest, GoldenChecksum) {
+  auto mesh = BuildMesh(testing::MakeBlocksPanorama());
+  ASSERT_TRUE(mesh.ok());
+  EXPECT_EQ(mesh->num_triangles(), 309166u);
+  EXPECT_EQ(mesh->num_vertices(), 156880u);
+  EXPECT_EQ(testing::MeshChecksum(*mesh), 0xd3093ee1021d7926ull);
+}
+
+}  // namespace
+}  // namespace casual3d

@@ -1,0 +1,168 @@
+#include "format/package_reader.h"
+
+#include <atomic>
+#include <mutex>
+#include <thread>
+
+#include "format/sha256.h"
+
+namespace casual3d {
+
+PackageReader::PackageReader(Manifest manifest)
+    : manifest_(std::move(manifest)),
+      tile_decoder_(std::make_shared<TileDecoder>(manifest_.quantization())) {}
+
+StatusOr<PackageReader> PackageReader::Create(std::string_view manifest_bytes) {
+  CASUAL3D_ASSIGN_OR_RETURN(Manifest manifest, ParseManifest(manifest_bytes));
+  return PackageReader(std::move(manifest));
+}
+
+std::vector<std::string> PackageReader::FilesForLevel(int level) const {
+  std::vector<std::string> paths;
+  if (level < 0 || level >= num_levels()) return paths;
+  for (const TileEntry& t : manifest_.levels[level].tiles)
+    for (const std::string& p : t.files) paths.push_back(p);
+  return paths;
+}
+
+Status PackageReader::VerifyFile(const std::string& path, const uint8_t* data,
+                                 size_t size) const {
+  const FileEntry* f = manifest_.FindFile(path);
+  if (f == nullptr) return NotFound(path + ": not listed in the manifest");
+  if (size != f->bytes)
+    return InvalidData(path + ": " + std::to_string(size) + " bytes, the manifest says " +
+                       std::to_string(f->bytes) + " (truncated or replaced file)");
+  if (Sha256Hex(data, size) != f->sha256)
+    return InvalidData(path + ": SHA-256 does not match the manifest (corrupt file)");
+  return Status::Ok();
+}
+
+Status PackageReader::BeginLevel(int level, int64_t max_pixels) {
+  if (level < 0 || level >= num_levels())
+    return InvalidArgument("level " + std::to_string(level) + " does not exist (the package has " +
+                           std::to_string(num_levels()) + " levels, 0 = full resolution)");
+  const LevelEntry& L = manifest_.levels[level];
+  if (static_cast<int64_t>(L.width) * L.height > max_pixels)
+    return LimitExceeded("level " + std::to_string(level) + " is " + std::to_string(L.width) +
+                         "x" + std::to_string(L.height) + ", more than the limit of " +
+                         std::to_string(max_pixels) + " pixels");
+  level_ = level;
+  pano_ = TwoLayerPanorama(L.width, L.height);
+  pano_.frame() = manifest_.frame;
+  received_.assign(L.tiles.size() * kNumTileImageKinds, 0);
+  return Status::Ok();
+}
+
+Status PackageReader::AddTileImage(int tile, TileImageKind kind, ImageView<const uint8_t> pixels) {
+  if (level_ < 0) return InvalidArgument("AddTileImage before BeginLevel");
+  const LevelEntry& L = manifest_.levels[level_];
+  const int k = static_cast<int>(kind);
+  if (tile < 0 || static_cast<size_t>(tile) >= L.tiles.size() || k < 0 || k >= kNumTileImageKinds)
+    return InvalidArgument("tile " + std::to_string(tile) + " or image kind " + std::to_string(k) +
+                           " is out of range");
+  int x, y, w, h;
+  manifest_.TileRect(level_, tile, &x, &y, &w, &h);
+  Status s = DecodeTileImage(pixels, kind, x, y, w, h, *tile_decoder_, &pano_);
+  if (!s.ok()) return Status(s.code(), L.tiles[tile].files[k] + ": " + s.message());
+  received_[static_cast<size_t>(tile) * kNumTileImageKinds + k] = 1;
+  return Status::Ok();
+}
+
+Status PackageReader::AddTileFile(int tile, TileImageKind kind, const uint8_t* data, size_t size,
+                                  const ImageDecoder& decoder) {
+  StatusOr<Image8> image = decoder.Decode(data, size);
+  if (!image.ok()) {
+    std::string path = "tile " + std::to_string(tile);
+    if (level_ >= 0 && tile >= 0 && static_cast<size_t>(tile) < manifest_.levels[level_].tiles.size())
+      path = manifest_.levels[level_].tiles[tile].files[static_cast<int>(kind) & 3];
+    return Status(image.status().code(), path + ": " + image.status().message());
+  }
+  const Image8& decoded = *image;
+  return AddTileImage(tile, kind, decoded.view());
+}
+
+StatusOr<TwoLayerPanorama> PackageReader::FinishLevel() {
+  if (level_ < 0) return InvalidArgument("FinishLevel before BeginLevel");
+  const LevelEntry& L = manifest_.levels[level_];
+  for (size_t i = 0; i < received_.size(); ++i) {
+    if (!received_[i])
+      return InvalidArgument("level " + std::to_string(level_) + ": " +
+                             L.tiles[i / kNumTileImageKinds].files[i % kNumTileImageKinds] +
+                             " was not added");
+  }
+  CASUAL3D_RETURN_IF_ERROR(FinishDecodedPanorama(&pano_));
+  Status valid = pano_.Validate();
+  if (!valid.ok())
+    return InvalidData("level " + std::to_string(level_) + ": the decoded panorama is invalid: " +
+                       valid.message());
+  level_ = -1;
+  received_.clear();
+  return std::move(pano_);
+}
+
+Status ReadOptions::Check() const {
+  if (level < 0 || level >= kMaxLevels)
+    return InvalidArgument("level " + std::to_string(level) + " is outside [0, " +
+                           std::to_string(kMaxLevels - 1) + "]");
+  if (num_threads < 1 || num_threads > 256)
+    return InvalidArgument("num_threads " + std::to_string(num_threads) + " is outside [1, 256]");
+  if (max_pixels < 1) return InvalidArgument("max_pixels must be positive");
+  return Status::Ok();
+}
+
+StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source, const ImageDecoder& decoder,
+                                       const ReadOptions& options, Manifest* manifest_out) {
+  CASUAL3D_RETURN_IF_ERROR(options.Check());
+  CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> manifest_bytes,
+                            source.Read(kManifestFileName, kMaxManifestBytes));
+  CASUAL3D_ASSIGN_OR_RETURN(
+      PackageReader reader,
+      PackageReader::Create(std::string_view(reinterpret_cast<const char*>(manifest_bytes.data()),
+                                             manifest_bytes.size())));
+  if (manifest_out != nullptr) *manifest_out = reader.manifest();
+  CASUAL3D_RETURN_IF_ERROR(reader.BeginLevel(options.level, options.max_pixels));
+  const size_t num_tiles = reader.manifest().levels[options.level].tiles.size();
+  const size_t num_jobs = num_tiles * kNumTileImageKinds;
+
+  std::atomic<size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex error_mutex;
+  Status first_error;
+  auto work = [&] {
+    while (!failed.load()) {
+      const size_t job = next.fetch_add(1);
+      if (job >= num_jobs) return;
+      const int tile = static_cast<int>(job / kNumTileImageKinds);
+      const TileImageKind kind = static_cast<TileImageKind>(job % kNumTileImageKinds);
+      const std::string& path =
+          reader.manifest().levels[options.level].tiles[tile].files[static_cast<int>(kind)];
+      const FileEntry* entry = reader.manifest().FindFile(path);
+      Status s;
+      StatusOr<std::vector<uint8_t>> bytes = source.Read(path, entry->bytes);
+      if (!bytes.ok()) {
+        s = bytes.status();
+      } else {
+        if (options.verify_checksums) s = reader.VerifyFile(path, bytes->data(), bytes->size());
+        if (s.ok()) s = reader.AddTileFile(tile, kind, bytes->data(), bytes->size(), decoder);
+      }
+      if (!s.ok()) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!failed.exchange(true)) first_error = s;
+        return;
+      }
+    }
+  };
+  const int threads = static_cast<int>(
+      std::min<size_t>(static_cast<size_t>(options.num_threads), num_jobs));
+  if (threads <= 1) {
+    work();
+  } else {
+    std::vector<std::thread> pool;
+    for (int i = 0; i < threads; ++i) pool.emplace_back(work);
+    for (std::thread& t : pool) t.join();
+  }
+  if (failed.load()) return first_error;
+  return reader.FinishLevel();
+}
+
+}  // namespace casual3d

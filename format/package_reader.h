@@ -1,0 +1,100 @@
+#pragma once
+
+// Reads a casual3d web package (spec/package.md) back into a two-layer
+// panorama at a chosen level of detail. Standard library only, no exceptions:
+// every entry point takes untrusted bytes and returns a Status.
+//
+// Two ways to use it:
+//  - ReadPackage(): one call with a FileSource and an ImageDecoder (native
+//    tools: FolderFileSource or SingleFileSource and the libwebp decoder of
+//    encoder/webp_codec.h).
+//  - PackageReader: step by step, for callers that fetch and decode files
+//    themselves (the WebAssembly viewer: JavaScript fetches the files the
+//    reader names, decodes them with the browser's decoder and hands in the
+//    RGBA pixels).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "format/file_source.h"
+#include "format/image.h"
+#include "format/manifest.h"
+#include "format/status.h"
+#include "format/tile_codec.h"
+#include "format/two_layer.h"
+
+namespace casual3d {
+
+// Decodes a compressed image (WebP in packages 1.x) to 8-bit pixels with 3
+// (RGB) or 4 (RGBA) channels. Must be safe to call from several threads.
+class ImageDecoder {
+ public:
+  virtual ~ImageDecoder() = default;
+  virtual StatusOr<Image8> Decode(const uint8_t* data, size_t size) const = 0;
+};
+
+// Step-by-step reader of one package.
+class PackageReader {
+ public:
+  // Parses and validates manifest.json.
+  static StatusOr<PackageReader> Create(std::string_view manifest_bytes);
+
+  const Manifest& manifest() const { return manifest_; }
+  int num_levels() const { return static_cast<int>(manifest_.levels.size()); }
+
+  // Paths of the files needed to assemble `level` (tile by tile, in the order
+  // colour, depth, normal, graph). Empty for a level out of range.
+  std::vector<std::string> FilesForLevel(int level) const;
+
+  // Checks `size` and the SHA-256 of a fetched file against the manifest.
+  Status VerifyFile(const std::string& path, const uint8_t* data, size_t size) const;
+
+  // Starts assembling `level`: allocates its (empty) panorama. Fails with
+  // kLimitExceeded if the level has more than `max_pixels` pixels.
+  Status BeginLevel(int level, int64_t max_pixels = int64_t{1} << 25);
+
+  // Hands in the decoded image of `kind` for tile `tile` (row-major index) of
+  // the level being assembled; the image is 3- or 4-channel 8-bit. Tiles and
+  // kinds may come in any order; calls for different (tile, kind) pairs may run
+  // concurrently.
+  Status AddTileImage(int tile, TileImageKind kind, ImageView<const uint8_t> pixels);
+
+  // Decodes a compressed file of tile `tile` with `decoder` and adds it.
+  Status AddTileFile(int tile, TileImageKind kind, const uint8_t* data, size_t size,
+                     const ImageDecoder& decoder);
+
+  // After every image of every tile was added: clears absent nodes, validates
+  // the panorama (TwoLayerPanorama::Validate) and returns it. The reader can
+  // then begin another level.
+  StatusOr<TwoLayerPanorama> FinishLevel();
+
+ private:
+  explicit PackageReader(Manifest manifest);
+
+  Manifest manifest_;
+  std::shared_ptr<TileDecoder> tile_decoder_;
+  int level_ = -1;
+  TwoLayerPanorama pano_;
+  std::vector<uint8_t> received_;  // One per (tile, kind).
+};
+
+struct ReadOptions {
+  int level = 0;                  // Level of detail, 0 = full resolution.
+  int num_threads = 1;            // Threads decoding tiles, 1..256.
+  bool verify_checksums = true;   // Check each file's SHA-256 against the manifest.
+  int64_t max_pixels = int64_t{1} << 25;  // Refuse larger levels (memory bound).
+
+  Status Check() const;
+};
+
+// Reads manifest.json and all tiles of `options.level` from `source`, decodes
+// them with `decoder` and returns the level's panorama. If `manifest_out` is
+// not null it receives the manifest.
+StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source, const ImageDecoder& decoder,
+                                       const ReadOptions& options = ReadOptions(),
+                                       Manifest* manifest_out = nullptr);
+
+}  // namespace casual3d

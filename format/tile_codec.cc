@@ -1,0 +1,295 @@
+#include "format/tile_codec.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace casual3d {
+namespace {
+
+constexpr int kFlagFrontPresent = 1, kFlagBackPresent = 2, kFlagFrontLabel = 4,
+              kFlagBackLabel = 8;
+constexpr int kFlagReserved = 0xF0;
+
+std::string PixelName(int x, int y) {
+  return "(" + std::to_string(x) + ", " + std::to_string(y) + ")";
+}
+
+// Colour of one layer half, with absent pixels filled from the nearest node of
+// the row (or the nearest filled row) so that lossy coding spends few bits on them.
+void EncodeColorHalf(const TwoLayerPanorama& pano, int layer, int x0, int y0, int w, int h,
+                     uint8_t* out /* w*h*3, row-major */) {
+  const LayerData& L = pano.layer(layer);
+  std::vector<uint8_t> row_filled(h, 0);
+  for (int y = 0; y < h; ++y) {
+    uint8_t* row = out + static_cast<size_t>(y) * w * 3;
+    int first = -1;
+    for (int x = 0; x < w; ++x) {
+      const size_t i = pano.index(x0 + x, y0 + y);
+      if (L.present[i]) {
+        for (int c = 0; c < 3; ++c) row[3 * x + c] = L.rgb[3 * i + c];
+        if (first < 0) first = x;
+      } else if (first >= 0) {
+        for (int c = 0; c < 3; ++c) row[3 * x + c] = row[3 * (x - 1) + c];
+      }
+    }
+    if (first < 0) continue;
+    row_filled[y] = 1;
+    for (int x = 0; x < first; ++x)
+      for (int c = 0; c < 3; ++c) row[3 * x + c] = row[3 * first + c];
+  }
+  // Empty rows copy the nearest filled row above, then below.
+  int last = -1;
+  for (int y = 0; y < h; ++y) {
+    if (row_filled[y]) {
+      last = y;
+    } else if (last >= 0) {
+      std::copy_n(out + static_cast<size_t>(last) * w * 3, w * 3, out + static_cast<size_t>(y) * w * 3);
+    }
+  }
+  int first_filled = -1;
+  for (int y = 0; y < h && first_filled < 0; ++y)
+    if (row_filled[y]) first_filled = y;
+  if (first_filled < 0) {
+    std::fill_n(out, static_cast<size_t>(w) * h * 3, uint8_t{128});
+    return;
+  }
+  for (int y = 0; y < first_filled; ++y)
+    std::copy_n(out + static_cast<size_t>(first_filled) * w * 3, w * 3,
+                out + static_cast<size_t>(y) * w * 3);
+}
+
+}  // namespace
+
+const char* TileImageKindName(TileImageKind kind) {
+  switch (kind) {
+    case TileImageKind::kColor: return "color";
+    case TileImageKind::kDepth: return "depth";
+    case TileImageKind::kNormal: return "normal";
+    case TileImageKind::kGraph: return "graph";
+  }
+  return "unknown";
+}
+
+void TileImageSize(TileImageKind kind, int w, int h, int* image_w, int* image_h) {
+  *image_w = w;
+  *image_h = kind == TileImageKind::kGraph ? h : 2 * h;
+}
+
+Status DepthQuantization::Check() const {
+  if (!std::isfinite(near_m) || !(near_m > 0))
+    return InvalidArgument("depth near_m " + std::to_string(near_m) + " must be finite and > 0");
+  if (!std::isfinite(far_m) || !(far_m >= near_m))
+    return InvalidArgument("depth far_m " + std::to_string(far_m) +
+                           " must be finite and >= near_m " + std::to_string(near_m));
+  if (far_m / near_m > 1e9)
+    return InvalidArgument("depth far_m / near_m = " + std::to_string(far_m / near_m) +
+                           " exceeds the limit of 1e9");
+  if (bits < 8 || bits > 16)
+    return InvalidArgument("depth bits " + std::to_string(bits) + " is outside [8, 16]");
+  return Status::Ok();
+}
+
+double DepthQuantization::MaxRelativeError() const {
+  return std::expm1(std::log(far_m / near_m) / (2.0 * (MaxCode() - 1)));
+}
+
+Status NormalQuantization::Check() const {
+  if (bits < 4 || bits > 8)
+    return InvalidArgument("normal bits " + std::to_string(bits) + " is outside [4, 8]");
+  return Status::Ok();
+}
+
+Status TileQuantization::Check() const {
+  CASUAL3D_RETURN_IF_ERROR(depth.Check());
+  return normal.Check();
+}
+
+uint16_t QuantizeDepth(double depth_m, const DepthQuantization& q) {
+  if (!(q.far_m > q.near_m)) return 1;
+  const double d = std::fmin(q.far_m, std::fmax(q.near_m, depth_m));
+  const double t = std::log(d / q.near_m) / std::log(q.far_m / q.near_m);
+  const long code = 1 + std::lround(t * (q.MaxCode() - 1));
+  return static_cast<uint16_t>(code < 1 ? 1 : (code > q.MaxCode() ? q.MaxCode() : code));
+}
+
+double DequantizeDepth(uint16_t code, const DepthQuantization& q) {
+  if (code == 0) return 0.0;
+  if (!(q.far_m > q.near_m)) return q.near_m;
+  return q.near_m *
+         std::exp(static_cast<double>(code - 1) / (q.MaxCode() - 1) * std::log(q.far_m / q.near_m));
+}
+
+void EncodeOctahedral(const float normal[3], const NormalQuantization& q, uint8_t code[2]) {
+  const double x = normal[0], y = normal[1], z = normal[2];
+  const double s = std::fabs(x) + std::fabs(y) + std::fabs(z);
+  if (!(s > 0) || !std::isfinite(s)) {
+    code[0] = code[1] = 0;
+    return;
+  }
+  double u = x / s, v = y / s;
+  if (z < 0) {
+    const double fu = (1.0 - std::fabs(v)) * (u >= 0 ? 1.0 : -1.0);
+    const double fv = (1.0 - std::fabs(u)) * (v >= 0 ? 1.0 : -1.0);
+    u = fu;
+    v = fv;
+  }
+  const double scale = (q.MaxCode() - 1) / 2.0;
+  auto quantize = [scale](double t) {
+    const long c = 1 + std::lround((std::fmin(1.0, std::fmax(-1.0, t)) + 1.0) * scale);
+    return static_cast<uint8_t>(c);
+  };
+  code[0] = quantize(u);
+  code[1] = quantize(v);
+}
+
+bool DecodeOctahedral(const uint8_t code[2], const NormalQuantization& q, float normal[3]) {
+  normal[0] = normal[1] = normal[2] = 0.0f;
+  if (code[0] == 0 && code[1] == 0) return true;
+  if (code[0] == 0 || code[1] == 0 || code[0] > q.MaxCode() || code[1] > q.MaxCode())
+    return false;
+  const double scale = 2.0 / (q.MaxCode() - 1);
+  double u = (code[0] - 1) * scale - 1.0, v = (code[1] - 1) * scale - 1.0;
+  const double z = 1.0 - std::fabs(u) - std::fabs(v);
+  if (z < 0) {
+    const double fu = (1.0 - std::fabs(v)) * (u >= 0 ? 1.0 : -1.0);
+    const double fv = (1.0 - std::fabs(u)) * (v >= 0 ? 1.0 : -1.0);
+    u = fu;
+    v = fv;
+  }
+  const double n = std::sqrt(u * u + v * v + z * z);
+  normal[0] = static_cast<float>(u / n);
+  normal[1] = static_cast<float>(v / n);
+  normal[2] = static_cast<float>(z / n);
+  return true;
+}
+
+Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int h,
+                       TileImageKind kind, const TileQuantization& q) {
+  int iw, ih;
+  TileImageSize(kind, w, h, &iw, &ih);
+  Image8 image(iw, ih, 3, 0);
+  if (kind == TileImageKind::kColor) {
+    for (int l = 0; l < kNumLayers; ++l)
+      EncodeColorHalf(pano, l, x0, y0, w, h, image.row(l * h));
+    return image;
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = pano.index(x0 + x, y0 + y);
+      if (kind == TileImageKind::kGraph) {
+        uint8_t* px = &image.at(x, y);
+        const LayerData& F = pano.layer(kFront);
+        const LayerData& B = pano.layer(kBack);
+        px[0] = F.present[i] ? F.links[i] : 0;
+        px[1] = B.present[i] ? B.links[i] : 0;
+        px[2] = static_cast<uint8_t>((F.present[i] ? kFlagFrontPresent : 0) |
+                                     (B.present[i] ? kFlagBackPresent : 0) |
+                                     (F.present[i] && F.label[i] ? kFlagFrontLabel : 0) |
+                                     (B.present[i] && B.label[i] ? kFlagBackLabel : 0));
+        continue;
+      }
+      for (int l = 0; l < kNumLayers; ++l) {
+        const LayerData& L = pano.layer(l);
+        if (!L.present[i]) continue;
+        uint8_t* px = &image.at(x, l * h + y);
+        if (kind == TileImageKind::kDepth) {
+          const uint16_t code = QuantizeDepth(L.depth_m[i], q.depth);
+          px[0] = static_cast<uint8_t>(code >> 8);
+          px[1] = static_cast<uint8_t>(code & 255);
+        } else {
+          EncodeOctahedral(&L.normal[3 * i], q.normal, px);
+        }
+      }
+    }
+  }
+  return image;
+}
+
+TileDecoder::TileDecoder(const TileQuantization& q) : q_(q), table_(q.depth.MaxCode() + 1) {
+  for (int code = 0; code <= q.depth.MaxCode(); ++code)
+    table_[code] = static_cast<float>(DequantizeDepth(static_cast<uint16_t>(code), q.depth));
+}
+
+Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
+                       int h, const TileDecoder& decoder, TwoLayerPanorama* pano) {
+  if (w <= 0 || h <= 0 || x0 < 0 || y0 < 0 || x0 > pano->width() - w || y0 > pano->height() - h)
+    return InvalidArgument("tile region " + std::to_string(w) + "x" + std::to_string(h) + " at " +
+                           PixelName(x0, y0) + " lies outside the panorama");
+  int iw, ih;
+  TileImageSize(kind, w, h, &iw, &ih);
+  if (image.width() != iw || image.height() != ih)
+    return InvalidData(std::string(TileImageKindName(kind)) + " image is " +
+                       std::to_string(image.width()) + "x" + std::to_string(image.height()) +
+                       ", expected " + std::to_string(iw) + "x" + std::to_string(ih));
+  if (image.channels() != 3 && image.channels() != 4)
+    return InvalidData(std::string(TileImageKindName(kind)) + " image has " +
+                       std::to_string(image.channels()) + " channels, expected 3 or 4");
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = pano->index(x0 + x, y0 + y);
+      if (kind == TileImageKind::kGraph) {
+        const uint8_t* px = &image.at(x, y);
+        if (px[2] & kFlagReserved)
+          return InvalidData("graph image: reserved flag bits set at pixel " +
+                             PixelName(x0 + x, y0 + y));
+        LayerData& F = pano->layer(kFront);
+        LayerData& B = pano->layer(kBack);
+        F.present[i] = (px[2] & kFlagFrontPresent) ? 1 : 0;
+        B.present[i] = (px[2] & kFlagBackPresent) ? 1 : 0;
+        F.label[i] = (px[2] & kFlagFrontLabel) ? 1 : 0;
+        B.label[i] = (px[2] & kFlagBackLabel) ? 1 : 0;
+        F.links[i] = px[0];
+        B.links[i] = px[1];
+        continue;
+      }
+      for (int l = 0; l < kNumLayers; ++l) {
+        LayerData& L = pano->layer(l);
+        const uint8_t* px = &image.at(x, l * h + y);
+        if (kind == TileImageKind::kColor) {
+          for (int c = 0; c < 3; ++c) L.rgb[3 * i + c] = px[c];
+        } else if (kind == TileImageKind::kDepth) {
+          const uint16_t code = static_cast<uint16_t>((px[0] << 8) | px[1]);
+          const float d = decoder.Depth(code);
+          if (d < 0)
+            return InvalidData("depth image: code " + std::to_string(code) + " above the maximum " +
+                               std::to_string(decoder.quantization().depth.MaxCode()) +
+                               " at pixel " + PixelName(x0 + x, y0 + y));
+          L.depth_m[i] = d;
+        } else if (!DecodeOctahedral(px, decoder.quantization().normal, &L.normal[3 * i])) {
+          return InvalidData("normal image: invalid octahedral code (" + std::to_string(px[0]) +
+                             ", " + std::to_string(px[1]) + ") at pixel " +
+                             PixelName(x0 + x, y0 + y) + (l == kFront ? " (front)" : " (back)"));
+        }
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+Status FinishDecodedPanorama(TwoLayerPanorama* pano) {
+  for (int l = 0; l < kNumLayers; ++l) {
+    LayerData& L = pano->layer(l);
+    const size_t n = L.present.size();
+    for (size_t i = 0; i < n; ++i) {
+      if (L.present[i]) {
+        if (!(L.depth_m[i] > 0))
+          return InvalidData(std::string(l == kFront ? "front" : "back") + " node at pixel " +
+                             PixelName(static_cast<int>(i % pano->width()),
+                                       static_cast<int>(i / pano->width())) +
+                             " has no depth (code 0)");
+        continue;
+      }
+      L.depth_m[i] = 0.0f;
+      L.label[i] = 0;
+      L.links[i] = 0;
+      for (int c = 0; c < 3; ++c) {
+        L.rgb[3 * i + c] = 0;
+        L.normal[3 * i + c] = 0.0f;
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace casual3d

@@ -1,0 +1,130 @@
+#pragma once
+
+// Quantization and bit packing of a two-layer panorama into the four images of
+// a package tile, and back (spec/package.md, "Tile images"). Standard library
+// only, no exceptions; decoding takes untrusted pixels and returns a Status.
+//
+// A tile covers pixels [x0, x0+w) x [y0, y0+h) of the panorama of its level.
+// Its images are 3-channel (RGB) 8-bit; decoders may hand in 4-channel RGBA,
+// whose alpha is ignored. For colour, depth and normal the image is w x 2h: rows
+// [0, h) hold the front layer and rows [h, 2h) the back layer. The graph image
+// is w x h.
+//   colour (lossy):   R, G, B = sRGB colour; pixels without a node are filled
+//                     with the nearest node's colour in the row (decoders ignore
+//                     them).
+//   depth (lossless): R = code >> 8, G = code & 255, B = 0, with code the
+//                     log-depth code of QuantizeDepth (0: no node).
+//   normal (lossless): R, G = octahedral code (EncodeOctahedral), B = 0.
+//   graph (lossless): R = front links, G = back links (TwoLayerPanorama's packed
+//                     byte: 2 bits per direction), B = flags: bit 0 front present,
+//                     bit 1 back present, bit 2 front label, bit 3 back label;
+//                     bits 4-7 are 0.
+
+#include <cstdint>
+#include <vector>
+
+#include "format/image.h"
+#include "format/status.h"
+#include "format/two_layer.h"
+
+namespace casual3d {
+
+enum class TileImageKind : int { kColor = 0, kDepth = 1, kNormal = 2, kGraph = 3 };
+constexpr int kNumTileImageKinds = 4;
+
+// "color", "depth", "normal", "graph": the names used in the manifest.
+const char* TileImageKindName(TileImageKind kind);
+
+// Pixel size of the image of `kind` for a tile of w x h panorama pixels.
+void TileImageSize(TileImageKind kind, int w, int h, int* image_w, int* image_h);
+
+// Whether the image of `kind` is stored lossless (all but colour).
+inline bool TileImageIsLossless(TileImageKind kind) { return kind != TileImageKind::kColor; }
+
+// The "log" depth encoding with b bits (8..16), M = 2^b - 1: code 0 means "no
+// node"; codes 1..M map depths in [near_m, far_m] logarithmically, so the
+// relative error is uniform:
+//   code  = 1 + round((M - 1) * ln(d / near) / ln(far / near))   (d clamped)
+//   depth = near * exp((code - 1) / (M - 1) * ln(far / near))
+// Codes above M are invalid. The largest relative error is
+// exp(ln(far / near) / (2 (M - 1))) - 1 (0.084% for b = 12 and far / near =
+// 1000). If far == near every valid code decodes to near.
+struct DepthQuantization {
+  double near_m = 1.0;  // Smallest encodable depth, metres, > 0.
+  double far_m = 100.0; // Largest encodable depth, metres, >= near_m, finite.
+  int bits = 16;        // Code bits b, 8..16.
+
+  // near_m > 0, far_m >= near_m, both finite, far/near at most 1e9, bits 8..16.
+  Status Check() const;
+  // Largest valid code M = 2^bits - 1.
+  int MaxCode() const { return (1 << bits) - 1; }
+  // Worst-case relative depth error of this encoding.
+  double MaxRelativeError() const;
+};
+
+// Depth to its code in 1..MaxCode() (clamped into [near, far]).
+uint16_t QuantizeDepth(double depth_m, const DepthQuantization& q);
+// Code 1..MaxCode() to depth in metres; 0 gives 0. Precondition: code <= MaxCode().
+double DequantizeDepth(uint16_t code, const DepthQuantization& q);
+
+// The octahedral normal encoding with b bits per coordinate (4..8), M = 2^b - 1:
+// the unit normal n is mapped to the octahedron (u, v) = (x, y) / (|x| + |y| +
+// |z|), folded for z < 0 as (u, v) <- ((1 - |v|) sgn u, (1 - |u|) sgn v) with
+// sgn 0 = +1; each of u, v in [-1, 1] is stored as 1 + round((u + 1) / 2 (M - 1)),
+// i.e. 1..M. The code (0, 0) means the zero normal (unlit, such as sky). A code
+// with exactly one 0, or above M, is invalid. Angular error at most about
+// 230 / (M - 1) degrees (0.9 degrees for b = 8).
+struct NormalQuantization {
+  int bits = 8;  // Bits b per coordinate, 4..8.
+
+  Status Check() const;
+  int MaxCode() const { return (1 << bits) - 1; }
+};
+
+void EncodeOctahedral(const float normal[3], const NormalQuantization& q, uint8_t code[2]);
+// Returns false for an invalid code (leaving `normal` zero).
+bool DecodeOctahedral(const uint8_t code[2], const NormalQuantization& q, float normal[3]);
+
+// How a package quantizes depth and normals (the manifest's encodings).
+struct TileQuantization {
+  DepthQuantization depth;
+  NormalQuantization normal;
+
+  Status Check() const;
+};
+
+// Builds the RGB image of `kind` for the tile [x0, x0+w) x [y0, y0+h) of
+// `pano`. Preconditions: the region lies inside the panorama, q.Check() is ok
+// and every present node's depth lies in [near, far] (others are clamped).
+Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int h,
+                       TileImageKind kind, const TileQuantization& q);
+
+// Precomputed DequantizeDepth for all valid codes (up to 256 KB), for fast
+// decoding, plus the normal encoding. Precondition: q.Check() is ok.
+class TileDecoder {
+ public:
+  explicit TileDecoder(const TileQuantization& q);
+  const TileQuantization& quantization() const { return q_; }
+  // Depth of `code`, or -1 for a code above the maximum.
+  float Depth(uint16_t code) const { return code < table_.size() ? table_[code] : -1.0f; }
+
+ private:
+  TileQuantization q_;
+  std::vector<float> table_;
+};
+
+// Writes the content of a decoded image of `kind` into the tile [x0, x0+w) x
+// [y0, y0+h) of `pano`. The image must have the size of TileImageSize and 3 or
+// 4 channels. The graph image sets presence, labels and links; the others set
+// values whether or not a node is present (FinishDecodedPanorama clears the
+// absent ones). Returns kInvalidData, naming the pixel, for a wrong size,
+// reserved bits, or an invalid depth or normal code. Never reads or writes out
+// of bounds.
+Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
+                       int h, const TileDecoder& decoder, TwoLayerPanorama* pano);
+
+// After all tiles are decoded: zeroes every field of absent nodes and checks
+// that every present node has a depth (code != 0). Returns the first problem.
+Status FinishDecodedPanorama(TwoLayerPanorama* pano);
+
+}  // namespace casual3d

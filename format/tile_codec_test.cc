@@ -1,0 +1,153 @@
+#include "format/tile_codec.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "format/package_test_scene.h"
+
+namespace casual3d {
+namespace {
+
+ImageView<const uint8_t> V(const Image8& image) { return image.view(); }
+
+TEST(TileCodecTest, DepthCodesFollowTheFormulaAndBound) {
+  for (int bits : {8, 12, 16}) {
+    DepthQuantization q;
+    q.near_m = 0.5;
+    q.far_m = 500.0;
+    q.bits = bits;
+    ASSERT_TRUE(q.Check().ok());
+    EXPECT_EQ(QuantizeDepth(0.5, q), 1);
+    EXPECT_EQ(QuantizeDepth(500.0, q), q.MaxCode());
+    EXPECT_EQ(QuantizeDepth(0.01, q), 1);         // Clamped.
+    EXPECT_EQ(QuantizeDepth(1e6, q), q.MaxCode());  // Clamped.
+    EXPECT_DOUBLE_EQ(DequantizeDepth(1, q), 0.5);
+    EXPECT_NEAR(DequantizeDepth(q.MaxCode(), q), 500.0, 1e-9);
+    EXPECT_EQ(DequantizeDepth(0, q), 0.0);
+    double worst = 0;
+    for (double d = 0.5; d < 500; d *= 1.0007) {
+      const double back = DequantizeDepth(QuantizeDepth(d, q), q);
+      worst = std::max(worst, std::fabs(back / d - 1));
+    }
+    EXPECT_LE(worst, q.MaxRelativeError() * (1 + 1e-9));
+    EXPECT_GT(worst, q.MaxRelativeError() * 0.9);  // The bound is tight.
+  }
+  DepthQuantization q12;
+  q12.near_m = 1;
+  q12.far_m = 1000;
+  q12.bits = 12;
+  EXPECT_NEAR(q12.MaxRelativeError(), 0.000844, 0.000005);
+  DepthQuantization bad;
+  bad.near_m = 0;
+  EXPECT_FALSE(bad.Check().ok());
+  bad.near_m = 2;
+  bad.far_m = 1;
+  EXPECT_FALSE(bad.Check().ok());
+  bad.far_m = 3;
+  bad.bits = 17;
+  EXPECT_FALSE(bad.Check().ok());
+}
+
+TEST(TileCodecTest, OctahedralNormalsWithinOneDegree) {
+  NormalQuantization q;
+  double worst = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // Fibonacci sphere directions.
+    const double z = 1 - 2 * (i + 0.5) / 20000, r = std::sqrt(1 - z * z), phi = i * 2.39996323;
+    const float n[3] = {float(r * std::cos(phi)), float(r * std::sin(phi)), float(z)};
+    uint8_t code[2];
+    EncodeOctahedral(n, q, code);
+    ASSERT_NE(code[0], 0);
+    ASSERT_NE(code[1], 0);
+    float back[3];
+    ASSERT_TRUE(DecodeOctahedral(code, q, back));
+    const double dot = n[0] * back[0] + n[1] * back[1] + n[2] * back[2];
+    worst = std::max(worst, std::acos(std::fmin(1.0, dot)) * 180 / M_PI);
+    EXPECT_NEAR(std::sqrt(back[0] * back[0] + back[1] * back[1] + back[2] * back[2]), 1.0, 1e-6);
+  }
+  EXPECT_LT(worst, 0.95);
+  const float zero[3] = {0, 0, 0};
+  uint8_t code[2];
+  EncodeOctahedral(zero, q, code);
+  EXPECT_EQ(code[0], 0);
+  EXPECT_EQ(code[1], 0);
+  const uint8_t invalid[2] = {0, 7};
+  float out[3];
+  EXPECT_FALSE(DecodeOctahedral(invalid, q, out));
+  NormalQuantization six;
+  six.bits = 6;
+  const uint8_t above[2] = {64, 3};
+  EXPECT_FALSE(DecodeOctahedral(above, six, out));
+}
+
+TEST(TileCodecTest, TileRoundTripKeepsTheGraphExactly) {
+  const TwoLayerPanorama pano = casual3d::testing::MakePackageTestPanorama(96, 48);
+  TileQuantization q;
+  q.depth.near_m = 2.0;
+  q.depth.far_m = 100.0;
+  q.depth.bits = 16;
+  const TileDecoder decoder(q);
+  TwoLayerPanorama out(96, 48);
+  out.frame() = pano.frame();
+  // Tiles of 40x32 with partial tiles at the right and bottom.
+  for (int y0 = 0; y0 < 48; y0 += 32) {
+    for (int x0 = 0; x0 < 96; x0 += 40) {
+      const int w = std::min(40, 96 - x0), h = std::min(32, 48 - y0);
+      for (int k = 0; k < kNumTileImageKinds; ++k) {
+        const Image8 image = EncodeTileImage(pano, x0, y0, w, h, static_cast<TileImageKind>(k), q);
+        int iw, ih;
+        TileImageSize(static_cast<TileImageKind>(k), w, h, &iw, &ih);
+        ASSERT_EQ(image.width(), iw);
+        ASSERT_EQ(image.height(), ih);
+        Status s = DecodeTileImage(image.view(), static_cast<TileImageKind>(k), x0, y0, w, h,
+                                   decoder, &out);
+        ASSERT_TRUE(s.ok()) << s.ToString();
+      }
+    }
+  }
+  ASSERT_TRUE(FinishDecodedPanorama(&out).ok());
+  ASSERT_TRUE(out.Validate().ok()) << out.Validate().ToString();
+  for (int l = 0; l < kNumLayers; ++l) {
+    EXPECT_EQ(out.layer(l).present, pano.layer(l).present);
+    EXPECT_EQ(out.layer(l).links, pano.layer(l).links);
+    EXPECT_EQ(out.layer(l).label, pano.layer(l).label);
+    EXPECT_EQ(out.layer(l).rgb, pano.layer(l).rgb);  // Colour is exact before WebP.
+    for (size_t i = 0; i < pano.layer(l).present.size(); ++i) {
+      if (!pano.layer(l).present[i]) continue;
+      ASSERT_NEAR(out.layer(l).depth_m[i] / pano.layer(l).depth_m[i], 1.0,
+                  q.depth.MaxRelativeError() * 1.001);
+    }
+  }
+}
+
+TEST(TileCodecTest, HostileImagesAreRefused) {
+  TwoLayerPanorama out(32, 16);
+  TileQuantization q;
+  q.depth.bits = 10;
+  const TileDecoder decoder(q);
+  Image8 graph(16, 16, 4, 0);
+  graph.at(3, 2, 2) = 0x40;  // Reserved flag bit.
+  Status s = DecodeTileImage(V(graph), TileImageKind::kGraph, 0, 0, 16, 16, decoder, &out);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidData);
+  EXPECT_NE(s.message().find("(3, 2)"), std::string::npos) << s.message();
+  Image8 depth(16, 32, 3, 0);
+  depth.at(1, 1, 0) = 0x04;  // Code 1024 > 1023.
+  EXPECT_EQ(DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 16, 16, decoder, &out).code(),
+            StatusCode::kInvalidData);
+  Image8 wrong(16, 16, 3, 0);  // Depth images are w x 2h.
+  EXPECT_EQ(DecodeTileImage(V(wrong), TileImageKind::kDepth, 0, 0, 16, 16, decoder, &out).code(),
+            StatusCode::kInvalidData);
+  Image8 gray(16, 32, 1, 0);
+  EXPECT_EQ(DecodeTileImage(V(gray), TileImageKind::kColor, 0, 0, 16, 16, decoder, &out).code(),
+            StatusCode::kInvalidData);
+  EXPECT_EQ(DecodeTileImage(V(depth), TileImageKind::kDepth, 20, 0, 16, 16, decoder, &out).code(),
+            StatusCode::kInvalidArgument);
+  // A present node without depth.
+  TwoLayerPanorama p(4, 4);
+  p.layer(kFront).present[5] = 1;
+  EXPECT_EQ(FinishDecodedPanorama(&p).code(), StatusCode::kInvalidData);
+}
+
+}  // namespace
+}  // namespace casual3d

@@ -1,0 +1,215 @@
+#include "format/two_layer.h"
+
+#include <cmath>
+#include <string>
+
+namespace casual3d {
+namespace {
+
+// Limits of spec/data-model.md, Sec. "Limits". They keep every array below
+// 2^31 elements and every mesh index below 2^32.
+constexpr int kMaxWidth = 32768;
+constexpr int kMaxHeight = 16384;
+
+// Tolerance on the length of a normal: |len - 1| <= kNormalLengthTolerance.
+// Normals quantised to 2 x 16-bit octahedral codes are within 1e-4 of unit.
+constexpr double kNormalLengthTolerance = 1e-3;
+// Tolerance on R R^T = I and det R = 1 for the frame rotation.
+constexpr double kRotationTolerance = 1e-6;
+
+const char* LayerName(int l) { return l == kFront ? "front" : "back"; }
+const char* DirectionName(int d) {
+  static const char* const kNames[kNumDirections] = {"right", "down", "left", "up"};
+  return kNames[d];
+}
+
+std::string Where(int l, int x, int y) {
+  return std::string(LayerName(l)) + " node (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+}
+
+Status CheckSize(const char* name, int l, size_t actual, size_t expected) {
+  if (actual == expected) return Status::Ok();
+  return InvalidData(std::string(LayerName(l)) + " layer: " + name + " has " +
+                     std::to_string(actual) + " elements, expected " + std::to_string(expected));
+}
+
+Status ValidateFrame(const PanoramaFrame& f) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(f.centre[i])) return InvalidData("frame: centre is not finite");
+  }
+  for (int i = 0; i < 9; ++i) {
+    if (!std::isfinite(f.rotation[i])) return InvalidData("frame: rotation is not finite");
+  }
+  const double* r = f.rotation;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double dot =
+          r[3 * i] * r[3 * j] + r[3 * i + 1] * r[3 * j + 1] + r[3 * i + 2] * r[3 * j + 2];
+      if (std::fabs(dot - (i == j ? 1.0 : 0.0)) > kRotationTolerance) {
+        return InvalidData("frame: rotation is not orthonormal");
+      }
+    }
+  }
+  const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                     r[2] * (r[3] * r[7] - r[4] * r[6]);
+  if (det < 0) return InvalidData("frame: rotation is a reflection (determinant -1)");
+  return Status::Ok();
+}
+
+}  // namespace
+
+TwoLayerPanorama::TwoLayerPanorama(int width, int height) : width_(width), height_(height) {
+  const size_t n = static_cast<size_t>(width > 0 ? width : 0) * (height > 0 ? height : 0);
+  for (LayerData& layer : layers_) {
+    layer.present.assign(n, 0);
+    layer.rgb.assign(3 * n, 0);
+    layer.depth_m.assign(n, 0.0f);
+    layer.normal.assign(3 * n, 0.0f);
+    layer.label.assign(n, 0);
+    layer.links.assign(n, 0);
+  }
+}
+
+bool TwoLayerPanorama::Neighbour(int x, int y, Direction d, int* nx, int* ny) const {
+  switch (d) {
+    case kRight:
+      *nx = x + 1 == width_ ? 0 : x + 1;
+      *ny = y;
+      return true;
+    case kLeft:
+      *nx = x == 0 ? width_ - 1 : x - 1;
+      *ny = y;
+      return true;
+    case kDown:
+      if (y + 1 >= height_) return false;
+      *nx = x;
+      *ny = y + 1;
+      return true;
+    case kUp:
+      if (y <= 0) return false;
+      *nx = x;
+      *ny = y - 1;
+      return true;
+  }
+  return false;
+}
+
+Status TwoLayerPanorama::Validate() const {
+  if (width_ < 1 || height_ < 1) {
+    return InvalidData("panorama size " + std::to_string(width_) + "x" + std::to_string(height_) +
+                       " is empty");
+  }
+  if (width_ > kMaxWidth || height_ > kMaxHeight) {
+    return LimitExceeded("panorama size " + std::to_string(width_) + "x" + std::to_string(height_) +
+                         " exceeds the limit of " + std::to_string(kMaxWidth) + "x" +
+                         std::to_string(kMaxHeight));
+  }
+  CASUAL3D_RETURN_IF_ERROR(ValidateFrame(frame_));
+  const size_t n = static_cast<size_t>(width_) * height_;
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& d = layers_[l];
+    CASUAL3D_RETURN_IF_ERROR(CheckSize("present", l, d.present.size(), n));
+    CASUAL3D_RETURN_IF_ERROR(CheckSize("rgb", l, d.rgb.size(), 3 * n));
+    CASUAL3D_RETURN_IF_ERROR(CheckSize("depth_m", l, d.depth_m.size(), n));
+    CASUAL3D_RETURN_IF_ERROR(CheckSize("normal", l, d.normal.size(), 3 * n));
+    CASUAL3D_RETURN_IF_ERROR(CheckSize("label", l, d.label.size(), n));
+    CASUAL3D_RETURN_IF_ERROR(CheckSize("links", l, d.links.size(), n));
+  }
+  // Per-node values first, so that the link pass can rely on `present` being 0 or 1.
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& d = layers_[l];
+    for (int y = 0; y < height_; ++y) {
+      for (int x = 0; x < width_; ++x) {
+        const size_t i = index(x, y);
+        const float* nrm = &d.normal[3 * i];
+        if (d.present[i] > 1) {
+          return InvalidData(Where(l, x, y) + ": present flag " + std::to_string(d.present[i]) +
+                             " is not 0 or 1");
+        }
+        if (!d.present[i]) {
+          if (d.rgb[3 * i] || d.rgb[3 * i + 1] || d.rgb[3 * i + 2] || d.depth_m[i] != 0.0f ||
+              nrm[0] != 0.0f || nrm[1] != 0.0f || nrm[2] != 0.0f || d.label[i] || d.links[i]) {
+            return InvalidData(Where(l, x, y) + ": absent node has non-zero fields");
+          }
+          continue;
+        }
+        if (!std::isfinite(d.depth_m[i]) || !(d.depth_m[i] > 0.0f)) {
+          return InvalidData(Where(l, x, y) + ": depth " + std::to_string(d.depth_m[i]) +
+                             " m is not finite and positive");
+        }
+        if (!std::isfinite(nrm[0]) || !std::isfinite(nrm[1]) || !std::isfinite(nrm[2])) {
+          return InvalidData(Where(l, x, y) + ": normal is not finite");
+        }
+        const double len2 = static_cast<double>(nrm[0]) * nrm[0] +
+                            static_cast<double>(nrm[1]) * nrm[1] +
+                            static_cast<double>(nrm[2]) * nrm[2];
+        if (len2 != 0.0 && std::fabs(std::sqrt(len2) - 1.0) > kNormalLengthTolerance) {
+          return InvalidData(Where(l, x, y) + ": normal has length " +
+                             std::to_string(std::sqrt(len2)) + ", expected 1 or 0");
+        }
+        if (d.label[i] > static_cast<uint8_t>(NodeLabel::kB)) {
+          return InvalidData(Where(l, x, y) + ": label " + std::to_string(d.label[i]) +
+                             " is not 0 (F) or 1 (B)");
+        }
+      }
+    }
+  }
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& d = layers_[l];
+    for (int y = 0; y < height_; ++y) {
+      for (int x = 0; x < width_; ++x) {
+        const size_t i = index(x, y);
+        if (!d.present[i]) continue;
+        for (int di = 0; di < kNumDirections; ++di) {
+          const Direction dir = static_cast<Direction>(di);
+          const Link link = GetLink(d.links[i], dir);
+          if (link == Link::kNone) continue;
+          if (static_cast<int>(link) > static_cast<int>(Link::kBack)) {
+            return InvalidData(Where(l, x, y) + ": " + DirectionName(di) +
+                               " link has the reserved value 3");
+          }
+          int nx, ny;
+          if (!Neighbour(x, y, dir, &nx, &ny)) {
+            return InvalidData(Where(l, x, y) + ": " + DirectionName(di) +
+                               " link points outside the panorama (rows do not wrap)");
+          }
+          const int target_layer = link == Link::kFront ? kFront : kBack;
+          const LayerData& t = layers_[target_layer];
+          const size_t j = index(nx, ny);
+          if (!t.present[j]) {
+            return InvalidData(Where(l, x, y) + ": " + DirectionName(di) + " link points at " +
+                               Where(target_layer, nx, ny) + ", which is absent");
+          }
+          const Link back = GetLink(t.links[j], Opposite(dir));
+          const Link expected = l == kFront ? Link::kFront : Link::kBack;
+          if (back != expected) {
+            return InvalidData(Where(l, x, y) + ": " + DirectionName(di) + " link to " +
+                               Where(target_layer, nx, ny) + " is not mutual");
+          }
+        }
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+bool TwoLayerPanorama::operator==(const TwoLayerPanorama& o) const {
+  if (width_ != o.width_ || height_ != o.height_) return false;
+  for (int i = 0; i < 3; ++i) {
+    if (frame_.centre[i] != o.frame_.centre[i]) return false;
+  }
+  for (int i = 0; i < 9; ++i) {
+    if (frame_.rotation[i] != o.frame_.rotation[i]) return false;
+  }
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& a = layers_[l];
+    const LayerData& b = o.layers_[l];
+    if (a.present != b.present || a.rgb != b.rgb || a.depth_m != b.depth_m ||
+        a.normal != b.normal || a.label != b.label || a.links != b.links) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace casual3d

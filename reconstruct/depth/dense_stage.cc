@@ -1,0 +1,468 @@
+#include "reconstruct/depth/dense_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "reconstruct/depth/depth_metrics.h"
+#include "reconstruct/depth/mrf_trws.h"
+#include "reconstruct/depth/parallel.h"
+#include "reconstruct/depth/workspace.h"
+#include "reconstruct/io/cv_bridge.h"
+#include "reconstruct/io/exr_io.h"
+#include "reconstruct/io/file_util.h"
+#include "reconstruct/io/image_io.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::depth {
+namespace fs = std::filesystem;
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+size_t PeakRssBytes() {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024;
+  return 0;
+}
+
+int ScaledRadius(int radius_at_reference, double ratio) {
+  return std::max(1, static_cast<int>(std::lround(radius_at_reference * ratio)));
+}
+
+// Inverse depth mapped to [0, 255] over the photo's range (near = 255) and
+// coloured with the turbo map; invalid pixels are black.
+Image8 Colorize(const ImageF& depth, const DepthRange& range) {
+  const int w = depth.width(), h = depth.height();
+  cv::Mat gray(h, w, CV_8UC1), mask(h, w, CV_8UC1);
+  const double inv_near = 1.0 / range.near_m, inv_far = 1.0 / range.far_m;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float d = depth.at(x, y);
+      const bool ok = d > 0 && std::isfinite(d);
+      const double t = ok ? (1.0 / d - inv_far) / (inv_near - inv_far) : 0.0;
+      gray.at<uint8_t>(y, x) = static_cast<uint8_t>(std::lround(255.0 * std::min(1.0, std::max(0.0, t))));
+      mask.at<uint8_t>(y, x) = ok ? 255 : 0;
+    }
+  cv::Mat bgr;
+  cv::applyColorMap(gray, bgr, cv::COLORMAP_TURBO);
+  Image8 rgb(w, h, 3, 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (!mask.at<uint8_t>(y, x)) continue;
+      const cv::Vec3b c = bgr.at<cv::Vec3b>(y, x);
+      rgb.at(x, y, 0) = c[2];
+      rgb.at(x, y, 1) = c[1];
+      rgb.at(x, y, 2) = c[0];
+    }
+  return rgb;
+}
+
+ImageF ResizeLinear(const ImageF& image, int width, int height) {
+  ImageF out(width, height, image.channels());
+  cv::Mat dst = io::ToMat(out);
+  cv::resize(io::ToMat(image), dst, cv::Size(width, height), 0, 0, cv::INTER_LINEAR);
+  return out;
+}
+
+int CountValid(const ImageF& depth) {
+  int n = 0;
+  for (float v : depth.vector()) n += v > 0;
+  return n;
+}
+
+// The cost volume between the two passes, on disk as 16-bit fixed point
+// (E_photo in [0, 1]; 1/65535 resolution is far below the costs' noise).
+void WriteCostCache(const std::string& path, const CostVolume& vol) {
+  std::vector<uint16_t> q(vol.cost.size());
+  for (size_t i = 0; i < q.size(); ++i)
+    q[i] = static_cast<uint16_t>(std::lround(std::min(1.0f, std::max(0.0f, vol.cost[i])) * 65535.0f));
+  const std::string tmp = io::TemporaryPathFor(path);
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(q.data()), static_cast<std::streamsize>(q.size() * 2));
+    f.write(reinterpret_cast<const char*>(vol.photo_weight.data()),
+            static_cast<std::streamsize>(vol.photo_weight.size() * sizeof(float)));
+    if (!f) throw io::IoError(path + ": cannot write the cost cache (disk full?)");
+  }
+  io::CommitTemporary(tmp, path);
+}
+
+void ReadCostCache(const std::string& path, CostVolume* vol) {
+  const size_t n = static_cast<size_t>(vol->width) * vol->height;
+  std::vector<uint16_t> q(n * vol->num_labels);
+  vol->photo_weight = ImageF(vol->width, vol->height, 1);
+  std::ifstream f(path, std::ios::binary);
+  f.read(reinterpret_cast<char*>(q.data()), static_cast<std::streamsize>(q.size() * 2));
+  f.read(reinterpret_cast<char*>(vol->photo_weight.data()), static_cast<std::streamsize>(n * sizeof(float)));
+  if (!f) throw io::IoError(path + ": cost cache truncated");
+  vol->cost.resize(q.size());
+  for (size_t i = 0; i < q.size(); ++i) vol->cost[i] = q[i] * (1.0f / 65535.0f);
+}
+
+ImageF ReadGroundTruth(const std::string& dir, const std::string& stem) {
+  const std::string path = (fs::path(dir) / (stem + ".exr")).string();
+  if (!fs::exists(path)) return ImageF();
+  io::ExrImage exr = io::ReadExr(path);
+  int channel = 0;
+  for (size_t c = 0; c < exr.channels.size(); ++c)
+    if (exr.channels[c] == "Z" || exr.channels[c] == "depth") channel = static_cast<int>(c);
+  ImageF gt(exr.pixels.width(), exr.pixels.height(), 1);
+  for (int y = 0; y < gt.height(); ++y)
+    for (int x = 0; x < gt.width(); ++x) gt.at(x, y) = exr.pixels.at(x, y, channel);
+  return gt;
+}
+
+}  // namespace
+
+Status MrfTermOptions::Check() const {
+  if (!(lambda_smooth >= 0 && lambda_smooth <= 100)) return InvalidArgument("lambda_smooth outside [0, 100]");
+  if (!(lambda_near >= 0 && lambda_near <= 100)) return InvalidArgument("lambda_near outside [0, 100]");
+  if (!(sigma_color > 0 && sigma_color <= 10)) return InvalidArgument("mrf sigma_color outside (0, 10]");
+  if (!(color_floor >= 0 && color_floor <= 1)) return InvalidArgument("mrf color_floor outside [0, 1]");
+  if (truncation_labels < 1 || truncation_labels > 4096)
+    return InvalidArgument("truncation_labels outside [1, 4096]");
+  if (max_iterations < 1 || max_iterations > 1000) return InvalidArgument("mrf max_iterations outside [1, 1000]");
+  return Status::Ok();
+}
+
+Status DenseOptions::Check() const {
+  if (!(working_scale > 0 && working_scale <= 1)) return InvalidArgument("working_scale outside (0, 1]");
+  if (num_neighbors < 1 || num_neighbors > 16)
+    return InvalidArgument("num_neighbors " + std::to_string(num_neighbors) + " outside [1, 16]");
+  if (!(reference_diagonal > 0)) return InvalidArgument("reference_diagonal must be > 0");
+  if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
+  for (const Status& s : {neighbors.Check(), sweep.Check(), gc.Check(), prune.Check(), envelope.Check(),
+                          mrf.Check(), upsample.Check()})
+    if (!s.ok()) return s;
+  return Status::Ok();
+}
+
+DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& out_dir,
+                          const DenseOptions& options) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument(st.message());
+  const auto t_start = Clock::now();
+  const int threads = ResolveThreads(options.num_threads);
+  if (!options.ground_truth_dir.empty() && !fs::is_directory(options.ground_truth_dir))
+    throw std::runtime_error(options.ground_truth_dir + ": ground-truth folder does not exist");
+
+  LoadedWorkspace ws = LoadWorkspace(workspace_dir, options.working_scale, options.neighbors);
+  const int n = static_cast<int>(ws.views.size());
+  DenseReport report;
+  report.seconds_load = Since(t_start);
+
+  io::CreateDirectories(out_dir);
+  for (const char* sub : {"depth", "confidence", "envelope"}) io::CreateDirectories((fs::path(out_dir) / sub).string());
+  const std::string debug_dir = (fs::path(out_dir) / "debug").string();
+  if (options.debug) io::CreateDirectories(debug_dir);
+  const std::string cache_dir = (fs::path(out_dir) / ".dense-cache").string();
+  io::CreateDirectories(cache_dir);
+  struct CacheGuard {
+    std::string dir;
+    ~CacheGuard() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } cache_guard{cache_dir};
+
+  report.photos.resize(n);
+  std::vector<ImageF> wta(n);
+  std::vector<CostVolume> shells(n);  // Sizes and depth grid; costs live in the cache.
+  auto cache_path = [&](int i) {
+    return (fs::path(cache_dir) / (OutputStem(ws.views[i].name) + ".cost")).string();
+  };
+
+  // Pass 1: cost volumes and WTA depth maps of every photo (the GC filter
+  // needs all WTA maps before any envelope can be built).
+  {
+    util::Progress progress("dense: plane sweep", n);
+    SweepOptions sweep = options.sweep;
+    sweep.num_threads = threads;
+    for (int i = 0; i < n; ++i) {
+      const auto t0 = Clock::now();
+      const DenseView& v = ws.views[i];
+      PhotoReport& pr = report.photos[i];
+      pr.name = v.name;
+      pr.near_m = v.range.near_m;
+      pr.far_m = v.range.far_m;
+      pr.work_width = v.camera.width;
+      pr.work_height = v.camera.height;
+      pr.width = v.full_width;
+      pr.height = v.full_height;
+      std::vector<const DenseView*> nbs;
+      for (int j : ws.ranked_neighbors[i]) {
+        if (static_cast<int>(nbs.size()) >= options.num_neighbors) break;
+        nbs.push_back(&ws.views[j]);
+        pr.neighbors.push_back(ws.views[j].name);
+      }
+      CostVolume vol = ComputeCostVolume(v, nbs, sweep);
+      wta[i] = WinnerTakesAll(vol, threads);
+      WriteCostCache(cache_path(i), vol);
+      shells[i].width = vol.width;
+      shells[i].height = vol.height;
+      shells[i].num_labels = vol.num_labels;
+      shells[i].inv_near = vol.inv_near;
+      shells[i].inv_far = vol.inv_far;
+      pr.t_sweep = Since(t0);
+      progress.Advance();
+    }
+  }
+
+  // Pass 2: envelope, MRF, upsampling and outputs. Photos run concurrently,
+  // one thread each (TRW-S is sequential).
+  std::vector<const DenseView*> view_ptrs;
+  std::vector<const ImageF*> wta_ptrs;
+  for (int i = 0; i < n; ++i) {
+    view_ptrs.push_back(&ws.views[i]);
+    wta_ptrs.push_back(&wta[i]);
+  }
+  const double diag_ratio =
+      std::hypot(ws.views[0].camera.width, ws.views[0].camera.height) / options.reference_diagonal;
+  util::Progress progress("dense: envelope + MRF", n);
+  std::mutex error_mutex;
+  std::string first_error;
+  const int outer = std::min(threads, n);
+  const int inner = std::max(1, threads / outer);
+
+  ParallelFor(0, n, outer, [&](int64_t ii) {
+    const int i = static_cast<int>(ii);
+    try {
+      const DenseView& v = ws.views[i];
+      PhotoReport& pr = report.photos[i];
+      const std::string stem = OutputStem(v.name);
+      const LabelGrid grid{shells[i].inv_near, shells[i].inv_far, shells[i].num_labels};
+      auto t0 = Clock::now();
+
+      // Anchors (Fig. 4a-d).
+      const ImageF gc = options.use_gc_filter
+                            ? GeometricConsistencyFilter(i, view_ptrs, wta_ptrs, ws.ranked_neighbors[i],
+                                                         grid.InvStep(), options.gc, inner)
+                            : wta[i];
+      MedianPruneOptions prune = options.prune;
+      prune.small_radius = ScaledRadius(options.prune.small_radius, diag_ratio);
+      prune.large_radius = ScaledRadius(options.prune.large_radius, diag_ratio);
+      const ImageF med = MedianPrune(gc, grid, prune, inner);
+      const ImageF bil = BilateralMedianPrune(med, v.color, grid, prune, inner);
+      pr.anchors = {CountValid(wta[i]), CountValid(gc), CountValid(med), CountValid(bil)};
+
+      // Propagation and envelope (Fig. 4e-f).
+      EnvelopeOptions env_opt = options.envelope;
+      env_opt.variance_radius = ScaledRadius(options.envelope.variance_radius, diag_ratio);
+      PropagationStats ps;
+      const ImageF propagated = PropagateAnchors(bil, v.color, env_opt, &ps);
+      pr.cg_iterations = ps.iterations;
+      ImageF envelope;
+      if (!propagated.empty()) envelope = FinalizeEnvelope(propagated, env_opt);
+      pr.t_envelope = Since(t0);
+
+      // MRF (Eq. 1-4).
+      t0 = Clock::now();
+      CostVolume vol = shells[i];
+      ReadCostCache(cache_path(i), &vol);
+      const int w = vol.width, h = vol.height, L = vol.num_labels;
+      const size_t np = static_cast<size_t>(w) * h;
+      GridMrf mrf;
+      mrf.width = w;
+      mrf.height = h;
+      mrf.num_labels = L;
+      mrf.truncation = options.mrf.truncation_labels;
+      mrf.unary.resize(np * L);
+      const bool near_term = options.use_near_envelope && !envelope.empty() && options.mrf.lambda_near > 0;
+      for (size_t p = 0; p < np; ++p) {
+        const float wp = vol.photo_weight.data()[p];
+        const float* c = vol.cost.data() + p * L;
+        float* u = mrf.unary.data() + p * L;
+        for (int k = 0; k < L; ++k) u[k] = wp * c[k];
+        if (near_term) {
+          // Eq. 4: labels nearer than the envelope (k < label of n_i) pay lambda_near.
+          const double kn = grid.LabelOf(envelope.data()[p]);
+          const int kmax = std::min(L, static_cast<int>(std::ceil(kn)));
+          for (int k = 0; k < kmax; ++k) u[k] += static_cast<float>(options.mrf.lambda_near);
+        }
+      }
+      mrf.weight_right.assign(np, 0.0f);
+      mrf.weight_down.assign(np, 0.0f);
+      const double inv2s2 = 1.0 / (2.0 * options.mrf.sigma_color * options.mrf.sigma_color);
+      const double scale = options.mrf.lambda_smooth / options.mrf.truncation_labels;
+      auto wcolor = [&](int x0, int y0, int x1, int y1) {
+        double d2 = 0;
+        for (int c = 0; c < 3; ++c) {
+          const double e = v.color.at(x0, y0, c) - v.color.at(x1, y1, c);
+          d2 += e * e;
+        }
+        return static_cast<float>(scale * std::max(options.mrf.color_floor, std::exp(-d2 * inv2s2)));
+      };
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const size_t p = static_cast<size_t>(y) * w + x;
+          if (x + 1 < w) mrf.weight_right[p] = wcolor(x, y, x + 1, y);
+          if (y + 1 < h) mrf.weight_down[p] = wcolor(x, y, x, y + 1);
+        }
+      TrwsOptions trws;
+      trws.max_iterations = options.mrf.max_iterations;
+      const TrwsResult res = SolveTrws(mrf, trws);
+      mrf.unary.clear();
+      mrf.unary.shrink_to_fit();
+      pr.mrf_energy = res.energy;
+      pr.mrf_iterations = res.iterations;
+
+      // Labels to depth, with sub-label refinement on E_photo, and confidence.
+      ImageF low_depth(w, h, 1), low_conf(w, h, 1);
+      for (size_t p = 0; p < np; ++p) {
+        const int k = res.labels[p];
+        const float* c = vol.cost.data() + p * L;
+        double kf = k;
+        if (options.mrf.refine_sublabel && k > 0 && k + 1 < L && c[k] <= c[k - 1] && c[k] <= c[k + 1]) {
+          const double denom = c[k - 1] - 2.0 * c[k] + c[k + 1];
+          if (denom > 1e-6) kf += std::min(0.5, std::max(-0.5, 0.5 * (c[k - 1] - c[k + 1]) / denom));
+        }
+        low_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(kf));
+        low_conf.data()[p] = vol.photo_weight.data()[p] * std::max(0.0f, 1.0f - c[k]);
+      }
+      vol.cost.clear();
+      vol.cost.shrink_to_fit();
+      pr.t_mrf = Since(t0);
+
+      // Full resolution (Sec. 4.3.1: joint bilateral weighted median).
+      t0 = Clock::now();
+      const ImageF full_color = ReadPhotoFloat((fs::path(ws.images_dir) / v.name).string());
+      UpsampleOptions up = options.upsample;
+      up.num_threads = inner;
+      const ImageF depth = JointBilateralMedianUpsample(low_depth, v.color, full_color, up);
+      const ImageF conf = ResizeLinear(low_conf, v.full_width, v.full_height);
+      ImageF env_full;
+      if (!envelope.empty()) {
+        env_full = ResizeLinear(envelope, v.full_width, v.full_height);
+      } else {
+        env_full = ImageF(v.full_width, v.full_height, 1, static_cast<float>(v.range.near_m));
+      }
+      io::WriteExr((fs::path(out_dir) / "depth" / (stem + ".exr")).string(), depth.view(), {"Z"});
+      io::WriteExr((fs::path(out_dir) / "confidence" / (stem + ".exr")).string(), conf.view(), {"Y"});
+      io::WriteExr((fs::path(out_dir) / "envelope" / (stem + ".exr")).string(),
+                   static_cast<const ImageF&>(env_full).view(), {"Z"});
+      if (options.debug) {
+        auto png = [&](const char* what, const ImageF& img) {
+          const Image8 rgb = Colorize(img, v.range);
+          io::WritePng((fs::path(debug_dir) / (stem + "_" + what + ".png")).string(), rgb.view());
+        };
+        png("wta", wta[i]);
+        png("gc", gc);
+        png("median", med);
+        png("bilateral", bil);
+        if (!propagated.empty()) png("propagated", propagated);
+        if (!envelope.empty()) png("envelope", envelope);
+        png("mrf", low_depth);
+        png("depth", depth);
+      }
+      pr.t_upsample = Since(t0);
+
+      if (!options.ground_truth_dir.empty()) {
+        const ImageF gt = ReadGroundTruth(options.ground_truth_dir, stem);
+        if (!gt.empty()) {
+          pr.evaluated = true;
+          const DepthAccuracy acc = EvaluateDepth(depth, gt, 0.5 * v.range.far_m);
+          pr.median_rel_error = acc.median_rel_error;
+          pr.within_3pct = acc.within_3pct;
+          pr.near_floaters = acc.near_floaters;
+          pr.sky_near = acc.sky_near;
+          const double tol = 2.0 * grid.InvStep();
+          const char* names[] = {"wta", "gc", "median", "bilateral"};
+          const ImageF* maps[] = {&wta[i], &gc, &med, &bil};
+          for (int s = 0; s < 4; ++s) {
+            const AnchorQuality q = EvaluateAnchors(*maps[s], gt, tol);
+            pr.stages.push_back({names[s], q.completeness, q.precision});
+          }
+          if (!envelope.empty()) {
+            const EnvelopeQuality eq = EvaluateEnvelope(envelope, gt);
+            pr.envelope_error = eq.error;
+            pr.envelope_tightness = eq.tightness;
+          }
+        }
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (first_error.empty()) first_error = ws.views[i].name + ": " + e.what();
+    }
+    progress.Advance();
+  });
+  progress.Finish();
+  if (!first_error.empty()) throw std::runtime_error(first_error);
+
+  // Summary.
+  long long weight = 0;
+  for (const PhotoReport& pr : report.photos) {
+    if (!pr.evaluated) continue;
+    const long long px = static_cast<long long>(pr.width) * pr.height;
+    report.evaluated = true;
+    report.median_rel_error += pr.median_rel_error * px;
+    report.within_3pct += pr.within_3pct * px;
+    report.near_floaters += pr.near_floaters * px;
+    weight += px;
+  }
+  if (weight > 0) {
+    report.median_rel_error /= weight;
+    report.within_3pct /= weight;
+    report.near_floaters /= weight;
+  }
+  report.seconds_total = Since(t_start);
+  report.peak_rss_bytes = PeakRssBytes();
+
+  nlohmann::json j;
+  j["format"] = "casual3d-dense-report";
+  j["version"] = "1.0";
+  j["seconds_total"] = report.seconds_total;
+  j["seconds_load"] = report.seconds_load;
+  j["peak_rss_bytes"] = report.peak_rss_bytes;
+  j["use_near_envelope"] = options.use_near_envelope;
+  j["use_gc_filter"] = options.use_gc_filter;
+  j["num_depths"] = options.sweep.num_depths;
+  j["working_scale"] = options.working_scale;
+  if (report.evaluated) {
+    j["accuracy"] = {{"median_rel_error", report.median_rel_error},
+                     {"within_3pct", report.within_3pct},
+                     {"near_floaters", report.near_floaters}};
+  }
+  for (const PhotoReport& pr : report.photos) {
+    nlohmann::json p;
+    p["name"] = pr.name;
+    p["neighbors"] = pr.neighbors;
+    p["near_m"] = pr.near_m;
+    p["far_m"] = pr.far_m;
+    p["size"] = {pr.width, pr.height};
+    p["work_size"] = {pr.work_width, pr.work_height};
+    p["anchors"] = {{"wta", pr.anchors[0]}, {"gc", pr.anchors[1]}, {"median", pr.anchors[2]},
+                    {"bilateral", pr.anchors[3]}};
+    p["cg_iterations"] = pr.cg_iterations;
+    p["mrf_energy"] = pr.mrf_energy;
+    p["mrf_iterations"] = pr.mrf_iterations;
+    p["seconds"] = {{"sweep", pr.t_sweep}, {"envelope", pr.t_envelope}, {"mrf", pr.t_mrf},
+                    {"upsample_write", pr.t_upsample}};
+    if (pr.evaluated) {
+      p["accuracy"] = {{"median_rel_error", pr.median_rel_error}, {"within_3pct", pr.within_3pct},
+                       {"near_floaters", pr.near_floaters}, {"sky_near", pr.sky_near}};
+      for (const StageQuality& s : pr.stages)
+        p["anchor_quality"][s.stage] = {{"completeness", s.completeness}, {"precision", s.precision}};
+      p["envelope_quality"] = {{"error", pr.envelope_error}, {"tightness", pr.envelope_tightness}};
+    }
+    j["photos"].push_back(p);
+  }
+  io::WriteFileAtomic((fs::path(out_dir) / "dense.json").string(), j.dump(2) + "\n");
+  return report;
+}
+
+}  // namespace casual3d::depth

@@ -1,0 +1,112 @@
+#pragma once
+
+// The dense stage (Sec. 4.3): a depth map per photo from a workspace of
+// undistorted photos and their COLMAP model.
+//
+// Inputs:  WORKSPACE/images/<name>, WORKSPACE/sparse/ (PINHOLE cameras),
+//          optional WORKSPACE/{sparse/,}depth_ranges.json.
+// Outputs (OUT/, every file written atomically; spec/stage-dense.md):
+//   depth/<stem>.exr       float "Z": depth in metres along the optical axis, full resolution
+//   confidence/<stem>.exr  float "Y" in [0, 1]: w_photo * (1 - E_photo) of the chosen depth
+//   envelope/<stem>.exr    float "Z": the near envelope (metres), full resolution
+//   dense.json             per photo: neighbours, depth range, anchor counts, timings
+//                          (and accuracy when ground truth is given)
+//   debug/<stem>_{wta,gc,median,bilateral,propagated,envelope,mrf,depth}.png  with debug
+//
+// Per photo: neighbour selection; plane sweep with ZNCC (plane_sweep.h);
+// WTA; near envelope: GC filter (gc_filter.h), median and bilateral median
+// pruning (median_prune.h), Poisson propagation, scaling and min filter
+// (near_envelope.h); MRF of Eq. 1-4 solved by TRW-S (mrf_trws.h); sub-label
+// refinement; joint bilateral weighted-median upsampling (upsample.h).
+
+#include <string>
+#include <vector>
+
+#include "format/status.h"
+#include "reconstruct/depth/gc_filter.h"
+#include "reconstruct/depth/median_prune.h"
+#include "reconstruct/depth/near_envelope.h"
+#include "reconstruct/depth/neighbor_selection.h"
+#include "reconstruct/depth/plane_sweep.h"
+#include "reconstruct/depth/upsample.h"
+
+namespace casual3d::depth {
+
+// Terms of Eq. 1, 2 and 4.
+struct MrfTermOptions {
+  double lambda_smooth = 0.25;  // Sec. 4.3.1: lambda_smooth. [0, 100].
+  double lambda_near = 1.0;     // Sec. 4.3.2: lambda_near (Eq. 4). [0, 100].
+  double sigma_color = 0.06;    // w_color = exp(-|c_i - c_j|^2 / (2 sigma^2)), colour in [0, 1]. (0, 10].
+  double color_floor = 0.02;    // Lower bound of w_color, so strong edges still regularise a little. [0, 1].
+  int truncation_labels = 8;    // w_depth = min(|k_i - k_j|, T) / T, labels (inverse depth). [1, 4096].
+  int max_iterations = 8;       // TRW-S passes. [1, 1000].
+  bool refine_sublabel = true;  // Parabola fit of E_photo around the chosen label.
+
+  Status Check() const;
+};
+
+struct DenseOptions {
+  double working_scale = 0.5;  // Sweep, envelope and MRF resolution relative to the photos. (0, 1].
+  int num_neighbors = 4;       // Sec. 4.3.1 (issue): neighbours per sweep. [1, 16].
+  // Filter sizes below are given for a 900x1350 image (Sec. 4.3.2) and scaled
+  // with the working image's diagonal.
+  double reference_diagonal = 1622.5;  // sqrt(900^2 + 1350^2), pixels.
+  NeighborOptions neighbors;
+  SweepOptions sweep;
+  GcFilterOptions gc;
+  MedianPruneOptions prune;
+  EnvelopeOptions envelope;
+  MrfTermOptions mrf;
+  UpsampleOptions upsample;
+  bool use_near_envelope = true;  // false: the "MRF without near envelope" baseline (Fig. 5).
+  bool use_gc_filter = true;      // false: skip the GC filter when building anchors.
+  bool debug = false;             // Colour-mapped PNGs of every intermediate.
+  int num_threads = 0;            // 0 = all cores.
+  // Optional: folder with ground-truth depth <stem>.exr ("Z", metres, +inf sky)
+  // to evaluate against (reported in dense.json).
+  std::string ground_truth_dir;
+
+  Status Check() const;
+};
+
+struct StageQuality {
+  std::string stage;  // "wta", "gc", "median", "bilateral".
+  double completeness = 0.0;
+  double precision = 0.0;
+};
+
+struct PhotoReport {
+  std::string name;
+  std::vector<std::string> neighbors;
+  double near_m = 0.0, far_m = 0.0;
+  int width = 0, height = 0;              // Output size.
+  int work_width = 0, work_height = 0;    // Working size.
+  std::vector<int> anchors;               // Surviving pixels after wta, gc, median, bilateral.
+  int cg_iterations = 0;
+  double mrf_energy = 0.0;
+  int mrf_iterations = 0;
+  // Seconds per step.
+  double t_sweep = 0, t_envelope = 0, t_mrf = 0, t_upsample = 0;
+  // Filled when ground truth is available.
+  bool evaluated = false;
+  double median_rel_error = 0, within_3pct = 0, near_floaters = 0, sky_near = 0;
+  std::vector<StageQuality> stages;
+  double envelope_error = 0, envelope_tightness = 0;
+};
+
+struct DenseReport {
+  std::vector<PhotoReport> photos;
+  double seconds_total = 0.0;
+  double seconds_load = 0.0;
+  size_t peak_rss_bytes = 0;
+  // Means over evaluated photos (pixel-weighted for accuracy).
+  bool evaluated = false;
+  double median_rel_error = 0, within_3pct = 0, near_floaters = 0;
+};
+
+// Runs the stage. Throws std::invalid_argument for bad options and
+// std::runtime_error (naming the file) for bad inputs.
+DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& out_dir,
+                          const DenseOptions& options);
+
+}  // namespace casual3d::depth

@@ -1,0 +1,87 @@
+#include "reconstruct/depth/dense_stage.h"
+
+#include <cstdlib>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "reconstruct/depth/depth_metrics.h"
+#include "reconstruct/depth/testing/toy_scene.h"
+#include "reconstruct/io/exr_io.h"
+
+namespace casual3d::depth {
+namespace {
+namespace fs = std::filesystem;
+
+class DenseStageTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = new fs::path(fs::temp_directory_path() /
+                         ("casual3d_dense_test_" + std::to_string(::getpid())));
+    fs::create_directories(*root_);
+    testing::WriteToyWorkspace((*root_ / "ws").string(), testing::ToyScene::Default(), 3, 3, 0.12,
+                               240, 180, 200.0);
+  }
+  static void TearDownTestSuite() {
+    if (std::getenv("CASUAL3D_KEEP_TEST_OUTPUT")) return;  // For inspecting debug images.
+    std::error_code ec;
+    fs::remove_all(*root_, ec);
+    delete root_;
+  }
+  static DenseOptions Options() {
+    DenseOptions o;
+    o.working_scale = 0.5;
+    o.num_threads = 2;
+    o.ground_truth_dir = (*root_ / "ws" / "gt").string();
+    return o;
+  }
+  static fs::path* root_;
+};
+fs::path* DenseStageTest::root_ = nullptr;
+
+TEST_F(DenseStageTest, ReconstructsTheToySceneAccurately) {
+  DenseOptions o = Options();
+  o.debug = true;
+  const fs::path out = *root_ / "out";
+  const DenseReport r = RunDenseStage((*root_ / "ws").string(), out.string(), o);
+  ASSERT_EQ(r.photos.size(), 9u);
+  ASSERT_TRUE(r.evaluated);
+  std::printf("toy: median rel %.4f within3 %.4f floaters %.4f\n", r.median_rel_error, r.within_3pct,
+              r.near_floaters);
+  EXPECT_LE(r.median_rel_error, 0.015);
+  EXPECT_GE(r.within_3pct, 0.80);
+  EXPECT_LE(r.near_floaters, 0.01);
+  // Outputs exist at full resolution; the cost cache is gone.
+  const ImageF d = io::ReadExrChannels((out / "depth" / "0005.exr").string(), {"Z"});
+  EXPECT_EQ(d.width(), 240);
+  EXPECT_EQ(d.height(), 180);
+  EXPECT_TRUE(fs::exists(out / "confidence" / "0005.exr"));
+  EXPECT_TRUE(fs::exists(out / "envelope" / "0005.exr"));
+  EXPECT_TRUE(fs::exists(out / "dense.json"));
+  EXPECT_TRUE(fs::exists(out / "debug" / "0005_bilateral.png"));
+  EXPECT_FALSE(fs::exists(out / ".dense-cache"));
+  // The pruning stages raise precision (Fig. 6): anchors after the last
+  // filter are more precise than the raw WTA and the envelope rarely cuts content.
+  for (const PhotoReport& p : r.photos) {
+    ASSERT_EQ(p.stages.size(), 4u);
+    EXPECT_GE(p.stages[3].precision, p.stages[0].precision) << p.name;
+    EXPECT_GE(p.stages[3].precision, 0.9) << p.name;
+    EXPECT_LE(p.envelope_error, 0.02) << p.name;
+  }
+}
+
+TEST_F(DenseStageTest, RejectsAMissingWorkspaceWithAClearMessage) {
+  try {
+    RunDenseStage((*root_ / "nope").string(), (*root_ / "out2").string(), Options());
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nope"), std::string::npos) << e.what();
+  }
+  DenseOptions bad = Options();
+  bad.working_scale = 2.0;
+  EXPECT_THROW(RunDenseStage((*root_ / "ws").string(), (*root_ / "out3").string(), bad),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace casual3d::depth

@@ -1,0 +1,41 @@
+#pragma once
+
+// Accuracy of depth maps against ground truth (metres along the optical
+// axis, +inf or non-finite for sky), as the dense stage reports them
+// (spec/stage-dense.md, "Evaluation"). Maps may differ in size: the ground
+// truth is sampled at each estimate pixel's centre (nearest pixel).
+
+#include "format/image.h"
+
+namespace casual3d::depth {
+
+// Final depth map accuracy over pixels with finite ground truth.
+struct DepthAccuracy {
+  long long pixels = 0;            // Pixels with finite ground truth.
+  double median_rel_error = 0.0;   // median |d - g| / g.
+  double within_3pct = 0.0;        // Fraction with |d - g| / g <= 0.03.
+  double near_floaters = 0.0;      // Fraction with d < 0.85 g (or d missing).
+  long long sky_pixels = 0;        // Pixels with infinite ground truth.
+  double sky_near = 0.0;           // Fraction of sky pixels with d < sky_near_m.
+};
+// `sky_near_m`: depth below which an estimate on a sky pixel counts as a
+// near floater (callers pass half the sweep's far bound).
+DepthAccuracy EvaluateDepth(const ImageF& depth, const ImageF& ground_truth, double sky_near_m);
+
+// Completeness and precision of a pruned anchor map (Fig. 6, left).
+// An anchor is an inlier when |1/d - 1/g| <= inv_tolerance (1/m), which also
+// handles sky (1/g = 0).
+struct AnchorQuality {
+  double completeness = 0.0;  // Fraction of all pixels that are anchors.
+  double precision = 0.0;     // Fraction of anchors that are inliers.
+};
+AnchorQuality EvaluateAnchors(const ImageF& anchors, const ImageF& ground_truth, double inv_tolerance);
+
+// Near envelope quality (Fig. 6, right).
+struct EnvelopeQuality {
+  double error = 0.0;      // Fraction of pixels where the envelope lies behind the true surface.
+  double tightness = 0.0;  // Mean of 1/n - 1/g over pixels with finite ground truth, 1/m.
+};
+EnvelopeQuality EvaluateEnvelope(const ImageF& envelope, const ImageF& ground_truth);
+
+}  // namespace casual3d::depth

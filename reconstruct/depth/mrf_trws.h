@@ -1,0 +1,47 @@
+#pragma once
+
+// Multi-label MRF on a 4-connected grid with truncated-linear pairwise terms,
+// minimised by sequential tree-reweighted message passing (TRW-S,
+// Kolmogorov 2006). The dense stage uses it for Eq. 1:
+//   E(x) = sum_i U_i(x_i) + sum_(i,j) w_ij * min(|x_i - x_j|, T)
+// where U is the data term (Eq. 3 plus Eq. 4) and w_ij * min(|.|, T) is
+// lambda_smooth * w_color * w_depth (Eq. 2) with w_depth truncated linear in
+// the label (inverse depth) difference. Messages are computed in O(L) per
+// edge with the lower-envelope distance transform of Felzenszwalb and
+// Huttenlocher (2006), so one iteration costs O(pixels * labels).
+
+#include <cstdint>
+#include <vector>
+
+namespace casual3d::depth {
+
+struct GridMrf {
+  int width = 0;
+  int height = 0;
+  int num_labels = 0;
+  std::vector<float> unary;         // (y * width + x) * num_labels + label.
+  std::vector<float> weight_right;  // width*height: weight of edge (x,y)-(x+1,y); last column unused.
+  std::vector<float> weight_down;   // width*height: weight of edge (x,y)-(x,y+1); last row unused.
+  int truncation = 1;               // T, in labels (>= 1).
+};
+
+struct TrwsOptions {
+  int max_iterations = 12;        // Forward+backward passes. [1, 1000].
+  double relative_tolerance = 1e-4;  // A pass "improves" when the best energy drops by more. [0, 1].
+  int patience = 3;                  // Stop after this many passes without improvement. [1, 1000].
+};
+
+struct TrwsResult {
+  std::vector<uint16_t> labels;  // Best labelling found, row-major.
+  double energy = 0.0;           // Its energy.
+  int iterations = 0;
+};
+
+// Minimises the MRF. Requires num_labels in [1, 65535] and consistent sizes
+// (throws std::invalid_argument otherwise). Deterministic.
+TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options = TrwsOptions());
+
+// Energy of a labelling.
+double MrfEnergy(const GridMrf& mrf, const std::vector<uint16_t>& labels);
+
+}  // namespace casual3d::depth

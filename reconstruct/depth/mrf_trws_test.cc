@@ -1,0 +1,134 @@
+#include "reconstruct/depth/mrf_trws.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace casual3d::depth {
+namespace {
+
+GridMrf RandomMrf(int w, int h, int labels, int truncation, unsigned seed, float smooth) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  GridMrf m;
+  m.width = w;
+  m.height = h;
+  m.num_labels = labels;
+  m.truncation = truncation;
+  m.unary.resize(static_cast<size_t>(w) * h * labels);
+  for (float& v : m.unary) v = u01(rng);
+  m.weight_right.resize(static_cast<size_t>(w) * h);
+  m.weight_down.resize(static_cast<size_t>(w) * h);
+  for (float& v : m.weight_right) v = smooth * u01(rng);
+  for (float& v : m.weight_down) v = smooth * u01(rng);
+  return m;
+}
+
+// Exhaustive minimum over all labellings (small problems only).
+double BruteForce(const GridMrf& m) {
+  const size_t n = static_cast<size_t>(m.width) * m.height;
+  std::vector<uint16_t> lab(n, 0);
+  double best = std::numeric_limits<double>::infinity();
+  for (;;) {
+    best = std::min(best, MrfEnergy(m, lab));
+    size_t i = 0;
+    while (i < n && ++lab[i] == m.num_labels) lab[i++] = 0;
+    if (i == n) break;
+  }
+  return best;
+}
+
+// Iterated conditional modes from the unary minimum: a weak reference solver.
+double Icm(const GridMrf& m) {
+  const int w = m.width, h = m.height, L = m.num_labels;
+  std::vector<uint16_t> lab(static_cast<size_t>(w) * h);
+  for (size_t p = 0; p < lab.size(); ++p)
+    lab[p] = static_cast<uint16_t>(std::min_element(&m.unary[p * L], &m.unary[p * L] + L) - &m.unary[p * L]);
+  for (int it = 0; it < 20; ++it)
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t p = static_cast<size_t>(y) * w + x;
+        int best = lab[p];
+        double best_c = std::numeric_limits<double>::infinity();
+        for (int l = 0; l < L; ++l) {
+          double c = m.unary[p * L + l];
+          auto pw = [&](float wt, int o) { c += wt * std::min(std::abs(l - o), m.truncation); };
+          if (x > 0) pw(m.weight_right[p - 1], lab[p - 1]);
+          if (x + 1 < w) pw(m.weight_right[p], lab[p + 1]);
+          if (y > 0) pw(m.weight_down[p - w], lab[p - w]);
+          if (y + 1 < h) pw(m.weight_down[p], lab[p + w]);
+          if (c < best_c) {
+            best_c = c;
+            best = l;
+          }
+        }
+        lab[p] = static_cast<uint16_t>(best);
+      }
+  return MrfEnergy(m, lab);
+}
+
+TEST(Trws, MatchesExhaustiveSearchOnSmallGrids) {
+  double worst_gap = 0.0, total_gap = 0.0;
+  int optimal = 0;
+  const int kProblems = 24;
+  for (int s = 0; s < kProblems; ++s) {
+    // 3x3 grid, 4 labels: 262,144 labellings. Strong smoothness makes it non-trivial.
+    const GridMrf m = RandomMrf(3, 3, 4, 2, 100 + s, 0.6f);
+    const double ref = BruteForce(m);
+    const TrwsResult r = SolveTrws(m);  // Default options, as the dense stage uses them.
+    EXPECT_NEAR(r.energy, MrfEnergy(m, r.labels), 1e-5);
+    EXPECT_GE(r.energy, ref - 1e-6);
+    const double gap = (r.energy - ref) / ref;
+    worst_gap = std::max(worst_gap, gap);
+    total_gap += gap;
+    optimal += gap < 1e-6;
+  }
+  EXPECT_LE(worst_gap, 0.01);
+  EXPECT_LE(total_gap / kProblems, 0.001);
+  EXPECT_GE(optimal, kProblems - 2);
+}
+
+TEST(Trws, BeatsIcmOnLargerProblems) {
+  for (int s = 0; s < 3; ++s) {
+    const GridMrf m = RandomMrf(40, 30, 32, 6, 7 + s, 0.3f);
+    const TrwsResult r = SolveTrws(m);
+    EXPECT_LT(r.energy, Icm(m) * 0.99);
+  }
+}
+
+TEST(Trws, DenoisesAPiecewiseConstantLabelImage) {
+  // Two regions (labels 5 and 20 of 32); unaries favour the truth with noise.
+  const int w = 48, h = 32, L = 32;
+  GridMrf m;
+  m.width = w;
+  m.height = h;
+  m.num_labels = L;
+  m.truncation = 4;
+  m.unary.resize(static_cast<size_t>(w) * h * L);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> noise(0.0f, 1.0f);
+  std::vector<int> truth(static_cast<size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t p = static_cast<size_t>(y) * w + x;
+      truth[p] = x < w / 2 ? 5 : 20;
+      for (int l = 0; l < L; ++l) m.unary[p * L + l] = 0.6f * noise(rng) + (l == truth[p] ? 0.0f : 0.35f);
+    }
+  m.weight_right.assign(static_cast<size_t>(w) * h, 0.15f);
+  m.weight_down.assign(static_cast<size_t>(w) * h, 0.15f);
+  const TrwsResult r = SolveTrws(m);
+  int correct = 0;
+  for (size_t p = 0; p < truth.size(); ++p) correct += r.labels[p] == truth[p];
+  EXPECT_GE(correct, static_cast<int>(0.98 * truth.size()));
+}
+
+TEST(Trws, RejectsInconsistentSizes) {
+  GridMrf m = RandomMrf(4, 4, 3, 1, 1, 0.1f);
+  m.unary.pop_back();
+  EXPECT_THROW(SolveTrws(m), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace casual3d::depth

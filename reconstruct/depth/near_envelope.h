@@ -1,0 +1,56 @@
+#pragma once
+
+// Near envelope from pruned anchors (Sec. 4.3.2, Fig. 4e-f).
+//
+// Propagation (Eq. 5): minimise sum_i w_i (x_i - x'_i)^2 + sum_(i,j) w_ij (x_i - x_j)^2
+// over the 4-connected grid, with x' the anchors, w_ij = exp(-|c_i - c_j|^2 / (2 sigma_env^2))
+// (Levin et al. 2004) and w_i = unary_scale * sigma_i^2 (+ unary_floor) at anchors, sigma_i^2
+// the colour variance of the surrounding patch (Kopf et al. 2013). The normal
+// equations (W + L) x = W x' are symmetric positive definite whenever one
+// anchor exists; they are solved with Eigen's preconditioned conjugate
+// gradient. We propagate inverse depth rather than depth: the sweep samples
+// inverse depth uniformly, and interpolating inverse depth between a near and
+// a far anchor stays nearer (more conservative for a lower bound) than
+// interpolating depth.
+//
+// Final envelope: the propagated depth times `scale` (0.9), then a
+// morphological minimum filter of diameter min_filter_fraction (about 3%) of
+// the image diagonal.
+
+#include "format/image.h"
+#include "format/status.h"
+
+namespace casual3d::depth {
+
+struct EnvelopeOptions {
+  double sigma_env = 0.1;            // Sec. 4.3.2: colour affinity sigma, colour in [0, 1].
+  double unary_scale = 250.0;        // Sec. 4.3.2: w_i = 250 sigma_i^2.
+  double unary_floor = 0.01;         // Added to w_i so flat anchors still count. [0, 1e3].
+  int variance_radius = 9;           // Sec. 4.3.2: 19x19 patch at 900x1350 (scaled by caller).
+  double scale = 0.9;                // Sec. 4.3.2: envelope = scale * propagated. (0, 1].
+  double min_filter_fraction = 0.03; // Sec. 4.3.2: min-filter diameter / image diagonal. [0, 0.5].
+  double cg_tolerance = 1e-5;        // Relative residual of the conjugate gradient. (0, 0.1].
+  int cg_max_iterations = 3000;      // [1, 100000].
+
+  Status Check() const;
+};
+
+struct PropagationStats {
+  int anchors = 0;
+  int iterations = 0;
+  double residual = 0.0;  // Relative residual reached.
+};
+
+// Propagates the anchors of `anchors_depth` (metres, 0 = none) over the
+// image guided by `color` (RGB in [0, 1], same size). Returns a dense depth
+// map (metres). With no anchor at all, returns an empty image.
+ImageF PropagateAnchors(const ImageF& anchors_depth, const ImageF& color,
+                        const EnvelopeOptions& options, PropagationStats* stats = nullptr);
+
+// scale * propagated, then the minimum filter. Returns the envelope (metres).
+ImageF FinalizeEnvelope(const ImageF& propagated, const EnvelopeOptions& options);
+
+// Morphological minimum filter with a square window of odd side `diameter`.
+ImageF MinFilter(const ImageF& image, int diameter);
+
+}  // namespace casual3d::depth

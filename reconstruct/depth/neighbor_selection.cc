@@ -1,0 +1,107 @@
+#include "reconstruct/depth/neighbor_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace casual3d::depth {
+
+Status NeighborOptions::Check() const {
+  if (!(theta_good_deg > 0 && theta_good_deg <= 90))
+    return InvalidArgument("theta_good_deg outside (0, 90]");
+  if (!(min_angle_deg >= 0 && min_angle_deg < 90)) return InvalidArgument("min_angle_deg outside [0, 90)");
+  if (!(max_angle_deg > min_angle_deg && max_angle_deg <= 180))
+    return InvalidArgument("max_angle_deg must lie in (min_angle_deg, 180]");
+  if (min_shared_points < 1 || min_shared_points > 1000000)
+    return InvalidArgument("min_shared_points outside [1, 1e6]");
+  return Status::Ok();
+}
+
+std::vector<std::vector<int>> RankNeighbors(
+    const std::vector<NeighborInput>& views,
+    const std::vector<std::pair<long long, Eigen::Vector3d>>& point_positions,
+    const NeighborOptions& options) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument(st.message());
+  const int n = static_cast<int>(views.size());
+  std::unordered_map<long long, int> point_index;
+  for (size_t i = 0; i < point_positions.size(); ++i) point_index[point_positions[i].first] = static_cast<int>(i);
+  // Which views observe each point.
+  std::vector<std::vector<int>> observers(point_positions.size());
+  for (int v = 0; v < n; ++v)
+    for (long long id : views[v].point_ids) {
+      auto it = point_index.find(id);
+      if (it != point_index.end()) observers[it->second].push_back(v);
+    }
+  for (auto& o : observers) {
+    std::sort(o.begin(), o.end());
+    o.erase(std::unique(o.begin(), o.end()), o.end());
+  }
+
+  // Pairwise angle lists, accumulated per point.
+  std::vector<std::vector<std::vector<float>>> angles(n, std::vector<std::vector<float>>(n));
+  const double rad2deg = 180.0 / M_PI;
+  for (size_t p = 0; p < observers.size(); ++p) {
+    const auto& obs = observers[p];
+    const Eigen::Vector3d& x = point_positions[p].second;
+    for (size_t a = 0; a < obs.size(); ++a)
+      for (size_t b = a + 1; b < obs.size(); ++b) {
+        const Eigen::Vector3d ra = (views[obs[a]].center - x).normalized();
+        const Eigen::Vector3d rb = (views[obs[b]].center - x).normalized();
+        const float ang = static_cast<float>(
+            std::acos(std::min(1.0, std::max(-1.0, ra.dot(rb)))) * rad2deg);
+        angles[obs[a]][obs[b]].push_back(ang);
+      }
+  }
+
+  // Fallback score from geometry alone.
+  std::vector<double> baselines;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) baselines.push_back((views[i].center - views[j].center).norm());
+  double median_baseline = 1.0;
+  if (!baselines.empty()) {
+    std::nth_element(baselines.begin(), baselines.begin() + baselines.size() / 2, baselines.end());
+    median_baseline = std::max(1e-12, baselines[baselines.size() / 2]);
+  }
+  auto fallback = [&](int i, int j) {
+    const double c = std::max(0.0, views[i].direction.dot(views[j].direction));
+    const double b = (views[i].center - views[j].center).norm();
+    return c * std::min(1.0, b / median_baseline);
+  };
+
+  std::vector<std::vector<int>> ranked(n);
+  for (int i = 0; i < n; ++i) {
+    // (primary, score): primary pairs (enough shared points with usable angles) first.
+    std::vector<std::pair<std::pair<int, double>, int>> cand;
+    for (int j = 0; j < n; ++j) {
+      if (j == i) continue;
+      std::vector<float> a = i < j ? angles[i][j] : angles[j][i];
+      int primary = 0;
+      double score = fallback(i, j);
+      if (static_cast<int>(a.size()) >= options.min_shared_points) {
+        std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+        const double med = a[a.size() / 2];
+        if (med >= options.min_angle_deg && med <= options.max_angle_deg) {
+          primary = 1;
+          score = 0.0;
+          for (float t : a) {
+            const double g = std::min(1.0, t / options.theta_good_deg);
+            score += t <= options.max_angle_deg ? g * g : 0.0;
+          }
+        }
+      }
+      cand.push_back({{primary, score}, j});
+    }
+    std::sort(cand.begin(), cand.end(), [](const auto& x, const auto& y) {
+      if (x.first.first != y.first.first) return x.first.first > y.first.first;
+      if (x.first.second != y.first.second) return x.first.second > y.first.second;
+      return x.second < y.second;
+    });
+    for (const auto& c : cand) ranked[i].push_back(c.second);
+  }
+  return ranked;
+}
+
+}  // namespace casual3d::depth

@@ -1,0 +1,50 @@
+#pragma once
+
+// Neighbour selection for the plane sweep (Sec. 4.3.1): for each photo, the
+// other photos ranked by how useful they are as stereo partners.
+//
+// Score of view j for reference i (our choice; the supplement is lost):
+//   sum over sparse points seen by both of g(theta), g(theta) = min(1, theta / theta_good)^2
+// where theta is the triangulation angle at the point: shared points show
+// overlap, the angle term rewards the baseline that makes depth measurable.
+// Views sharing fewer than min_shared_points, or whose median triangulation
+// angle is below min_angle_deg (no measurable parallax) or above
+// max_angle_deg (too different for patch matching), are ranked after all
+// the others by the fallback score. When a model has no usable points, views
+// are ranked by the fallback: cos(angle between optical axes), positive only,
+// times min(1, baseline / median baseline).
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "format/status.h"
+
+namespace casual3d::depth {
+
+struct NeighborOptions {
+  double theta_good_deg = 5.0;    // Triangulation angle with full score, degrees. (0, 90].
+  double min_angle_deg = 0.1;     // Median angle below which a pair has no parallax. [0, 90).
+  double max_angle_deg = 45.0;    // Median angle above which patches differ too much. (0, 180].
+  int min_shared_points = 10;     // Shared sparse points for a ranked pair. [1, 1e6].
+
+  Status Check() const;
+};
+
+// What neighbour selection needs to know about one view.
+struct NeighborInput {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();     // Camera centre, world.
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ(); // Optical axis, world (unit).
+  std::vector<long long> point_ids;                     // Sparse points it observes (any order).
+};
+
+// Returns, for every view, the other views ordered best first (all of them;
+// callers take the first few). `points` holds the sparse points' positions,
+// indexed by the ids in point_ids (via `point_positions`, a map from id to
+// position built by the caller as a sorted vector of (id, xyz)).
+std::vector<std::vector<int>> RankNeighbors(
+    const std::vector<NeighborInput>& views,
+    const std::vector<std::pair<long long, Eigen::Vector3d>>& point_positions,
+    const NeighborOptions& options);
+
+}  // namespace casual3d::depth

@@ -1,0 +1,75 @@
+#pragma once
+
+// Plane-sweep cost volume (Sec. 4.3.1, Collins 1996): for each pixel of a
+// reference photo and each of `num_depths` fronto-parallel planes spaced
+// uniformly in inverse depth, the photo-consistency cost E_photo of Eq. 3
+// against the neighbouring photos, and the per-pixel confidence w_photo.
+//
+// Photo-consistency (the paper's supplement is lost; our choice, see
+// spec/stage-dense.md): zero-mean normalised cross-correlation (ZNCC) over a
+// (2r+1)^2 window on the grey image, which is invariant to gain and offset
+// (exposure changes). Per neighbour the cost is min(1, 1 - ZNCC) in [0, 1];
+// the costs of the `best_k` best neighbours are averaged, which tolerates
+// partial occlusion (a surface hidden in some neighbours still matches in the
+// others). w_photo = var / (var + texture_sigma^2) with var the reference
+// window's intensity variance: low in textureless regions, where ZNCC is noise.
+
+#include <cstdint>
+#include <vector>
+
+#include "format/image.h"
+#include "format/status.h"
+#include "reconstruct/depth/view.h"
+
+namespace casual3d::depth {
+
+struct SweepOptions {
+  int num_depths = 220;          // Sec. 4.3.1: depth hypotheses. Range [2, 4096].
+  int window_radius = 3;         // ZNCC window radius at working resolution, pixels. [1, 15].
+  int best_k = 2;                // Neighbours averaged per pixel (best costs first). [1, 16].
+  double ncc_epsilon = 2.5e-5;   // Variance added to both windows (intensity^2); damps ZNCC of
+                                 // flat, noisy windows towards 0. [0, 1].
+  double texture_sigma = 0.02;   // w_photo = var / (var + texture_sigma^2), intensity. (0, 1].
+  int num_threads = 0;           // 0 = all cores.
+
+  Status Check() const;
+};
+
+// Costs for every pixel and depth label, pixel-major so that one pixel's
+// costs are contiguous (the MRF's access pattern). Label 0 is the nearest
+// plane, label num_labels-1 the farthest.
+struct CostVolume {
+  int width = 0;
+  int height = 0;
+  int num_labels = 0;
+  double inv_near = 0.0;  // 1 / near_m: inverse depth of label 0, 1/m.
+  double inv_far = 0.0;   // 1 / far_m: inverse depth of the last label, 1/m.
+  std::vector<float> cost;  // E_photo in [0, 1], index (y * width + x) * num_labels + k.
+  ImageF photo_weight;      // w_photo per pixel in [0, 1].
+
+  const float* Costs(int x, int y) const {
+    return cost.data() + (static_cast<size_t>(y) * width + x) * num_labels;
+  }
+  // Inverse depth (1/m) of a possibly fractional label.
+  double InvDepthOfLabel(double k) const {
+    return inv_near + (inv_far - inv_near) * k / (num_labels - 1);
+  }
+  double DepthOfLabel(double k) const { return 1.0 / InvDepthOfLabel(k); }
+  // Fractional label of a depth (metres), not clamped.
+  double LabelOfDepth(double depth_m) const {
+    return (1.0 / depth_m - inv_near) / (inv_far - inv_near) * (num_labels - 1);
+  }
+};
+
+// Builds the cost volume of `ref` against `neighbors` (all at the working
+// resolution, same size or not). Requires ref.range with 0 < near < far and at
+// least one neighbour. Throws std::invalid_argument on bad options or input.
+CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const DenseView*>& neighbors,
+                             const SweepOptions& options);
+
+// Winner-takes-all (Sec. 4.3.2): per pixel, the depth (metres) of the label
+// minimising E_photo, ignoring smoothness. Pixels where every label costs 1
+// (seen by no neighbour) get depth 0 (invalid).
+ImageF WinnerTakesAll(const CostVolume& volume, int num_threads = 0);
+
+}  // namespace casual3d::depth

@@ -1,0 +1,40 @@
+#pragma once
+
+// Loading a dense-stage workspace: WORKSPACE/images/<name> (undistorted
+// photos) and WORKSPACE/sparse/ (COLMAP model of PINHOLE or SIMPLE_PINHOLE
+// cameras), with per-photo depth ranges from WORKSPACE/sparse/depth_ranges.json
+// or WORKSPACE/depth_ranges.json when the sparse stage wrote one, otherwise
+// computed from the model (sfm::ComputeDepthRanges). This is the one place
+// where geometry:: types are converted to the dense stage's PinholeCamera.
+
+#include <string>
+#include <vector>
+
+#include "reconstruct/depth/neighbor_selection.h"
+#include "reconstruct/depth/view.h"
+
+namespace casual3d::depth {
+
+struct LoadedWorkspace {
+  std::vector<DenseView> views;                  // Sorted by image name.
+  std::vector<std::vector<int>> ranked_neighbors;  // Per view, the others best first.
+  std::string images_dir;
+};
+
+// Reads the model and the photos, downscales them by `working_scale` (0, 1]
+// and ranks neighbours. Throws std::runtime_error naming the file and the
+// problem (missing folder, undecodable photo, distorted camera model, ...).
+LoadedWorkspace LoadWorkspace(const std::string& workspace_dir, double working_scale,
+                              const NeighborOptions& neighbor_options);
+
+// Reads one photo at full resolution as RGB float in [0, 1].
+ImageF ReadPhotoFloat(const std::string& path);
+
+// Resizes an RGB or grey float image with area averaging (OpenCV INTER_AREA).
+ImageF ResizeArea(const ImageF& image, int width, int height);
+
+// File stem used for a photo's outputs: the image name without its
+// extension, with path separators replaced by '_'.
+std::string OutputStem(const std::string& image_name);
+
+}  // namespace casual3d::depth

@@ -1,0 +1,70 @@
+#pragma once
+
+// Two-layer fusion (paper Sec. 4.4.3, Fig. 9): turns the stitched front and
+// back colour-and-depth panoramas into one two-layer graph.
+//   1. Remove redundant back nodes: a back node whose depth is within the
+//      ratio tau_dratio of its front node's (min/max > tau) repeats the front
+//      surface and is dropped. (The paper writes d(f)/d(b) < tau for "too
+//      similar"; with d(f) <= d(b) similar means a ratio near 1, so the test
+//      here is d(f)/d(b) > tau.)
+//   2. Recompute connectivity: for each pair of 4-neighbouring pixels, all
+//      front/back node pairs are sorted by depth ratio, most similar first; the
+//      most similar pair is linked if its ratio exceeds tau, and the other pair
+//      too if it does not cross the first (front-front with back-back).
+//   3. Grow the back layer ring by ring: a node without a link towards a
+//      neighbour spawns a candidate there with the mean depth and colour of its
+//      spawners; the candidate is kept where the neighbour has a front node
+//      clearly in front of it (ratio <= tau) and no back node, and only if it
+//      links to a spawner. Kept nodes are hallucinated, labelled B.
+//   4. Remove colour fringes: the B label spreads from B nodes along links onto
+//      front nodes for a few rings; those front nodes take the back stitch's
+//      colour where the back stitch saw the same surface (the redundant back
+//      node of step 1), which is free of foreground colour bleeding.
+// Normals are left zero (the normals stage fills them).
+
+#include <string>
+
+#include "format/equirect.h"
+#include "format/image.h"
+#include "format/two_layer.h"
+
+namespace casual3d::fuse {
+
+struct FuseOptions {
+  // Sec. 4.4.3: depth ratio (min / max) above which two nodes are one surface; (0, 1).
+  double tau_dratio = 0.75;
+  // Rings of back-layer growth, as a fraction of the panorama width
+  // (0.01 at 4096 px: 41 rings, enough for about 10 cm of head motion with a
+  // foreground at 1 m); >= 0.
+  double expansion_fraction = 0.01;
+  // Rings of B-label propagation onto front nodes, fraction of the width (0.001 at 4096: 4); >= 0.
+  double fringe_fraction = 0.001;
+
+  std::string Check() const;
+};
+
+// Inputs: both layers at the same size (width = 2 * height), depth 0 where a
+// layer has no content. Depth is the distance from the centre along the ray.
+struct FuseInput {
+  const Image8* front_rgb = nullptr;
+  const ImageF* front_depth_m = nullptr;
+  const Image8* back_rgb = nullptr;
+  const ImageF* back_depth_m = nullptr;
+  PanoramaFrame frame;
+};
+
+struct FuseStats {
+  long front_nodes = 0;
+  long back_nodes_in = 0;        // Back stitch pixels with content.
+  long back_nodes_redundant = 0; // Removed in step 1.
+  long back_nodes_hallucinated = 0;
+  long front_nodes_relabelled = 0;  // Step 4.
+  long links = 0;                   // Undirected links.
+};
+
+// Throws std::invalid_argument on mismatched or invalid inputs. The result
+// passes TwoLayerPanorama::Validate().
+TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options,
+                      FuseStats* stats = nullptr);
+
+}  // namespace casual3d::fuse

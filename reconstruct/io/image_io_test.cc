@@ -1,0 +1,182 @@
+#include "reconstruct/io/image_io.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "reconstruct/io/cv_bridge.h"
+
+namespace casual3d::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ImageIoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("casual3d_image_io_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+// A smooth colour ramp with a distinct value in each channel, 40x30.
+Image8 Ramp(int w = 40, int h = 30) {
+  Image8 img(w, h, 3);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      img.at(x, y, 0) = static_cast<uint8_t>(x * 255 / (w - 1));
+      img.at(x, y, 1) = static_cast<uint8_t>(y * 255 / (h - 1));
+      img.at(x, y, 2) = static_cast<uint8_t>(128 + 60 * std::sin(0.2 * (x + y)));
+    }
+  }
+  return img;
+}
+
+TEST_F(ImageIoTest, PngRoundTripIsExactAndKeepsRgbOrder) {
+  const Image8 img = Ramp();
+  WritePng(Path("a.png"), img.view());
+  const Image8 back = ReadImage(Path("a.png"));
+  EXPECT_EQ(back, img);
+  // Red grows with x: a BGR/RGB swap would put the ramp in channel 2.
+  EXPECT_EQ(back.at(39, 0, 0), 255);
+  EXPECT_EQ(back.at(0, 0, 0), 0);
+}
+
+TEST_F(ImageIoTest, GreyPngIsExpandedToRgb) {
+  Image8 grey(8, 4, 1);
+  for (int i = 0; i < 32; ++i) grey.data()[i] = static_cast<uint8_t>(i * 8);
+  WritePng(Path("g.png"), grey);
+  const Image8 back = ReadImage(Path("g.png"));
+  ASSERT_EQ(back.channels(), 3);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(back.at(x, y, c), grey.at(x, y));
+}
+
+TEST_F(ImageIoTest, JpegRoundTripIsCloseAndQualityMatters) {
+  const Image8 img = Ramp(64, 48);
+  WriteJpeg(Path("hi.jpg"), img, {95});
+  WriteJpeg(Path("lo.jpg"), img, {30});
+  const Image8 back = ReadImage(Path("hi.jpg"));
+  ASSERT_EQ(back.width(), 64);
+  ASSERT_EQ(back.height(), 48);
+  double sum = 0;
+  for (size_t i = 0; i < img.size(); ++i) sum += std::abs(back.data()[i] - img.data()[i]);
+  EXPECT_LT(sum / img.size(), 2.0);
+  EXPECT_LT(fs::file_size(Path("lo.jpg")), fs::file_size(Path("hi.jpg")));
+  // Same pixels and quality give the same bytes.
+  WriteJpeg(Path("hi2.jpg"), img, {95});
+  EXPECT_EQ(ReadFile(Path("hi.jpg")), ReadFile(Path("hi2.jpg")));
+}
+
+TEST_F(ImageIoTest, JpegQualityIsChecked) {
+  const Image8 img = Ramp();
+  EXPECT_THROW(WriteJpeg(Path("q.jpg"), img, {0}), IoError);
+  EXPECT_THROW(WriteJpeg(Path("q.jpg"), img, {101}), IoError);
+  EXPECT_FALSE(fs::exists(Path("q.jpg")));
+}
+
+TEST_F(ImageIoTest, GarbageIsNotADecodableImage) {
+  WriteFileAtomic(Path("junk.jpg"), "this is not an image at all");
+  try {
+    ReadImage(Path("junk.jpg"));
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_EQ(std::string(e.what()), Path("junk.jpg") + ": not a decodable image");
+  }
+  WriteFileAtomic(Path("empty.png"), "");
+  EXPECT_THROW(ReadImage(Path("empty.png")), IoError);
+}
+
+TEST_F(ImageIoTest, MissingFileNamesThePath) {
+  try {
+    ReadImage(Path("nope.jpg"));
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find(Path("nope.jpg") + ": cannot open"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(ImageIoTest, FailedWriteLeavesNothingBehind) {
+  const Image8 img = Ramp();
+  EXPECT_THROW(WritePng(Path("no_such_dir/a.png"), img.view()), IoError);
+  EXPECT_THROW(WritePng(Path("two.png"), Image8(4, 4, 2)), IoError);
+  EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+// Inserts an EXIF APP1 segment with Orientation = `orientation` after the SOI marker.
+std::string WithExifOrientation(const std::string& jpeg, int orientation) {
+  std::string tiff = std::string("II*\0", 4) + std::string("\x08\0\0\0", 4);  // Header, IFD0 at 8.
+  tiff += std::string("\x01\0", 2);                       // One entry.
+  tiff += std::string("\x12\x01\x03\0\x01\0\0\0", 8);     // Tag 0x0112, SHORT, count 1.
+  tiff += static_cast<char>(orientation);
+  tiff += std::string("\0\0\0", 3);                       // Value (padded to 4 bytes).
+  tiff += std::string("\0\0\0\0", 4);                     // No next IFD.
+  const std::string payload = std::string("Exif\0\0", 6) + tiff;
+  const size_t len = payload.size() + 2;
+  std::string app1 = "\xFF\xE1";
+  app1 += static_cast<char>(len >> 8);
+  app1 += static_cast<char>(len & 0xFF);
+  app1 += payload;
+  return jpeg.substr(0, 2) + app1 + jpeg.substr(2);
+}
+
+TEST_F(ImageIoTest, ExifOrientationIsAppliedOnlyWhenAsked) {
+  const Image8 img = Ramp(64, 32);
+  const std::string jpeg = EncodeJpeg(img.view(), {95});
+  WriteFileAtomic(Path("rot.jpg"), WithExifOrientation(jpeg, 6));  // 6: rotate 90 clockwise.
+  const Image8 stored = ReadImage(Path("rot.jpg"));
+  EXPECT_EQ(stored.width(), 64);
+  EXPECT_EQ(stored.height(), 32);
+  ReadImageOptions options;
+  options.apply_exif_orientation = true;
+  const Image8 upright = ReadImage(Path("rot.jpg"), options);
+  EXPECT_EQ(upright.width(), 32);
+  EXPECT_EQ(upright.height(), 64);
+}
+
+TEST_F(ImageIoTest, MaxSideIsEnforced) {
+  WritePng(Path("big.png"), Ramp(40, 30));
+  ReadImageOptions options;
+  options.max_side = 32;
+  EXPECT_THROW(ReadImage(Path("big.png"), options), IoError);
+}
+
+TEST(CvBridgeTest, MatAndViewShareMemory) {
+  Image8 img(10, 6, 3, 7);
+  cv::Mat mat = ToMat(img);
+  EXPECT_EQ(mat.data, img.data());
+  EXPECT_EQ(mat.cols, 10);
+  EXPECT_EQ(mat.rows, 6);
+  EXPECT_EQ(mat.type(), CV_8UC3);
+  mat.at<cv::Vec3b>(2, 4)[1] = 200;  // Row 2, column 4, channel 1.
+  EXPECT_EQ(img.at(4, 2, 1), 200);
+
+  // A cropped view keeps the parent's stride.
+  ImageView<uint8_t> crop = img.view().Crop(3, 1, 4, 2);
+  cv::Mat crop_mat = ToMat(crop);
+  EXPECT_EQ(crop_mat.step[0], 30u);
+  EXPECT_EQ(crop_mat.at<cv::Vec3b>(1, 1)[1], 200);
+
+  cv::Mat f(5, 7, CV_32FC2, cv::Scalar(1.5f, -2.0f));
+  ImageView<float> v = ToView<float>(f(cv::Rect(2, 1, 3, 3)));
+  EXPECT_EQ(v.width(), 3);
+  EXPECT_EQ(v.stride(), 14);
+  EXPECT_FLOAT_EQ(v.at(0, 0, 1), -2.0f);
+  v.at(0, 0, 0) = 9.0f;
+  EXPECT_FLOAT_EQ(f.at<cv::Vec2f>(1, 2)[0], 9.0f);
+}
+
+}  // namespace
+}  // namespace casual3d::io

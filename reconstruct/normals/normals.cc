@@ -1,0 +1,298 @@
+#include "reconstruct/normals/normals.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace casual3d::normals {
+namespace {
+
+using Vec3 = Eigen::Vector3f;
+
+template <typename Fn>
+void ParallelRange(size_t count, Fn fn) {
+  const size_t threads = std::max<size_t>(1, std::min<size_t>(count / 4096 + 1,
+                                                              std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  for (size_t t = 0; t < threads; ++t) {
+    pool.emplace_back([&, t] { fn(count * t / threads, count * (t + 1) / threads); });
+  }
+  for (std::thread& th : pool) th.join();
+}
+
+// The nodes of both layers, numbered layer * n + pixel, with their links as
+// node numbers (-1: none).
+struct NodeGraph {
+  int width = 0, height = 0;
+  size_t n = 0;  // Pixels.
+  std::vector<uint8_t> present;        // 2n.
+  std::vector<int64_t> neighbour;      // 2n * 4, by Direction.
+  std::vector<Vec3> position;          // 2n.
+  std::vector<Vec3> ray;               // n: unit direction of the pixel centre.
+  std::vector<float> luminance;        // 2n, in [0, 1].
+
+  int64_t next(size_t node, int dir) const { return neighbour[4 * node + dir]; }
+};
+
+NodeGraph BuildGraph(const TwoLayerPanorama& pano) {
+  NodeGraph g;
+  g.width = pano.width();
+  g.height = pano.height();
+  g.n = static_cast<size_t>(g.width) * g.height;
+  g.present.assign(2 * g.n, 0);
+  g.neighbour.assign(8 * g.n, -1);
+  g.position.assign(2 * g.n, Vec3::Zero());
+  g.luminance.assign(2 * g.n, 0.0f);
+  g.ray.resize(g.n);
+  for (int y = 0; y < g.height; ++y) {
+    for (int x = 0; x < g.width; ++x) {
+      const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, g.width, g.height);
+      g.ray[pano.index(x, y)] = Vec3(static_cast<float>(d.x), static_cast<float>(d.y),
+                                     static_cast<float>(d.z));
+    }
+  }
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& layer = pano.layer(l);
+    for (int y = 0; y < g.height; ++y) {
+      for (int x = 0; x < g.width; ++x) {
+        const size_t i = pano.index(x, y);
+        if (!layer.present[i]) continue;
+        const size_t node = l * g.n + i;
+        g.present[node] = 1;
+        g.position[node] = g.ray[i] * layer.depth_m[i];
+        const uint8_t* c = &layer.rgb[3 * i];
+        g.luminance[node] = (0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]) / 255.0f;
+        for (int d = 0; d < kNumDirections; ++d) {
+          const Link link = GetLink(layer.links[i], static_cast<Direction>(d));
+          if (link == Link::kNone) continue;
+          int nx, ny;
+          if (!pano.Neighbour(x, y, static_cast<Direction>(d), &nx, &ny)) continue;
+          const int nl = link == Link::kFront ? kFront : kBack;
+          g.neighbour[4 * node + d] = static_cast<int64_t>(nl * g.n + pano.index(nx, ny));
+        }
+      }
+    }
+  }
+  return g;
+}
+
+// Tangent of the surface along one grid axis from the linked neighbours
+// (central difference where both exist, else one-sided); false if none.
+bool Tangent(const NodeGraph& g, size_t node, int forward, int backward, Vec3* t) {
+  const int64_t f = g.next(node, forward), b = g.next(node, backward);
+  if (f >= 0 && b >= 0) {
+    *t = g.position[f] - g.position[b];
+  } else if (f >= 0) {
+    *t = g.position[f] - g.position[node];
+  } else if (b >= 0) {
+    *t = g.position[node] - g.position[b];
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// The rotation taking unit vector a onto unit vector b by the smallest angle.
+Eigen::Matrix3f MinimalRotation(const Vec3& a, const Vec3& b) {
+  return Eigen::Quaternionf::FromTwoVectors(a, b).toRotationMatrix();
+}
+
+}  // namespace
+
+std::string NormalOptions::Check() const {
+  if (!(smoothness > 0)) return "smoothness: must be > 0";
+  if (iterations < 0 || iterations > 10000) return "iterations: must be in [0, 10000]";
+  if (!(detail_strength >= 0)) return "detail_strength: must be >= 0";
+  if (detail_radius < 1 || detail_radius > 64) return "detail_radius: must be in [1, 64]";
+  if (!(sky_depth_fraction > 0 && sky_depth_fraction <= 1)) {
+    return "sky_depth_fraction: must be in (0, 1]";
+  }
+  if (!(sky_max_texture >= 0)) return "sky_max_texture: must be >= 0";
+  return "";
+}
+
+NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options) {
+  const std::string why = options.Check();
+  if (!why.empty()) throw std::invalid_argument("normal options: " + why);
+  const NodeGraph g = BuildGraph(*pano);
+  const size_t num_nodes = 2 * g.n;
+  NormalStats stats;
+
+  // 1. Forward-difference normals, oriented towards the centre.
+  std::vector<Vec3> raw(num_nodes, Vec3::Zero());
+  std::vector<float> weight(num_nodes, 0.0f);
+  ParallelRange(num_nodes, [&](size_t begin, size_t end) {
+    for (size_t node = begin; node < end; ++node) {
+      if (!g.present[node]) continue;
+      Vec3 tu, tv;
+      if (!Tangent(g, node, kRight, kLeft, &tu) || !Tangent(g, node, kDown, kUp, &tv)) continue;
+      Vec3 nrm = tu.cross(tv);
+      const float len = nrm.norm();
+      if (!(len > 0)) continue;
+      nrm /= len;
+      if (nrm.dot(g.position[node]) > 0) nrm = -nrm;
+      raw[node] = nrm;
+      weight[node] = 1.0f;
+    }
+  });
+
+  // Smoothing (Eq. 5, binary weights): x_i = (w_i x'_i + s sum_j x_j) / (w_i + s deg_i).
+  const float s = static_cast<float>(options.smoothness);
+  std::vector<Vec3> base = raw, next(num_nodes, Vec3::Zero());
+  for (int it = 0; it < options.iterations; ++it) {
+    ParallelRange(num_nodes, [&](size_t begin, size_t end) {
+      for (size_t node = begin; node < end; ++node) {
+        if (!g.present[node]) continue;
+        Vec3 sum = weight[node] * raw[node];
+        float total = weight[node];
+        for (int d = 0; d < kNumDirections; ++d) {
+          const int64_t j = g.next(node, d);
+          if (j < 0) continue;
+          sum += s * base[j];
+          total += s;
+        }
+        next[node] = total > 0 ? Vec3(sum / total) : Vec3::Zero();
+      }
+    });
+    base.swap(next);
+  }
+
+  // 2. Detail: high-pass luminance over the link graph (a graph box blur
+  // repeated detail_radius times), then its gradient along the links.
+  std::vector<float> low = g.luminance, low_next(num_nodes, 0.0f);
+  for (int it = 0; it < options.detail_radius; ++it) {
+    ParallelRange(num_nodes, [&](size_t begin, size_t end) {
+      for (size_t node = begin; node < end; ++node) {
+        if (!g.present[node]) continue;
+        float sum = low[node];
+        int count = 1;
+        for (int d = 0; d < kNumDirections; ++d) {
+          const int64_t j = g.next(node, d);
+          if (j >= 0) {
+            sum += low[j];
+            ++count;
+          }
+        }
+        low_next[node] = sum / count;
+      }
+    });
+    low.swap(low_next);
+  }
+  auto detail = [&](int64_t node) { return g.luminance[node] - low[node]; };
+  auto derivative = [&](size_t node, int forward, int backward) {
+    const int64_t f = g.next(node, forward), b = g.next(node, backward);
+    if (f >= 0 && b >= 0) return 0.5f * (detail(f) - detail(b));
+    if (f >= 0) return detail(f) - detail(node);
+    if (b >= 0) return detail(node) - detail(b);
+    return 0.0f;
+  };
+
+  // 3. Combine (Eq. 14 to 16) and 4. write, leaving sky for below.
+  const float k = static_cast<float>(options.detail_strength);
+  std::vector<Vec3> result(num_nodes, Vec3::Zero());
+  ParallelRange(num_nodes, [&](size_t begin, size_t end) {
+    for (size_t node = begin; node < end; ++node) {
+      if (!g.present[node]) continue;
+      const size_t pixel = node % g.n;
+      const Vec3& r = g.ray[pixel];
+      Vec3 nf = base[node];
+      if (!(nf.norm() > 1e-6f)) nf = -r;  // No geometry around: face the centre.
+      nf.normalize();
+      Vec3 n = nf;
+      if (k > 0) {
+        // East and south unit vectors of the pixel (image x and y).
+        const float lon = std::atan2(r.x(), -r.z());
+        const float lat = std::asin(std::clamp(r.y(), -1.0f, 1.0f));
+        const Vec3 east(std::cos(lon), 0.0f, std::sin(lon));
+        const Vec3 south(std::sin(lat) * std::sin(lon), -std::cos(lat),
+                         -std::sin(lat) * std::cos(lon));
+        const float hx = derivative(node, kRight, kLeft);
+        const float hy = derivative(node, kDown, kUp);
+        // Detail normal in the radial frame R_s: facing the centre, tilted by
+        // the height gradient (brighter is nearer).
+        const Vec3 ni = (-r - k * hx * east - k * hy * south).normalized();
+        // n_c = R_f^-1 R_s n_i: carry the tilt from facing the centre (-r) to
+        // the base normal, by the minimal rotation (defined for floors too).
+        n = (MinimalRotation(-r, nf) * ni).normalized();
+      }
+      result[node] = n;
+    }
+  });
+
+  // 4. Sky: far, untextured front nodes connected to the top of the content.
+  std::vector<uint8_t> sky(g.n, 0);
+  if (options.detect_sky) {
+    std::vector<float> depths;
+    depths.reserve(g.n);
+    const LayerData& front = pano->layer(kFront);
+    for (size_t i = 0; i < g.n; ++i)
+      if (front.present[i]) depths.push_back(front.depth_m[i]);
+    if (!depths.empty()) {
+      const size_t k99 = depths.size() * 99 / 100;
+      std::nth_element(depths.begin(), depths.begin() + k99, depths.end());
+      const float far = depths[k99] * static_cast<float>(options.sky_depth_fraction);
+      std::vector<uint8_t> candidate(g.n, 0);
+      for (size_t i = 0; i < g.n; ++i) {
+        if (!front.present[i] || front.depth_m[i] < far) continue;
+        // Texture: luminance spread over the pixel and its linked neighbours.
+        float sum = g.luminance[i], sum2 = sum * sum;
+        int count = 1;
+        for (int d = 0; d < kNumDirections; ++d) {
+          const int64_t j = g.next(i, d);
+          if (j < 0) continue;
+          sum += g.luminance[j];
+          sum2 += g.luminance[j] * g.luminance[j];
+          ++count;
+        }
+        const float mean = sum / count;
+        const float var = std::max(0.0f, sum2 / count - mean * mean);
+        const uint8_t* c = &front.rgb[3 * i];
+        const bool sky_colour = c[2] >= c[0] || mean > 0.6f;
+        candidate[i] = std::sqrt(var) <= options.sky_max_texture && sky_colour;
+      }
+      // Flood fill from candidates at the top of the content (no front node above).
+      std::vector<size_t> stack;
+      for (size_t i = 0; i < g.n; ++i) {
+        const size_t y = i / g.width;
+        if (candidate[i] && (y == 0 || !front.present[i - g.width])) {
+          sky[i] = 1;
+          stack.push_back(i);
+        }
+      }
+      while (!stack.empty()) {
+        const size_t i = stack.back();
+        stack.pop_back();
+        const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
+        for (int d = 0; d < kNumDirections; ++d) {
+          int nx, ny;
+          if (!pano->Neighbour(x, y, static_cast<Direction>(d), &nx, &ny)) continue;
+          const size_t j = pano->index(nx, ny);
+          if (candidate[j] && !sky[j]) {
+            sky[j] = 1;
+            stack.push_back(j);
+          }
+        }
+      }
+    }
+  }
+
+  for (int l = 0; l < kNumLayers; ++l) {
+    LayerData& layer = pano->layer(l);
+    for (size_t i = 0; i < g.n; ++i) {
+      if (!layer.present[i]) continue;
+      ++stats.nodes;
+      const bool unlit = l == kFront && sky[i];
+      stats.sky_nodes += unlit;
+      const Vec3 n = unlit ? Vec3::Zero() : result[l * g.n + i];
+      for (int c = 0; c < 3; ++c) layer.normal[3 * i + c] = n[c];
+    }
+  }
+  return stats;
+}
+
+}  // namespace casual3d::normals

@@ -1,0 +1,302 @@
+#include "reconstruct/pipeline/panorama_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "encoder/master_file.h"
+#include "reconstruct/depth/workspace.h"
+#include "reconstruct/geometry/colmap_model.h"
+#include "reconstruct/io/exr_io.h"
+#include "reconstruct/io/file_util.h"
+#include "reconstruct/io/image_io.h"
+#include "reconstruct/sfm/scene_setup.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// Inverse depth as a colour ramp (near = warm, far = dark blue), for previews.
+void RampColour(double t, uint8_t out[3]) {
+  t = std::clamp(t, 0.0, 1.0);
+  // A perceptually ordered ramp: dark blue -> teal -> yellow -> red.
+  const double r = std::clamp(1.5 - std::abs(4.0 * t - 3.0), 0.0, 1.0);
+  const double g = std::clamp(1.5 - std::abs(4.0 * t - 2.0), 0.0, 1.0);
+  const double b = std::clamp(1.5 - std::abs(4.0 * t - 1.0), 0.0, 1.0);
+  out[0] = static_cast<uint8_t>(std::lround(255 * r));
+  out[1] = static_cast<uint8_t>(std::lround(255 * g));
+  out[2] = static_cast<uint8_t>(std::lround(255 * b));
+}
+
+void WritePreviews(const TwoLayerPanorama& pano, const std::string& dir) {
+  io::CreateDirectories(dir);
+  const int W = pano.width(), H = pano.height();
+  // Previews at most 2048 wide.
+  const int step = std::max(1, W / 2048);
+  const int pw = W / step, ph = H / step;
+  float near = 1e30f;
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& layer = pano.layer(l);
+    for (size_t i = 0; i < layer.depth_m.size(); ++i)
+      if (layer.present[i]) near = std::min(near, layer.depth_m[i]);
+  }
+  if (!(near < 1e30f)) near = 1.0f;
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& layer = pano.layer(l);
+    Image8 color(pw, ph, 3, 0), depth(pw, ph, 3, 0);
+    for (int y = 0; y < ph; ++y) {
+      for (int x = 0; x < pw; ++x) {
+        const size_t i = pano.index(x * step, y * step);
+        if (!layer.present[i]) continue;
+        for (int c = 0; c < 3; ++c) color.at(x, y, c) = layer.rgb[3 * i + c];
+        RampColour(near / layer.depth_m[i], &depth.at(x, y, 0));
+      }
+    }
+    const std::string name = l == kFront ? "front" : "back";
+    io::WritePng(dir + "/" + name + "_color.png", color);
+    io::WritePng(dir + "/" + name + "_depth.png", depth);
+  }
+  Image8 normals(pw, ph, 3, 0), labels(pw, ph, 3, 0);
+  const LayerData& front = pano.layer(kFront);
+  const LayerData& back = pano.layer(kBack);
+  for (int y = 0; y < ph; ++y) {
+    for (int x = 0; x < pw; ++x) {
+      const size_t i = pano.index(x * step, y * step);
+      if (!front.present[i]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const float n = front.normal[3 * i + c];
+        normals.at(x, y, c) = static_cast<uint8_t>(std::lround(127.5f + 127.5f * n));
+      }
+      // Labels: F grey, B (relabelled front) orange, with a back node: tinted blue.
+      const bool b_label = front.label[i] == static_cast<uint8_t>(NodeLabel::kB);
+      labels.at(x, y, 0) = b_label ? 230 : 128;
+      labels.at(x, y, 1) = b_label ? 140 : 128;
+      labels.at(x, y, 2) = back.present[i] ? 255 : 128;
+    }
+  }
+  io::WritePng(dir + "/normals.png", normals);
+  io::WritePng(dir + "/labels.png", labels);
+}
+
+}  // namespace
+
+std::string PanoramaStageOptions::Check() const {
+  if (pano_width < 64 || pano_width > 16384 || pano_width % 2 != 0) {
+    return "pano_width " + std::to_string(pano_width) + ": must be even and in [64, 16384]";
+  }
+  if (stitch.solve_width > pano_width) {
+    return "stitch.solve_width " + std::to_string(stitch.solve_width) +
+           ": must not exceed pano_width " + std::to_string(pano_width);
+  }
+  if (!(sky_depth_m >= 0)) return "sky_depth_m: must be >= 0";
+  if (num_threads < 0) return "num_threads: must be >= 0";
+  warp::WarpOptions w = warp;
+  w.pano_width = pano_width;
+  w.pano_height = pano_width / 2;
+  for (const std::string& why : {w.Check(), stitch.Check(), fuse.Check(), normals.Check()}) {
+    if (!why.empty()) return why;
+  }
+  return "";
+}
+
+PanoramaFrame LoadOrComputeFrame(const std::string& sparse_dir) {
+  const fs::path root(sparse_dir);
+  if (fs::exists(root / "frame.json")) return sfm::ReadPanoramaFrame((root / "frame.json").string());
+  if (fs::exists(root / "capture.json")) {
+    const std::string path = (root / "capture.json").string();
+    try {
+      const nlohmann::json j = nlohmann::json::parse(io::ReadFile(path));
+      const auto& f = j.at("panorama_frame");
+      PanoramaFrame frame;
+      for (int k = 0; k < 3; ++k) frame.centre[k] = f.at("centre").at(k).get<double>();
+      for (int k = 0; k < 9; ++k) frame.rotation[k] = f.at("rotation").at(k).get<double>();
+      return frame;
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error(path + ": no valid panorama_frame (" + e.what() + ")");
+    }
+  }
+  const geometry::SparseModel model = geometry::ReadModel((root / "sparse").string());
+  return sfm::ComputePanoramaFrame(model, sfm::PanoramaFrameOptions());
+}
+
+TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::string& depth_dir,
+                                  const std::string& out_dir, const PanoramaStageOptions& options,
+                                  PanoramaStageReport* report_out) {
+  const std::string why = options.Check();
+  if (!why.empty()) throw std::invalid_argument("panorama options: " + why);
+  const auto start = Clock::now();
+  PanoramaStageReport report;
+  const int W = options.pano_width, H = W / 2;
+  report.width = W;
+  report.height = H;
+
+  // Load photos, cameras and depth maps.
+  auto t = Clock::now();
+  const geometry::SparseModel model =
+      geometry::ReadModel((fs::path(sparse_dir) / "sparse").string());
+  const PanoramaFrame frame = LoadOrComputeFrame(sparse_dir);
+  struct Loaded {
+    Image8 rgb;
+    ImageF depth;
+    geometry::Camera camera;
+    geometry::Pose pose;
+  };
+  std::vector<Loaded> photos;
+  {
+    util::Progress progress("panorama: loading photos", static_cast<int64_t>(model.images.size()));
+    for (const auto& [id, image] : model.images) {
+      Loaded p;
+      const auto cam = model.cameras.find(image.camera_id);
+      if (cam == model.cameras.end()) {
+        throw std::runtime_error(sparse_dir + "/sparse: image " + image.name +
+                                 " names a missing camera " + std::to_string(image.camera_id));
+      }
+      if (cam->second.HasDistortion()) {
+        throw std::runtime_error(sparse_dir + "/sparse: camera " + std::to_string(image.camera_id) +
+                                 " has lens distortion; the panorama stage needs undistorted "
+                                 "photos (run the sparse stage)");
+      }
+      p.camera = cam->second;
+      p.pose = image.pose;
+      p.rgb = io::ReadImage((fs::path(sparse_dir) / "images" / image.name).string());
+      const std::string depth_path =
+          (fs::path(depth_dir) / "depth" / (depth::OutputStem(image.name) + ".exr")).string();
+      if (!fs::exists(depth_path)) {
+        throw std::runtime_error(depth_path + ": missing depth map for photo " + image.name +
+                                 " (run the dense stage first)");
+      }
+      p.depth = io::ReadExrChannels(depth_path, {"Z"});
+      photos.push_back(std::move(p));
+      progress.Advance();
+    }
+  }
+  if (photos.empty()) throw std::runtime_error(sparse_dir + "/sparse: the model has no photos");
+  report.num_photos = static_cast<int>(photos.size());
+
+  // Sky (non-finite depth) gets a finite depth beyond everything else.
+  double sky = options.sky_depth_m;
+  if (sky <= 0) {
+    float far = 0;
+    for (const Loaded& p : photos)
+      for (float d : p.depth.vector())
+        if (std::isfinite(d) && d > far) far = d;
+    sky = far > 0 ? 1.5 * far : 1000.0;
+  }
+  report.sky_depth_m = sky;
+  for (Loaded& p : photos) {
+    for (float& d : p.depth.vector())
+      if (!std::isfinite(d) || d <= 0) d = static_cast<float>(sky);
+  }
+  report.seconds_load = Seconds(t);
+
+  // Warp at the output and at the solve resolution.
+  t = Clock::now();
+  std::vector<warp::SourceView> views;
+  std::vector<stitch::ViewGeometry> geometry;
+  Eigen::Matrix3d R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = frame.rotation[3 * r + c];
+  const Eigen::Vector3d centre(frame.centre[0], frame.centre[1], frame.centre[2]);
+  for (const Loaded& p : photos) {
+    views.push_back({&p.rgb, &p.depth, p.camera, p.pose});
+    const Eigen::Vector3d c = R * (p.pose.Center() - centre);
+    geometry.push_back({{c.x(), c.y(), c.z()}});
+  }
+  warp::WarpOptions warp_full = options.warp;
+  warp_full.pano_width = W;
+  warp_full.pano_height = H;
+  warp::WarpOptions warp_coarse = warp_full;
+  warp_coarse.pano_width = options.stitch.solve_width;
+  warp_coarse.pano_height = options.stitch.solve_height;
+  std::vector<warp::WarpedView> full, coarse;
+  {
+    util::Progress progress("panorama: warping", 2);
+    full = warp::WarpViews(views, frame, warp_full, options.num_threads);
+    progress.Advance();
+    coarse = warp::WarpViews(views, frame, warp_coarse, options.num_threads);
+  }
+  photos.clear();  // The warps hold everything needed from here on.
+  report.seconds_warp = Seconds(t);
+
+  // Stitch front, then back.
+  t = Clock::now();
+  stitch::StitchedLayer front, back;
+  {
+    util::Progress progress("panorama: stitching", options.back_layer ? 2 : 1);
+    front = stitch::StitchFront(full, coarse, geometry, W, options.stitch);
+    report.seconds_stitch_front = Seconds(t);
+    progress.Advance();
+    if (options.back_layer) {
+      t = Clock::now();
+      back = stitch::StitchBack(full, coarse, geometry, front, options.stitch);
+      report.seconds_stitch_back = Seconds(t);
+    } else {
+      back.rgb = Image8(W, H, 3, 0);
+      back.depth_m = ImageF(W, H, 1, 0.0f);
+    }
+  }
+  full.clear();
+  coarse.clear();
+
+  // Fuse and normals.
+  t = Clock::now();
+  fuse::FuseOptions fuse_options = options.fuse;
+  if (!options.back_layer) fuse_options.expansion_fraction = 0;
+  TwoLayerPanorama pano =
+      fuse::Fuse({&front.rgb, &front.depth_m, &back.rgb, &back.depth_m, frame}, fuse_options,
+                 &report.fuse);
+  report.seconds_fuse = Seconds(t);
+  t = Clock::now();
+  report.normals = normals::ComputeNormals(&pano, options.normals);
+  report.seconds_normals = Seconds(t);
+  report.front_coverage = static_cast<double>(report.fuse.front_nodes) / (static_cast<double>(W) * H);
+
+  // Write.
+  t = Clock::now();
+  io::CreateDirectories(out_dir);
+  const Status written = encoder::WriteMasterFile(pano, (fs::path(out_dir) / "master.exr").string());
+  if (!written.ok()) throw std::runtime_error(written.ToString());
+  if (options.write_previews) WritePreviews(pano, (fs::path(out_dir) / "preview").string());
+  report.seconds_write = Seconds(t);
+  report.seconds_total = Seconds(start);
+
+  nlohmann::json j;
+  j["photos"] = report.num_photos;
+  j["width"] = W;
+  j["height"] = H;
+  j["back_layer"] = options.back_layer;
+  j["sky_depth_m"] = report.sky_depth_m;
+  j["front_coverage"] = report.front_coverage;
+  j["fuse"] = {{"front_nodes", report.fuse.front_nodes},
+               {"back_nodes_in", report.fuse.back_nodes_in},
+               {"back_nodes_redundant", report.fuse.back_nodes_redundant},
+               {"back_nodes_hallucinated", report.fuse.back_nodes_hallucinated},
+               {"front_nodes_relabelled", report.fuse.front_nodes_relabelled},
+               {"links", report.fuse.links}};
+  j["normals"] = {{"nodes", report.normals.nodes}, {"sky_nodes", report.normals.sky_nodes}};
+  j["seconds"] = {{"load", report.seconds_load},
+                  {"warp", report.seconds_warp},
+                  {"stitch_front", report.seconds_stitch_front},
+                  {"stitch_back", report.seconds_stitch_back},
+                  {"fuse", report.seconds_fuse},
+                  {"normals", report.seconds_normals},
+                  {"write", report.seconds_write},
+                  {"total", report.seconds_total}};
+  io::WriteFileAtomic((fs::path(out_dir) / "panorama.json").string(), j.dump(2) + "\n");
+  if (report_out) *report_out = report;
+  return pano;
+}
+
+}  // namespace casual3d::pipeline

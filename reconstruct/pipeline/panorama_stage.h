@@ -1,0 +1,72 @@
+#pragma once
+
+// The panorama stages as one step of the pipeline (paper Sec. 4.4 and 5):
+// warp every depth map into the central panorama, stitch the front and back
+// layers, fuse them into a two-layer graph, compute normals.
+//
+// Inputs:
+//   SPARSE/images/<name>        undistorted photos (sparse stage or synth capture)
+//   SPARSE/sparse/              COLMAP model of their PINHOLE cameras
+//   SPARSE/frame.json           the 3D photo's frame (optional: else computed
+//                               from the cameras, or read from capture.json)
+//   DEPTH/depth/<stem>.exr      depth per photo ("Z", metres along the optical
+//                               axis; +inf or NaN = sky/unknown)
+// Outputs (OUT/, files written atomically):
+//   master.exr                  the two-layer panorama (encoder/master_file.h)
+//   preview/{front,back}_{color,depth}.png, preview/normals.png, preview/labels.png
+//   panorama.json               timings, statistics, options
+
+#include <string>
+#include <vector>
+
+#include "format/two_layer.h"
+#include "reconstruct/fuse/fuse.h"
+#include "reconstruct/normals/normals.h"
+#include "reconstruct/stitch/stitch.h"
+#include "reconstruct/warp/warp.h"
+
+namespace casual3d::pipeline {
+
+struct PanoramaStageOptions {
+  // Output panorama width (height = width / 2); even, [64, 16384]. The paper
+  // uses 8192; 4096 is the default on 2-core machines.
+  int pano_width = 4096;
+  warp::WarpOptions warp;        // pano_width/height are set from pano_width.
+  stitch::StitchOptions stitch;
+  fuse::FuseOptions fuse;
+  normals::NormalOptions normals;
+  // false: front layer only (the ablation of the paper's Fig. 15 / issue 8).
+  bool back_layer = true;
+  // Depth given to photo pixels without a finite depth (sky), metres; 0 =
+  // automatic: 1.5 x the largest finite depth of all photos.
+  double sky_depth_m = 0.0;
+  bool write_previews = true;
+  int num_threads = 0;  // 0 = all cores.
+
+  std::string Check() const;  // Empty if valid, else "field: reason".
+};
+
+struct PanoramaStageReport {
+  int num_photos = 0;
+  int width = 0, height = 0;
+  double sky_depth_m = 0.0;
+  double seconds_load = 0, seconds_warp = 0, seconds_stitch_front = 0, seconds_stitch_back = 0,
+         seconds_fuse = 0, seconds_normals = 0, seconds_write = 0, seconds_total = 0;
+  fuse::FuseStats fuse;
+  normals::NormalStats normals;
+  double front_coverage = 0.0;  // Fraction of pixels with a front node.
+};
+
+// Runs warp, stitch, fuse and normals; writes OUT (created if needed) and
+// returns the panorama. Throws std::invalid_argument for bad options and
+// std::runtime_error naming the file for bad inputs.
+TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::string& depth_dir,
+                                  const std::string& out_dir, const PanoramaStageOptions& options,
+                                  PanoramaStageReport* report = nullptr);
+
+// The 3D photo's frame for a workspace: SPARSE/frame.json if present, else the
+// "frame" of SPARSE/capture.json (synthetic captures), else computed from the
+// model's cameras.
+PanoramaFrame LoadOrComputeFrame(const std::string& sparse_dir);
+
+}  // namespace casual3d::pipeline

@@ -1,0 +1,283 @@
+#include "reconstruct/pipeline/pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "encoder/master_file.h"
+#include "encoder/package_writer.h"
+#include "format/sha256.h"
+#include "reconstruct/io/file_util.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Bump when a stage's output format or algorithm changes, so old caches are stale.
+constexpr const char* kStageVersions[kNumStages] = {"sparse-1", "dense-1", "panorama-1", "encode-1"};
+
+std::string HashHex(const std::string& text) {
+  return Sha256Hex(reinterpret_cast<const uint8_t*>(text.data()), text.size());
+}
+
+// Names, sizes and modification times of every file below `input`: a change
+// to any photo makes the sparse stage (and all after it) stale.
+std::string InputFingerprint(const std::string& input) {
+  std::vector<std::string> rows;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(input, ec); !ec && it != fs::end(it);
+       it.increment(ec)) {
+    if (!it->is_regular_file(ec)) continue;
+    const auto size = it->file_size(ec);
+    const auto mtime = it->last_write_time(ec).time_since_epoch().count();
+    rows.push_back(fs::relative(it->path(), input, ec).string() + " " + std::to_string(size) +
+                   " " + std::to_string(mtime));
+  }
+  if (ec) throw std::runtime_error(input + ": cannot list the input folder (" + ec.message() + ")");
+  std::sort(rows.begin(), rows.end());
+  std::string out;
+  for (const std::string& r : rows) out += r + "\n";
+  return out;
+}
+
+std::string SparseOptionsText(const sfm::SparseStageOptions& o) {
+  std::ostringstream s;
+  s << "input_type=" << static_cast<int>(o.input_type)
+    << " working_megapixels=" << o.import.working_megapixels
+    << " skip_unreadable=" << o.import.skip_unreadable
+    << " allow_mixed_devices=" << o.import.allow_mixed_devices << " focal_px=" << o.import.focal_px
+    << " camera_model=" << o.camera_model << " shared_camera=" << o.shared_camera
+    << " matcher=" << static_cast<int>(o.matcher) << " max_features=" << o.max_features
+    << " min_registered_fraction=" << o.min_registered_fraction;
+  return s.str();
+}
+
+std::string DenseOptionsText(const depth::DenseOptions& o) {
+  std::ostringstream s;
+  s << "working_scale=" << o.working_scale << " num_neighbors=" << o.num_neighbors
+    << " num_depths=" << o.sweep.num_depths << " window_radius=" << o.sweep.window_radius
+    << " lambda_smooth=" << o.mrf.lambda_smooth << " lambda_near=" << o.mrf.lambda_near
+    << " use_near_envelope=" << o.use_near_envelope << " use_gc_filter=" << o.use_gc_filter
+    << " envelope_scale=" << o.envelope.scale;
+  return s.str();
+}
+
+std::string PanoramaOptionsText(const PanoramaStageOptions& o) {
+  std::ostringstream s;
+  s << "pano_width=" << o.pano_width << " solve=" << o.stitch.solve_width
+    << " back_layer=" << o.back_layer << " tau_stretch=" << o.warp.tau_stretch_deg
+    << " lambda_gc=" << o.stitch.lambda_gc << " tau_dratio=" << o.fuse.tau_dratio
+    << " expansion=" << o.fuse.expansion_fraction << " sky_depth=" << o.sky_depth_m;
+  return s.str();
+}
+
+std::string ReadKey(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return "";
+  try {
+    return io::ReadFile(path.string());
+  } catch (const std::exception&) {
+    return "";
+  }
+}
+
+// Runs `run(tmp_dir)` into a fresh temporary folder next to `dir`, then
+// replaces `dir` by it and records `key`, so that `dir` is either absent,
+// or complete and labelled with the key it was made from.
+template <typename Fn>
+void RunIntoFolder(const fs::path& dir, const fs::path& key_path, const std::string& key, Fn run) {
+  const fs::path tmp = dir.string() + ".tmp";
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  fs::remove(key_path, ec);
+  run(tmp);
+  fs::remove_all(dir, ec);
+  fs::rename(tmp, dir, ec);
+  if (ec) throw std::runtime_error(dir.string() + ": cannot move the stage output in place (" + ec.message() + ")");
+  io::WriteFileAtomic(key_path.string(), key);
+}
+
+}  // namespace
+
+const char* StageName(Stage stage) {
+  switch (stage) {
+    case Stage::kSparse: return "sparse";
+    case Stage::kDense: return "dense";
+    case Stage::kPanorama: return "panorama";
+    case Stage::kEncode: return "encode";
+  }
+  return "?";
+}
+
+bool StageFromName(const std::string& name, Stage* stage) {
+  for (int s = 0; s < kNumStages; ++s) {
+    if (name == StageName(static_cast<Stage>(s))) {
+      *stage = static_cast<Stage>(s);
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string PipelineOptions::Check() const {
+  if (static_cast<int>(from) > static_cast<int>(to)) {
+    return std::string("--from ") + StageName(from) + " comes after --to " + StageName(to);
+  }
+  if (!(color_quality >= 0 && color_quality <= 100)) return "color_quality: must be in [0, 100]";
+  if (num_threads < 0) return "num_threads: must be >= 0";
+  Status s = sparse.Check();
+  if (!s.ok()) return s.message();
+  s = dense.Check();
+  if (!s.ok()) return s.message();
+  return panorama.Check();
+}
+
+PipelineReport RunPipeline(const std::string& input, const std::string& out,
+                           const PipelineOptions& options_in) {
+  const std::string why = options_in.Check();
+  if (!why.empty()) throw std::invalid_argument(why);
+  PipelineOptions options = options_in;
+  options.sparse.num_threads = options.num_threads;
+  options.dense.num_threads = options.num_threads;
+  options.panorama.num_threads = options.num_threads;
+  const auto start = Clock::now();
+
+  std::error_code ec;
+  if (!fs::is_directory(input, ec)) {
+    throw std::runtime_error(input + ": not a folder of photos or a COLMAP workspace");
+  }
+  const fs::path root(out);
+  const fs::path work = root / "work";
+  fs::create_directories(work, ec);
+  if (ec) throw std::runtime_error(out + ": cannot create the output folder (" + ec.message() + ")");
+
+  const fs::path dirs[kNumStages] = {work / "sparse", work / "dense", work / "panorama", root / "web"};
+  fs::path key_paths[kNumStages];
+  std::string keys[kNumStages];
+  for (int s = 0; s < kNumStages; ++s) {
+    key_paths[s] = work / (std::string(StageName(static_cast<Stage>(s))) + ".key");
+  }
+  keys[0] = HashHex(std::string(kStageVersions[0]) + "\n" + fs::absolute(input).string() + "\n" +
+                    InputFingerprint(input) + SparseOptionsText(options.sparse));
+  keys[1] = HashHex(std::string(kStageVersions[1]) + "\n" + keys[0] + "\n" + DenseOptionsText(options.dense));
+  keys[2] = HashHex(std::string(kStageVersions[2]) + "\n" + keys[1] + "\n" +
+                    PanoramaOptionsText(options.panorama));
+  keys[3] = HashHex(std::string(kStageVersions[3]) + "\n" + keys[2] + "\n" +
+                    std::to_string(options.color_quality) + " " + std::to_string(options.tile_size));
+
+  PipelineReport report;
+  nlohmann::json stage_json = nlohmann::json::object();
+  for (int s = 0; s < kNumStages; ++s) {
+    const Stage stage = static_cast<Stage>(s);
+    StageRun run;
+    run.stage = StageName(stage);
+    const bool current = fs::exists(dirs[s], ec) && ReadKey(key_paths[s]) == keys[s];
+    const bool selected = s >= static_cast<int>(options.from) && s <= static_cast<int>(options.to);
+    if (!selected) {
+      if (s < static_cast<int>(options.from) && !current) {
+        throw std::runtime_error(std::string("stage ") + run.stage + " has no current output in " +
+                                 work.string() + ": run it first (or drop --from)");
+      }
+      if (s > static_cast<int>(options.to)) break;
+      run.cached = true;
+      report.stages.push_back(run);
+      continue;
+    }
+    if (current && !options.force) {
+      util::LogInfo(std::string("stage ") + run.stage + ": up to date, skipped");
+      run.cached = true;
+      report.stages.push_back(run);
+      continue;
+    }
+    const auto t = Clock::now();
+    switch (stage) {
+      case Stage::kSparse: {
+        // The sparse stage writes OUT.tmp-XXXX and renames it itself.
+        sfm::SparseStageOptions sparse = options.sparse;
+        sparse.overwrite = true;
+        fs::remove(key_paths[s], ec);
+        const sfm::SparseStageResult r = sfm::RunSparseStage(input, dirs[s].string(), sparse);
+        io::WriteFileAtomic(key_paths[s].string(), keys[s]);
+        stage_json["sparse"] = {{"photos", r.num_photos},
+                                {"registered", r.num_registered},
+                                {"points", r.num_points},
+                                {"mean_reprojection_error_px", r.mean_reprojection_error_px}};
+        break;
+      }
+      case Stage::kDense: {
+        RunIntoFolder(dirs[s], key_paths[s], keys[s], [&](const fs::path& tmp) {
+          const depth::DenseReport r = depth::RunDenseStage(dirs[0].string(), tmp.string(), options.dense);
+          stage_json["dense"] = {{"photos", r.photos.size()}, {"seconds", r.seconds_total}};
+        });
+        break;
+      }
+      case Stage::kPanorama: {
+        RunIntoFolder(dirs[s], key_paths[s], keys[s], [&](const fs::path& tmp) {
+          PanoramaStageReport r;
+          RunPanoramaStage(dirs[0].string(), dirs[1].string(), tmp.string(), options.panorama, &r);
+          stage_json["panorama"] = {{"width", r.width},
+                                    {"front_coverage", r.front_coverage},
+                                    {"back_nodes", r.fuse.back_nodes_in - r.fuse.back_nodes_redundant +
+                                                       r.fuse.back_nodes_hallucinated}};
+        });
+        break;
+      }
+      case Stage::kEncode: {
+        const fs::path master = dirs[2] / "master.exr";
+        auto pano = encoder::ReadMasterFile(master.string());
+        if (!pano.ok()) throw std::runtime_error(pano.status().ToString());
+        encoder::PackageOptions package;
+        package.color_quality = options.color_quality;
+        package.tile_size = options.tile_size;
+        package.num_threads = options.num_threads;
+        encoder::PackageStats stats;
+        auto files = encoder::EncodePackage(*pano, package, &stats);
+        if (!files.ok()) throw std::runtime_error(files.status().ToString());
+        fs::remove(key_paths[s], ec);
+        Status st = encoder::WritePackageFolder(*files, dirs[s].string());
+        if (!st.ok()) throw std::runtime_error(st.ToString());
+        if (options.finish_web_package) options.finish_web_package(dirs[s].string());
+        st = encoder::WritePackageSingleFile(*files, (root / "photo.c3d").string());
+        if (!st.ok()) throw std::runtime_error(st.ToString());
+        // The archival master and the previews next to the package.
+        io::WriteFileAtomic((root / "master.exr").string(), io::ReadFile(master.string()));
+        const fs::path preview = dirs[2] / "preview";
+        if (fs::exists(preview, ec)) {
+          fs::create_directories(root / "preview", ec);
+          for (const auto& entry : fs::directory_iterator(preview, ec)) {
+            io::WriteFileAtomic((root / "preview" / entry.path().filename()).string(),
+                                io::ReadFile(entry.path().string()));
+          }
+        }
+        report.package_bytes = stats.total_bytes;
+        io::WriteFileAtomic(key_paths[s].string(), keys[s]);
+        stage_json["encode"] = {{"package_bytes", stats.total_bytes}, {"files", stats.num_files}};
+        break;
+      }
+    }
+    run.ran = true;
+    run.seconds = std::chrono::duration<double>(Clock::now() - t).count();
+    report.stages.push_back(run);
+  }
+  if (fs::exists(dirs[3] / "manifest.json", ec)) report.web_dir = dirs[3].string();
+  report.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
+
+  nlohmann::json j;
+  j["input"] = fs::absolute(input).string();
+  j["seconds_total"] = report.seconds_total;
+  for (const StageRun& r : report.stages) {
+    j["stages"].push_back({{"stage", r.stage}, {"cached", r.cached}, {"ran", r.ran}, {"seconds", r.seconds}});
+  }
+  j["results"] = stage_json;
+  io::WriteFileAtomic((root / "report.json").string(), j.dump(2) + "\n");
+  return report;
+}
+
+}  // namespace casual3d::pipeline

@@ -1,0 +1,74 @@
+#pragma once
+
+// `casual3d reconstruct`: photos in, web-ready 3D photo out. Runs the stages
+// sparse (reconstruct/sfm), dense (reconstruct/depth), panorama (warp, stitch,
+// fuse, normals: panorama_stage.h) and encode (encoder/), caching each stage's
+// output under OUT/work keyed by its inputs and options, so that a rerun after
+// a crash or a kill resumes at the first stage whose output is missing or
+// stale, and nothing already computed is lost.
+//
+// Output folder:
+//   OUT/web/            the web package with index.html and the viewer: deployable as is
+//   OUT/photo.c3d       the same package as one file
+//   OUT/master.exr      the lossless two-layer panorama (archival form)
+//   OUT/preview/        stitched colour, depth, normals and labels as PNG
+//   OUT/report.json     options, timings and statistics of every stage
+//   OUT/work/{sparse,dense,panorama}/ and OUT/work/<stage>.key   stage caches
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "reconstruct/depth/dense_stage.h"
+#include "reconstruct/pipeline/panorama_stage.h"
+#include "reconstruct/sfm/sparse_stage.h"
+
+namespace casual3d::pipeline {
+
+enum class Stage : int { kSparse = 0, kDense = 1, kPanorama = 2, kEncode = 3 };
+constexpr int kNumStages = 4;
+const char* StageName(Stage stage);
+// Parses "sparse", "dense", "panorama" or "encode"; false otherwise.
+bool StageFromName(const std::string& name, Stage* stage);
+
+struct PipelineOptions {
+  sfm::SparseStageOptions sparse;
+  depth::DenseOptions dense;
+  PanoramaStageOptions panorama;
+  // Encoding of the web package (encoder/package_writer.h), by its main knobs.
+  float color_quality = 90.0f;  // Lossy WebP quality of colour tiles, [0, 100].
+  int tile_size = 512;          // Tile side, pixels, [16, 4096].
+  // Run the stages from `from` to `to` (inclusive). Stages before `from` must
+  // have their outputs in the cache.
+  Stage from = Stage::kSparse;
+  Stage to = Stage::kEncode;
+  bool force = false;  // Recompute the selected stages even if cached.
+  int num_threads = 0; // 0 = all cores; passed to every stage.
+  // Called with OUT/web after the package is written there (the command-line
+  // program adds the viewer page and its files); may be empty.
+  std::function<void(const std::string& web_dir)> finish_web_package;
+
+  std::string Check() const;  // Empty if valid.
+};
+
+struct StageRun {
+  std::string stage;
+  bool cached = false;   // Skipped because its cached output was current.
+  bool ran = false;
+  double seconds = 0.0;
+};
+
+struct PipelineReport {
+  std::vector<StageRun> stages;
+  double seconds_total = 0.0;
+  std::string web_dir;     // OUT/web, when the encode stage ran or was cached.
+  uint64_t package_bytes = 0;
+};
+
+// Runs the pipeline on `input` (a folder of photos or a COLMAP workspace) into
+// `out`. Throws std::invalid_argument for bad options and std::runtime_error
+// with one clear line for everything else.
+PipelineReport RunPipeline(const std::string& input, const std::string& out,
+                           const PipelineOptions& options);
+
+}  // namespace casual3d::pipeline

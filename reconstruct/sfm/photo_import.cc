@@ -1,0 +1,210 @@
+#include "reconstruct/sfm/photo_import.h"
+
+#include <dirent.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <tuple>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+
+#include "reconstruct/io/cv_bridge.h"
+#include "reconstruct/io/image_io.h"
+
+namespace casual3d::sfm {
+namespace {
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string DeviceName(const ExifInfo& exif) {
+  std::string make = exif.make, model = exif.model;
+  // Phones often repeat the make in the model ("Canon" "Canon EOS 5D").
+  if (!make.empty() && Lower(model).rfind(Lower(make), 0) == 0) make.clear();
+  std::string name = make.empty() ? model : (model.empty() ? make : make + " " + model);
+  return name.empty() ? "unknown camera" : name;
+}
+
+std::string JoinList(const std::vector<std::string>& items, size_t max_items) {
+  std::string out;
+  for (size_t i = 0; i < items.size() && i < max_items; ++i) out += (i ? ", " : "") + items[i];
+  if (items.size() > max_items) out += ", ... (" + std::to_string(items.size()) + " in all)";
+  return out;
+}
+
+}  // namespace
+
+Status PhotoImportOptions::Check() const {
+  if (!(working_megapixels >= 0.05 && working_megapixels <= 100)) {
+    return InvalidArgument("working_megapixels " + std::to_string(working_megapixels) +
+                           " is outside [0.05, 100]");
+  }
+  if (!(focal_px == 0 || (focal_px >= 1 && focal_px <= 1e6))) {
+    return InvalidArgument("focal_px " + std::to_string(focal_px) + " must be 0 or in [1, 1e6]");
+  }
+  if (jpeg_quality < 50 || jpeg_quality > 100) {
+    return InvalidArgument("jpeg_quality " + std::to_string(jpeg_quality) + " is outside [50, 100]");
+  }
+  if (min_photos < 2 || min_photos > 1000000) {
+    return InvalidArgument("min_photos " + std::to_string(min_photos) + " is outside [2, 1e6]");
+  }
+  return Status::Ok();
+}
+
+bool IsPhotoFileName(const std::string& name) {
+  const std::string l = Lower(name);
+  return !name.empty() && name[0] != '.' &&
+         (EndsWith(l, ".jpg") || EndsWith(l, ".jpeg") || EndsWith(l, ".png"));
+}
+
+PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output_dir,
+                         const PhotoImportOptions& options,
+                         const std::function<void(int, int)>& on_photo) {
+  const Status status = options.Check();
+  if (!status.ok()) throw std::invalid_argument("photo import options: " + status.message());
+
+  DIR* dir = ::opendir(input_dir.c_str());
+  if (dir == nullptr) {
+    throw std::runtime_error(input_dir + ": cannot open the photo folder: " + std::strerror(errno));
+  }
+  std::vector<std::string> names;
+  while (dirent* e = ::readdir(dir)) {
+    const std::string name = e->d_name;
+    struct stat st;
+    if (IsPhotoFileName(name) && ::stat((input_dir + "/" + name).c_str(), &st) == 0 &&
+        S_ISREG(st.st_mode)) {
+      names.push_back(name);
+    }
+  }
+  ::closedir(dir);
+  std::sort(names.begin(), names.end());
+  if (static_cast<int>(names.size()) < options.min_photos) {
+    throw std::runtime_error(input_dir + ": found " + std::to_string(names.size()) +
+                             " photos (.jpg, .jpeg, .png); a 3D photo needs at least " +
+                             std::to_string(options.min_photos) +
+                             " overlapping photos (the paper's captures have 20 to 200)");
+  }
+
+  PhotoImport result;
+  std::vector<std::string> unreadable;
+  int done = 0;
+  for (const std::string& name : names) {
+    const std::string path = input_dir + "/" + name;
+    ImportedPhoto photo;
+    photo.name = name;
+    photo.exif = ReadExif(path);
+    Image8 image;
+    try {
+      io::ReadImageOptions read_options;
+      read_options.apply_exif_orientation = true;
+      image = io::ReadImage(path, read_options);
+    } catch (const std::exception& e) {
+      unreadable.push_back(e.what());
+      if (on_photo) on_photo(++done, static_cast<int>(names.size()));
+      continue;
+    }
+    photo.original_width = image.width();
+    photo.original_height = image.height();
+    const double pixels = static_cast<double>(image.width()) * image.height();
+    const double scale = std::min(1.0, std::sqrt(options.working_megapixels * 1e6 / pixels));
+    const std::string out_path = output_dir + "/" + name;
+    const bool png = EndsWith(Lower(name), ".png");
+    if (scale < 1.0) {
+      photo.width = std::max(1, static_cast<int>(std::lround(image.width() * scale)));
+      photo.height = std::max(1, static_cast<int>(std::lround(image.height() * scale)));
+      Image8 small(photo.width, photo.height, image.channels());
+      cv::Mat dst = io::ToMat(small);
+      cv::resize(io::ToMat(image), dst, dst.size(), 0, 0, cv::INTER_AREA);
+      image = std::move(small);
+    } else {
+      photo.width = image.width();
+      photo.height = image.height();
+    }
+    if (png) {
+      io::WritePng(out_path, std::as_const(image).view());
+    } else {
+      io::JpegOptions jpeg;
+      jpeg.quality = options.jpeg_quality;
+      io::WriteJpeg(out_path, std::as_const(image).view(), jpeg);
+    }
+    const int long_side = std::max(photo.original_width, photo.original_height);
+    if (options.focal_px > 0) {
+      // The prior scales with the working size (sizes are rounded per axis;
+      // the long side carries the least relative rounding).
+      photo.focal_px = options.focal_px * std::max(photo.width, photo.height) / long_side;
+    } else {
+      photo.focal_px = FocalPixelsFromExif(photo.exif, photo.width, photo.height, long_side);
+    }
+    photo.device = DeviceName(photo.exif);
+    result.photos.push_back(photo);
+    if (on_photo) on_photo(++done, static_cast<int>(names.size()));
+  }
+
+  if (!unreadable.empty()) {
+    if (!options.skip_unreadable) {
+      throw std::runtime_error(JoinList(unreadable, 5) +
+                               "; remove or replace the file, or pass --skip-unreadable");
+    }
+    result.skipped = unreadable;
+  }
+  if (static_cast<int>(result.photos.size()) < options.min_photos) {
+    throw std::runtime_error(input_dir + ": only " + std::to_string(result.photos.size()) +
+                             " readable photos; at least " + std::to_string(options.min_photos) +
+                             " are needed");
+  }
+
+  // Devices: make, model and sensor (long x short side).
+  std::map<std::string, std::vector<std::string>> devices;
+  for (const auto& p : result.photos) {
+    const int a = std::max(p.original_width, p.original_height);
+    const int b = std::min(p.original_width, p.original_height);
+    devices[p.device + " " + std::to_string(a) + "x" + std::to_string(b)].push_back(p.name);
+  }
+  if (devices.size() > 1 && !options.allow_mixed_devices) {
+    std::vector<std::string> list;
+    for (const auto& [device, photos] : devices) {
+      list.push_back(device + " (" + std::to_string(photos.size()) + " photos, e.g. " +
+                     photos.front() + ")");
+    }
+    throw std::runtime_error(input_dir + ": photos come from " + std::to_string(devices.size()) +
+                             " different cameras: " + JoinList(list, 4) +
+                             "; capture with one camera, or pass --mixed-cameras to calibrate "
+                             "each camera separately");
+  }
+
+  // Camera groups: device, upright working size and focal prior (0.1 px bins).
+  std::map<std::tuple<std::string, int, int, long>, int> group_of;
+  for (size_t i = 0; i < result.photos.size(); ++i) {
+    ImportedPhoto& p = result.photos[i];
+    const auto key = std::make_tuple(p.device, p.width, p.height, std::lround(p.focal_px * 10));
+    auto it = group_of.find(key);
+    if (it == group_of.end()) {
+      CameraGroup g;
+      g.device = p.device;
+      g.width = p.width;
+      g.height = p.height;
+      g.focal_px = p.focal_px;
+      result.groups.push_back(g);
+      it = group_of.emplace(key, static_cast<int>(result.groups.size()) - 1).first;
+    }
+    p.group = it->second;
+    result.groups[it->second].photos.push_back(static_cast<int>(i));
+  }
+  return result;
+}
+
+}  // namespace casual3d::sfm

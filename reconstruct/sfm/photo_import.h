@@ -1,0 +1,77 @@
+#pragma once
+
+// Photo import for the sparse stage: lists a folder of photos (JPEG, PNG),
+// reads their EXIF (orientation, focal length, make and model), decodes them
+// upright, downsamples them to the working resolution (Sec. 4.1: the paper's
+// depth maps are about 900x1350) and writes them for COLMAP, together with the
+// focal-length prior at the working size and the grouping into cameras (one
+// shared calibration per device, orientation and focal length).
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "format/status.h"
+#include "reconstruct/sfm/exif.h"
+
+namespace casual3d::sfm {
+
+struct PhotoImportOptions {
+  // Working resolution in megapixels; larger photos are downsampled (area
+  // filter) to about this many pixels, smaller ones are kept as they are.
+  double working_megapixels = 1.2;  // Range [0.05, 100]. Sec. 4.1: ~900x1350.
+  // Unreadable or corrupt photos: skip them with a warning (true) or stop with
+  // an error naming them (false).
+  bool skip_unreadable = false;
+  // Photos from different devices (EXIF make, model or sensor size differ): use
+  // one calibration per device (true) or stop with an error listing them.
+  bool allow_mixed_devices = false;
+  // Focal length prior in pixels at the photos' original size; overrides EXIF
+  // (needed for photos without EXIF). 0: from EXIF, or none.
+  double focal_px = 0.0;  // Range 0 or [1, 1e6].
+  int jpeg_quality = 95;  // Range [50, 100]; quality of the re-encoded photos.
+  int min_photos = 3;     // Range [2, 1e6]; fewer photos is an error.
+
+  Status Check() const;
+};
+
+struct ImportedPhoto {
+  std::string name;         // File name in the input and output folders.
+  int original_width = 0;   // Upright (after EXIF orientation), pixels.
+  int original_height = 0;
+  int width = 0;            // Written (working) size, pixels.
+  int height = 0;
+  double focal_px = 0.0;    // Focal prior at the working size; 0 = none.
+  std::string device;       // "make model" or "unknown camera".
+  int group = 0;            // Index into PhotoImport::groups.
+  ExifInfo exif;
+};
+
+// Photos that share one camera calibration in COLMAP.
+struct CameraGroup {
+  std::string device;
+  int width = 0;
+  int height = 0;
+  double focal_px = 0.0;  // Prior at the working size; 0 = none (COLMAP's default).
+  std::vector<int> photos;  // Indices into PhotoImport::photos.
+};
+
+struct PhotoImport {
+  std::vector<ImportedPhoto> photos;  // Sorted by name.
+  std::vector<CameraGroup> groups;
+  std::vector<std::string> skipped;   // "name: reason", when skip_unreadable.
+};
+
+// True for the file names the stage treats as photos (.jpg, .jpeg, .png, any case).
+bool IsPhotoFileName(const std::string& name);
+
+// Imports every photo of `input_dir` (not recursive) into `output_dir` (must
+// exist). `on_photo(done, total)` is called after each photo (may be empty).
+// Throws std::runtime_error with one clear line for: a missing input folder,
+// fewer than min_photos photos, unreadable photos (naming them) unless skipped,
+// mixed devices unless allowed, or a failed write.
+PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output_dir,
+                         const PhotoImportOptions& options,
+                         const std::function<void(int, int)>& on_photo);
+
+}  // namespace casual3d::sfm

@@ -1,0 +1,513 @@
+#include "reconstruct/sfm/sparse_stage.h"
+
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "reconstruct/geometry/colmap_model.h"
+#include "reconstruct/io/file_util.h"
+#include "reconstruct/sfm/colmap_runner.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::sfm {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+const char* const kCameraModels[] = {"SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL",
+                                     "OPENCV"};
+
+std::string FormatNumber(double v) {
+  std::ostringstream ss;
+  ss.precision(10);
+  ss << v;
+  return ss.str();
+}
+
+// COLMAP's --ImageReader.camera_params for `model` with focal f and the
+// principal point at the image centre; distortion starts at zero.
+std::string CameraParams(const std::string& model, double f, int width, int height) {
+  const std::string fs_ = FormatNumber(f);
+  const std::string cx = FormatNumber(width / 2.0), cy = FormatNumber(height / 2.0);
+  if (model == "SIMPLE_PINHOLE") return fs_ + "," + cx + "," + cy;
+  if (model == "PINHOLE") return fs_ + "," + fs_ + "," + cx + "," + cy;
+  if (model == "SIMPLE_RADIAL") return fs_ + "," + cx + "," + cy + ",0";
+  if (model == "RADIAL") return fs_ + "," + cx + "," + cy + ",0,0";
+  return fs_ + "," + fs_ + "," + cx + "," + cy + ",0,0,0,0";  // OPENCV.
+}
+
+bool HasModelFiles(const fs::path& dir) {
+  return (fs::exists(dir / "cameras.bin") && fs::exists(dir / "images.bin") &&
+          fs::exists(dir / "points3D.bin")) ||
+         (fs::exists(dir / "cameras.txt") && fs::exists(dir / "images.txt") &&
+          fs::exists(dir / "points3D.txt"));
+}
+
+// Model folders below a workspace: DIR/sparse itself or DIR/sparse/<N>.
+std::vector<fs::path> WorkspaceModels(const fs::path& input) {
+  std::vector<fs::path> models;
+  const fs::path sparse = input / "sparse";
+  std::error_code ec;
+  if (!fs::is_directory(sparse, ec)) return models;
+  if (HasModelFiles(sparse)) models.push_back(sparse);
+  for (const auto& entry : fs::directory_iterator(sparse, ec)) {
+    if (entry.is_directory() && HasModelFiles(entry.path())) models.push_back(entry.path());
+  }
+  std::sort(models.begin(), models.end());
+  return models;
+}
+
+// The model with the most registered images (then points) among `dirs`.
+std::pair<fs::path, geometry::SparseModel> LargestModel(const std::vector<fs::path>& dirs) {
+  fs::path best_dir;
+  geometry::SparseModel best;
+  bool have = false;
+  for (const auto& dir : dirs) {
+    geometry::SparseModel model = geometry::ReadModel(dir.string());
+    if (!have || model.images.size() > best.images.size() ||
+        (model.images.size() == best.images.size() && model.points.size() > best.points.size())) {
+      best = std::move(model);
+      best_dir = dir;
+      have = true;
+    }
+  }
+  return {best_dir, std::move(best)};
+}
+
+std::string JoinNames(const std::vector<std::string>& names, size_t max_names) {
+  std::string out;
+  for (size_t i = 0; i < names.size() && i < max_names; ++i) out += (i ? ", " : "") + names[i];
+  if (names.size() > max_names) out += ", ... (" + std::to_string(names.size()) + " in all)";
+  return out;
+}
+
+std::string LastLines(const std::string& text) {
+  std::string s = text;
+  while (!s.empty() && s.back() == '\n') s.pop_back();
+  const size_t pos = s.rfind('\n');
+  return pos == std::string::npos ? s : s.substr(pos + 1);
+}
+
+// The temporary output folder and its clean-up on failure.
+class StagingDir {
+ public:
+  StagingDir(const fs::path& output) : output_(output) {
+    std::string pattern = output.string() + ".tmp-XXXXXX";
+    std::vector<char> buf(pattern.begin(), pattern.end());
+    buf.push_back('\0');
+    if (::mkdtemp(buf.data()) == nullptr) {
+      throw std::runtime_error(output.string() + ": cannot create the output folder here (" +
+                               std::strerror(errno) +
+                               "); choose a writable location with -o");
+    }
+    path_ = buf.data();
+  }
+  ~StagingDir() {
+    if (committed_) return;
+    std::error_code ec;
+    if (fs::exists(path_ / "sparse_log.txt", ec)) {
+      const fs::path kept = output_.string() + ".failed-log.txt";
+      fs::rename(path_ / "sparse_log.txt", kept, ec);
+    }
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+  // Moves the staging folder to `output`, replacing an existing one only now.
+  void Commit(bool overwrite) {
+    std::error_code ec;
+    fs::path old;
+    if (fs::exists(output_, ec)) {
+      if (!overwrite) {
+        throw std::runtime_error(output_.string() +
+                                 ": already exists; pass --overwrite or choose another folder");
+      }
+      old = output_.string() + ".old-" + std::to_string(::getpid());
+      fs::rename(output_, old, ec);
+      if (ec) {
+        throw std::runtime_error(output_.string() + ": cannot replace it: " + ec.message());
+      }
+    }
+    fs::rename(path_, output_, ec);
+    if (ec) {
+      if (!old.empty()) fs::rename(old, output_);
+      throw std::runtime_error(output_.string() + ": cannot move the finished output in place: " +
+                               ec.message());
+    }
+    committed_ = true;
+    if (!old.empty()) fs::remove_all(old, ec);
+  }
+
+ private:
+  fs::path output_;
+  fs::path path_;
+  bool committed_ = false;
+};
+
+// Runs COLMAP steps with progress, timing and error reporting.
+class ColmapSteps {
+ public:
+  ColmapSteps(std::string colmap, std::string log_path, int num_images,
+              SparseStageResult* result)
+      : colmap_(std::move(colmap)), log_path_(std::move(log_path)), num_images_(num_images),
+        result_(result) {}
+
+  void Run(const std::string& command, const std::vector<std::string>& args,
+           const std::string& label) {
+    util::Progress progress(label, 1000);
+    auto on_line = [&](const std::string& line) {
+      long done = 0, total = 0;
+      if (ParseColmapProgress(line, num_images_, &done, &total)) {
+        progress.Set(done * 1000 / total);
+      }
+    };
+    const ColmapResult r = RunColmap(colmap_, command, args, log_path_, on_line);
+    if (InterruptRequested()) throw std::runtime_error("interrupted during COLMAP " + command);
+    if (r.signal != 0 || r.exit_code != 0) {
+      throw std::runtime_error("COLMAP " + command + " failed (" + DescribeExit(r) +
+                               "): " + LastLines(r.last_lines) + " [full log kept next to the output]");
+    }
+    progress.Finish();
+    Add(command, r.seconds);
+  }
+
+  void Add(const std::string& step, double seconds) {
+    // Repeated steps (one feature_extractor per camera group) add up.
+    for (auto& [name, s] : result_->timings_s) {
+      if (name == step) {
+        s += seconds;
+        return;
+      }
+    }
+    result_->timings_s.emplace_back(step, seconds);
+  }
+
+ private:
+  std::string colmap_;
+  std::string log_path_;
+  int num_images_;
+  SparseStageResult* result_;
+};
+
+void AppendLog(const std::string& log_path, const std::string& text) {
+  std::ofstream log(log_path, std::ios::app);
+  log << "# " << text << "\n";
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+Json OptionsJson(const SparseStageOptions& o) {
+  const char* matcher = o.matcher == MatcherType::kAuto         ? "auto"
+                        : o.matcher == MatcherType::kExhaustive ? "exhaustive"
+                                                                : "sequential";
+  return {{"working_megapixels", o.import.working_megapixels},
+          {"skip_unreadable", o.import.skip_unreadable},
+          {"allow_mixed_devices", o.import.allow_mixed_devices},
+          {"focal_px", o.import.focal_px},
+          {"jpeg_quality", o.import.jpeg_quality},
+          {"camera_model", o.camera_model},
+          {"shared_camera", o.shared_camera},
+          {"matcher", matcher},
+          {"exhaustive_max_photos", o.exhaustive_max_photos},
+          {"sequential_overlap", o.sequential_overlap},
+          {"max_features", o.max_features},
+          {"num_threads", o.num_threads},
+          {"min_registered_fraction", o.min_registered_fraction},
+          {"depth_ranges",
+           {{"near_percentile", o.depth_ranges.near_percentile},
+            {"far_percentile", o.depth_ranges.far_percentile},
+            {"near_margin", o.depth_ranges.near_margin},
+            {"far_margin", o.depth_ranges.far_margin},
+            {"min_points", o.depth_ranges.min_points}}},
+          {"frame",
+           {{"robust_centre", o.frame.robust_centre},
+            {"min_partial_resultant", o.frame.min_partial_resultant}}}};
+}
+
+}  // namespace
+
+Status SparseStageOptions::Check() const {
+  CASUAL3D_RETURN_IF_ERROR(import.Check());
+  CASUAL3D_RETURN_IF_ERROR(depth_ranges.Check());
+  CASUAL3D_RETURN_IF_ERROR(frame.Check());
+  if (std::find(std::begin(kCameraModels), std::end(kCameraModels), camera_model) ==
+      std::end(kCameraModels)) {
+    return InvalidArgument("camera_model " + camera_model +
+                           " is not one of SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV");
+  }
+  if (exhaustive_max_photos < 3 || exhaustive_max_photos > 100000) {
+    return InvalidArgument("exhaustive_max_photos " + std::to_string(exhaustive_max_photos) +
+                           " is outside [3, 100000]");
+  }
+  if (sequential_overlap < 1 || sequential_overlap > 1000) {
+    return InvalidArgument("sequential_overlap " + std::to_string(sequential_overlap) +
+                           " is outside [1, 1000]");
+  }
+  if (max_features < 500 || max_features > 100000) {
+    return InvalidArgument("max_features " + std::to_string(max_features) +
+                           " is outside [500, 100000]");
+  }
+  if (num_threads < 0 || num_threads > 1024) {
+    return InvalidArgument("num_threads " + std::to_string(num_threads) + " is outside [0, 1024]");
+  }
+  if (!(min_registered_fraction >= 0 && min_registered_fraction <= 1)) {
+    return InvalidArgument("min_registered_fraction " + std::to_string(min_registered_fraction) +
+                           " is outside [0, 1]");
+  }
+  return Status::Ok();
+}
+
+SparseStageResult RunSparseStage(const std::string& input, const std::string& output,
+                                 const SparseStageOptions& options) {
+  const Status status = options.Check();
+  if (!status.ok()) throw std::invalid_argument("sparse stage options: " + status.message());
+  const auto stage_start = std::chrono::steady_clock::now();
+
+  // Inputs first: cheap checks before any work.
+  const fs::path input_path(input);
+  std::error_code ec;
+  if (!fs::is_directory(input_path, ec)) {
+    throw std::runtime_error(input + ": not a folder; give a folder of photos or a COLMAP "
+                             "workspace (images/ and sparse/)");
+  }
+  const fs::path output_path = fs::absolute(fs::path(output)).lexically_normal();
+  if (fs::exists(output_path, ec) && !options.overwrite) {
+    throw std::runtime_error(output + ": already exists; pass --overwrite or choose another folder");
+  }
+  const std::vector<fs::path> workspace_models = WorkspaceModels(input_path);
+  bool workspace = false;
+  switch (options.input_type) {
+    case SparseInputType::kAuto:
+      workspace = !workspace_models.empty() && fs::is_directory(input_path / "images", ec);
+      break;
+    case SparseInputType::kWorkspace:
+      if (workspace_models.empty() || !fs::is_directory(input_path / "images", ec)) {
+        throw std::runtime_error(input + ": not a COLMAP workspace (expected images/ and a model "
+                                 "in sparse/ or sparse/0 with cameras, images and points3D files)");
+      }
+      workspace = true;
+      break;
+    case SparseInputType::kPhotos:
+      break;
+  }
+  const std::string colmap = FindColmap(options.colmap_path);
+  const std::string threads = std::to_string(options.num_threads == 0 ? -1 : options.num_threads);
+
+  ScopedInterruptHandler interrupt_handler;
+  StagingDir staging(output_path);
+  const fs::path tmp = staging.path();
+  const fs::path work = tmp / "work";
+  fs::create_directories(work / "images");
+  const std::string log_path = (tmp / "sparse_log.txt").string();
+  AppendLog(log_path, "casual3d sparse: input " + input + ", output " + output);
+
+  SparseStageResult result;
+  result.input_type = workspace ? "workspace" : "photos";
+  fs::path image_dir;
+  fs::path model_dir;
+  geometry::SparseModel raw_model;
+  std::vector<std::string> all_names;
+
+  if (workspace) {
+    image_dir = input_path / "images";
+    auto [dir, model] = LargestModel(workspace_models);
+    model_dir = dir;
+    raw_model = std::move(model);
+    for (const auto& [id, image] : raw_model.images) {
+      all_names.push_back(image.name);
+      if (!fs::exists(image_dir / image.name, ec)) {
+        throw std::runtime_error((image_dir / image.name).string() +
+                                 ": missing; the workspace's model " + model_dir.string() +
+                                 " lists it");
+      }
+    }
+    AppendLog(log_path, "workspace model " + model_dir.string());
+  } else {
+    // 1. Import the photos at the working resolution.
+    const auto t0 = std::chrono::steady_clock::now();
+    PhotoImport photos;
+    {
+      util::Progress progress("import photos", 1000);
+      photos = ImportPhotos(input, (work / "images").string(), options.import,
+                            [&](int done, int total) {
+                              if (InterruptRequested()) throw std::runtime_error("interrupted");
+                              progress.Set(static_cast<int64_t>(done) * 1000 / std::max(total, 1));
+                            });
+    }
+    result.skipped = photos.skipped;
+    for (const auto& s : photos.skipped) util::LogWarning("skipped " + s);
+    for (const auto& p : photos.photos) all_names.push_back(p.name);
+    result.timings_s.emplace_back("import", SecondsSince(t0));
+    image_dir = work / "images";
+    const int n = static_cast<int>(photos.photos.size());
+    ColmapSteps steps(colmap, log_path, n, &result);
+
+    // 2. Features, one extractor run per camera group so each gets its own
+    // calibration and focal prior (TOOLCHAIN.md: resized photos lost their EXIF).
+    const std::string db = (work / "database.db").string();
+    for (size_t g = 0; g < photos.groups.size(); ++g) {
+      const CameraGroup& group = photos.groups[g];
+      const fs::path list = work / ("group" + std::to_string(g) + ".txt");
+      {
+        std::ofstream out(list);
+        for (int i : group.photos) out << photos.photos[i].name << "\n";
+        if (!out) throw std::runtime_error(list.string() + ": cannot write (disk full?)");
+      }
+      std::vector<std::string> args = {
+          "--database_path", db, "--image_path", image_dir.string(), "--image_list_path",
+          list.string(), "--ImageReader.camera_model", options.camera_model,
+          "--ImageReader.single_camera", options.shared_camera ? "1" : "0",
+          "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
+          "--SiftExtraction.max_num_features", std::to_string(options.max_features)};
+      if (group.focal_px > 0) {
+        args.push_back("--ImageReader.camera_params");
+        args.push_back(CameraParams(options.camera_model, group.focal_px, group.width, group.height));
+      }
+      AppendLog(log_path, "camera group " + std::to_string(g) + ": " + group.device + ", " +
+                              std::to_string(group.width) + "x" + std::to_string(group.height) +
+                              ", focal prior " +
+                              (group.focal_px > 0 ? FormatNumber(group.focal_px) + " px" : "none"));
+      steps.Run("feature_extractor", args, "features");
+    }
+
+    // 3. Matching.
+    const bool exhaustive =
+        options.matcher == MatcherType::kExhaustive ||
+        (options.matcher == MatcherType::kAuto && n <= options.exhaustive_max_photos);
+    result.matcher = exhaustive ? "exhaustive" : "sequential";
+    std::vector<std::string> match_args = {"--database_path", db, "--SiftMatching.use_gpu", "0",
+                                           "--SiftMatching.num_threads", threads};
+    if (!exhaustive) {
+      match_args.insert(match_args.end(),
+                        {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
+                         "--SequentialMatching.loop_detection", "0"});
+    }
+    steps.Run(exhaustive ? "exhaustive_matcher" : "sequential_matcher", match_args, "matching");
+
+    // 4. Mapping; keep the largest model.
+    const fs::path mapped = work / "sparse";
+    fs::create_directories(mapped);
+    steps.Run("mapper",
+              {"--database_path", db, "--image_path", image_dir.string(), "--output_path",
+               mapped.string(), "--Mapper.num_threads", threads},
+              "mapping");
+    std::vector<fs::path> models;
+    for (const auto& entry : fs::directory_iterator(mapped, ec)) {
+      if (entry.is_directory() && HasModelFiles(entry.path())) models.push_back(entry.path());
+    }
+    std::sort(models.begin(), models.end());
+    if (models.empty()) {
+      throw std::runtime_error(
+          "COLMAP registered none of the " + std::to_string(n) +
+          " photos (no initial pair found); take more photos with more overlap (each scene "
+          "point in 3 or more photos) of a textured scene, and move the camera between shots");
+    }
+    auto [dir, model] = LargestModel(models);
+    model_dir = dir;
+    raw_model = std::move(model);
+    if (models.size() > 1) {
+      AppendLog(log_path, std::to_string(models.size()) + " models; kept " + model_dir.string());
+    }
+  }
+
+  // Registration check.
+  std::set<std::string> registered;
+  for (const auto& [id, image] : raw_model.images) registered.insert(image.name);
+  result.num_photos = static_cast<int>(all_names.size());
+  result.num_registered = static_cast<int>(registered.size());
+  for (const auto& name : all_names) {
+    if (!registered.count(name)) result.unregistered.push_back(name);
+  }
+  const int needed = std::max(
+      3, static_cast<int>(std::ceil(options.min_registered_fraction * result.num_photos - 1e-9)));
+  if (result.num_registered < needed) {
+    throw std::runtime_error(
+        "COLMAP registered only " + std::to_string(result.num_registered) + " of " +
+        std::to_string(result.num_photos) + " photos (need " + std::to_string(needed) +
+        "); not registered: " + JoinNames(result.unregistered, 8) +
+        ". Retake with more overlap between neighbouring photos and a more textured scene");
+  }
+  if (!result.unregistered.empty()) {
+    util::LogWarning("COLMAP registered " + std::to_string(result.num_registered) + " of " +
+                     std::to_string(result.num_photos) +
+                     " photos; left out: " + JoinNames(result.unregistered, 8));
+  }
+
+  // 5. Undistortion into PINHOLE cameras.
+  ColmapSteps steps(colmap, log_path, result.num_registered, &result);
+  const fs::path undistorted = work / "undistorted";
+  steps.Run("image_undistorter",
+            {"--image_path", image_dir.string(), "--input_path", model_dir.string(),
+             "--output_path", undistorted.string(), "--output_type", "COLMAP"},
+            "undistorting");
+  fs::rename(undistorted / "images", tmp / "images");
+  fs::create_directories(tmp / "sparse");
+  for (const char* f : {"cameras.bin", "images.bin", "points3D.bin"}) {
+    fs::rename(undistorted / "sparse" / f, tmp / "sparse" / f);
+  }
+  steps.Run("model_converter",
+            {"--input_path", (tmp / "sparse").string(), "--output_path", (tmp / "sparse").string(),
+             "--output_type", "TXT"},
+            "writing model");
+
+  // 6. Scene set-up: frame and depth ranges.
+  const auto t_setup = std::chrono::steady_clock::now();
+  const geometry::SparseModel model = geometry::ReadModel((tmp / "sparse").string());
+  result.num_points = static_cast<int>(model.points.size());
+  double error_sum = 0;
+  for (const auto& [id, p] : model.points) error_sum += p.error;
+  result.mean_reprojection_error_px = model.points.empty() ? 0.0 : error_sum / model.points.size();
+  const PanoramaFrame frame = ComputePanoramaFrame(model, options.frame, &result.frame);
+  WritePanoramaFrame(frame, (tmp / "frame.json").string(), &result.frame);
+  WriteDepthRanges(ComputeDepthRanges(model, options.depth_ranges),
+                   (tmp / "depth_ranges.json").string());
+  result.timings_s.emplace_back("scene_setup", SecondsSince(t_setup));
+
+  if (!options.keep_work) {
+    fs::remove_all(work, ec);
+  }
+  result.timings_s.emplace_back("total", SecondsSince(stage_start));
+
+  Json timings = Json::object();
+  for (const auto& [step, s] : result.timings_s) timings[step] = s;
+  Json stage = {{"format", "casual3d-stage-sparse"},
+                {"version", "1.0"},
+                {"input", fs::absolute(input_path).lexically_normal().string()},
+                {"input_type", result.input_type},
+                {"colmap", colmap},
+                {"options", OptionsJson(options)},
+                {"matcher", result.matcher},
+                {"num_photos", result.num_photos},
+                {"num_registered", result.num_registered},
+                {"unregistered", result.unregistered},
+                {"skipped", result.skipped},
+                {"num_points", result.num_points},
+                {"mean_reprojection_error_px", result.mean_reprojection_error_px},
+                {"timings_s", timings}};
+  io::WriteFileAtomic((tmp / "stage.json").string(), stage.dump(2) + "\n");
+  AppendLog(log_path, "done: " + std::to_string(result.num_registered) + "/" +
+                          std::to_string(result.num_photos) + " registered, " +
+                          std::to_string(result.num_points) + " points");
+  if (InterruptRequested()) throw std::runtime_error("interrupted");
+  staging.Commit(options.overwrite);
+  return result;
+}
+
+}  // namespace casual3d::sfm

@@ -1,0 +1,92 @@
+#pragma once
+
+// The sparse stage (Sec. 4.1 of the paper): photos in, calibrated cameras out.
+//
+// Input: a folder of photos (JPEG, PNG, with EXIF), or an existing COLMAP
+// workspace (DIR/images plus a sparse model in DIR/sparse or DIR/sparse/N).
+// For photos it imports them at the working resolution (photo_import.h), runs
+// Debian's COLMAP on the CPU (feature_extractor, exhaustive or sequential
+// matcher, mapper) and keeps the largest model; for a workspace it takes the
+// largest model found. Both then run COLMAP's image_undistorter and set up the
+// scene (scene_setup.h).
+//
+// Output (spec/stage-sparse.md), written to OUT.tmp-XXXXXX and renamed to OUT
+// only when complete:
+//   OUT/images/            undistorted photos (PINHOLE cameras)
+//   OUT/sparse/            COLMAP model of the undistorted cameras, .bin and .txt
+//   OUT/frame.json         the 3D photo's frame (PanoramaFrame)
+//   OUT/depth_ranges.json  per-photo near/far depth
+//   OUT/sparse_log.txt     COLMAP's full output and the stage's notes
+//   OUT/stage.json         inputs, options, counts and timings per step
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "format/status.h"
+#include "reconstruct/sfm/photo_import.h"
+#include "reconstruct/sfm/scene_setup.h"
+
+namespace casual3d::sfm {
+
+enum class SparseInputType {
+  kAuto,       // A workspace if DIR/images and a model below DIR/sparse exist, else photos.
+  kPhotos,     // A folder of photos.
+  kWorkspace,  // A COLMAP workspace.
+};
+
+enum class MatcherType {
+  kAuto,        // Exhaustive up to exhaustive_max_photos photos, else sequential.
+  kExhaustive,  // Every pair: best for small, unordered captures.
+  kSequential,  // Neighbours in file-name order: for large, ordered captures.
+};
+
+struct SparseStageOptions {
+  SparseInputType input_type = SparseInputType::kAuto;
+  PhotoImportOptions import;
+  // COLMAP camera model of the photos: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL,
+  // RADIAL or OPENCV. SIMPLE_RADIAL is COLMAP's default for phone photos.
+  std::string camera_model = "SIMPLE_RADIAL";
+  // One calibration per camera group (device, size, focal) rather than per photo.
+  bool shared_camera = true;
+  MatcherType matcher = MatcherType::kAuto;
+  int exhaustive_max_photos = 60;  // Range [3, 1e5]; kAuto's switch-over.
+  int sequential_overlap = 10;     // Range [1, 1000]; neighbours matched by kSequential.
+  // SIFT features per photo. 4096 (half COLMAP's default) suits ~1.2 MP photos
+  // and quarters CPU matching time, which grows with its square.
+  int max_features = 4096;  // Range [500, 1e5].
+  int num_threads = 0;             // Range [0, 1024]; 0 = all cores.
+  // Fewer registered photos than this fraction of the input is an error; any
+  // unregistered photo is a warning.
+  double min_registered_fraction = 0.5;  // Range [0, 1].
+  bool overwrite = false;   // Replace an existing OUT (only once the new one is complete).
+  bool keep_work = false;   // Keep COLMAP's database and raw models in OUT/work.
+  std::string colmap_path;  // Empty: `colmap` on PATH.
+  DepthRangeOptions depth_ranges;
+  PanoramaFrameOptions frame;
+
+  Status Check() const;
+};
+
+struct SparseStageResult {
+  std::string input_type;  // "photos" or "workspace".
+  int num_photos = 0;      // Photos given (workspace: images in its model).
+  int num_registered = 0;
+  std::vector<std::string> unregistered;  // Names.
+  std::vector<std::string> skipped;       // Unreadable photos skipped.
+  int num_points = 0;
+  double mean_reprojection_error_px = 0.0;
+  std::string matcher;  // "exhaustive", "sequential" or "" (workspace).
+  std::vector<std::pair<std::string, double>> timings_s;  // Step, seconds, in order.
+  PanoramaFrameInfo frame;
+};
+
+// Runs the stage from `input` into `output`. Throws std::invalid_argument for
+// bad options and std::runtime_error with one clear line for every failure the
+// user can meet (see spec/stage-sparse.md); on failure nothing is left at
+// `output` (an existing one is untouched) and COLMAP's log is kept at
+// `output` + ".failed-log.txt" when COLMAP had started.
+SparseStageResult RunSparseStage(const std::string& input, const std::string& output,
+                                 const SparseStageOptions& options);
+
+}  // namespace casual3d::sfm

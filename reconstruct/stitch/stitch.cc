@@ -1,0 +1,298 @@
+#include "reconstruct/stitch/stitch.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+#include <thread>
+
+namespace casual3d::stitch {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / kPi;
+// How strongly label upsampling avoids stretched fragments: a fully stretched
+// one (s = 1) weighs exp(-6), about 0.25%, of an unstretched one.
+constexpr double kUpsampleStretchWeight = 6.0;
+
+// The per-label data of one layer at the solve resolution, densely stored.
+struct CoarseStack {
+  int width = 0, height = 0, num_labels = 0;
+  std::vector<float> depth;     // [label][pixel]; 0 = no warp.
+  std::vector<float> log_depth; // [label][pixel].
+  std::vector<float> stretch;   // [label][pixel].
+  std::vector<uint8_t> rgb;     // [label][pixel][3].
+
+  size_t at(int label, int pixel) const {
+    return static_cast<size_t>(label) * width * height + pixel;
+  }
+};
+
+void FillStack(const std::vector<warp::WarpedView>& views, bool back, int width, int height,
+               CoarseStack* stack) {
+  stack->width = width;
+  stack->height = height;
+  stack->num_labels = static_cast<int>(views.size());
+  const size_t n = static_cast<size_t>(width) * height * views.size();
+  stack->depth.assign(n, 0.0f);
+  stack->log_depth.assign(n, 0.0f);
+  stack->stretch.assign(n, 1.0f);
+  stack->rgb.assign(3 * n, 0);
+  for (int l = 0; l < stack->num_labels; ++l) {
+    const warp::WarpedLayer& layer = back ? views[l].back : views[l].front;
+    for (int cy = 0; cy < layer.height(); ++cy) {
+      const int y = layer.y0 + cy;
+      if (y < 0 || y >= height) continue;
+      for (int cx = 0; cx < layer.width(); ++cx) {
+        const float d = layer.depth_m.at(cx, cy);
+        if (!(d > 0)) continue;
+        const int x = WrapColumn(layer.x0 + cx, width);
+        const size_t i = stack->at(l, y * width + x);
+        stack->depth[i] = d;
+        stack->log_depth[i] = std::log(d);
+        stack->stretch[i] = layer.stretch.at(cx, cy);
+        for (int c = 0; c < 3; ++c) stack->rgb[3 * i + c] = layer.rgb.at(cx, cy, c);
+      }
+    }
+  }
+}
+
+double ParallaxDeg(const Vec3d& dir, double depth, const Vec3d& camera) {
+  const double px = dir.x * depth, py = dir.y * depth, pz = dir.z * depth;
+  const double qx = px - camera.x, qy = py - camera.y, qz = pz - camera.z;
+  const double qn = std::sqrt(qx * qx + qy * qy + qz * qz);
+  if (qn <= 0) return 180.0;
+  const double c = (px * qx + py * qy + pz * qz) / (depth * qn);
+  return std::acos(std::clamp(c, -1.0, 1.0)) * kRadToDeg;
+}
+
+// Runs `fn(row_begin, row_end)` over rows on all cores.
+template <typename Fn>
+void ParallelRows(int rows, Fn fn) {
+  const int threads = std::max(1, std::min<int>(rows, std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&, t] { fn(rows * t / threads, rows * (t + 1) / threads); });
+  }
+  for (std::thread& th : pool) th.join();
+}
+
+StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
+                          const std::vector<warp::WarpedView>& coarse,
+                          const std::vector<ViewGeometry>& views, int pano_width,
+                          const StitchedLayer* front, const StitchOptions& options) {
+  const std::string why = options.Check();
+  if (!why.empty()) throw std::invalid_argument("stitch options: " + why);
+  if (full.size() != coarse.size() || full.size() != views.size() || full.empty()) {
+    throw std::invalid_argument("stitch: full, coarse warps and views must be equally many (>0)");
+  }
+  if (full.size() > 32000) throw std::invalid_argument("stitch: more than 32000 photos");
+  const int sw = options.solve_width, sh = options.solve_height;
+  const int W = pano_width, H = pano_width / 2;
+  const int L = static_cast<int>(full.size());
+  const int n = sw * sh;
+
+  CoarseStack stack;
+  FillStack(coarse, back, sw, sh, &stack);
+  // Any-surface depths for the back layer's consistency check.
+  CoarseStack front_stack;
+  if (back) FillStack(coarse, false, sw, sh, &front_stack);
+
+  GridMrf mrf(sw, sh, L, /*wrap_x=*/true);
+  const float tol = static_cast<float>(options.gc_depth_tolerance);
+  ParallelRows(sh, [&](int row_begin, int row_end) {
+    for (int y = row_begin; y < row_end; ++y) {
+      for (int x = 0; x < sw; ++x) {
+        const int p = y * sw + x;
+        const Vec3d dir = EquirectPixelToDirection(x + 0.5, y + 0.5, sw, sh);
+        const float front_depth = front ? front->solve_depth_m.at(x, y) : 0.0f;
+        for (int l = 0; l < L; ++l) {
+          const float d = stack.depth[stack.at(l, p)];
+          if (!(d > 0)) continue;
+          if (back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance)) continue;
+          double cost = options.lambda_stretch * stack.stretch[stack.at(l, p)];
+          cost += options.lambda_parallax *
+                  std::min(1.0, ParallaxDeg(dir, d, views[l].centre) / options.parallax_scale_deg);
+          if (options.lambda_gc > 0) {
+            int support = 0;
+            for (int k = 0; k < L && support < options.gc_min_support; ++k) {
+              if (k == l) continue;
+              const float dk = stack.depth[stack.at(k, p)];
+              bool agrees = dk > 0 && std::abs(dk - d) <= tol * d;
+              if (!agrees && back) {
+                const float fk = front_stack.depth[front_stack.at(k, p)];
+                agrees = fk > 0 && std::abs(fk - d) <= tol * d;
+              }
+              support += agrees;
+            }
+            cost += options.lambda_gc *
+                    std::max(0.0, 1.0 - static_cast<double>(support) / options.gc_min_support);
+          }
+          mrf.data_cost(p, l) = static_cast<float>(cost);
+        }
+      }
+    }
+  });
+
+  const float inv_scale = static_cast<float>(1.0 / options.seam_depth_scale);
+  auto pairwise = [&](int p, int q, int a, int b) -> float {
+    const size_t ap = stack.at(a, p), bp = stack.at(b, p), aq = stack.at(a, q), bq = stack.at(b, q);
+    if (!(stack.depth[ap] > 0 && stack.depth[bp] > 0 && stack.depth[aq] > 0 &&
+          stack.depth[bq] > 0)) {
+      return static_cast<float>(options.lambda_seam_invalid);
+    }
+    int color = 0;
+    for (int c = 0; c < 3; ++c) {
+      color += std::abs(stack.rgb[3 * ap + c] - stack.rgb[3 * bp + c]) +
+               std::abs(stack.rgb[3 * aq + c] - stack.rgb[3 * bq + c]);
+    }
+    const float depth = std::abs(stack.log_depth[ap] - stack.log_depth[bp]) +
+                        std::abs(stack.log_depth[aq] - stack.log_depth[bq]);
+    return static_cast<float>(options.lambda_seam_color) * color / (6.0f * 255.0f) +
+           static_cast<float>(options.lambda_seam_depth) * std::min(1.0f, 0.5f * depth * inv_scale);
+  };
+  const std::vector<int> labels = mrf.Solve(pairwise, options.solver);
+
+  StitchedLayer out;
+  out.energy = mrf.Energy(labels, pairwise);
+  out.solve_label = Image<int16_t>(sw, sh, 1, -1);
+  out.solve_depth_m = ImageF(sw, sh, 1, 0.0f);
+  Image8 solve_rgb(sw, sh, 3, 0);
+  for (int p = 0; p < n; ++p) {
+    const int l = labels[p];
+    if (l < 0) continue;
+    out.solve_label.vector()[p] = static_cast<int16_t>(l);
+    out.solve_depth_m.vector()[p] = stack.depth[stack.at(l, p)];
+    for (int c = 0; c < 3; ++c) solve_rgb.vector()[3 * p + c] = stack.rgb[3 * stack.at(l, p) + c];
+  }
+
+  // Edge-aware label upsampling: each full-resolution pixel takes, among the
+  // labels of the nearby solve-resolution pixels, the one whose full-resolution
+  // warp best matches the colours those pixels show, weighted by distance.
+  out.rgb = Image8(W, H, 3, 0);
+  out.depth_m = ImageF(W, H, 1, 0.0f);
+  out.label = Image<int16_t>(W, H, 1, -1);
+  const double scale = static_cast<double>(sw) / W;
+  const int r = options.upsample_radius;
+  const double inv_two_sigma2 =
+      1.0 / (2.0 * options.upsample_sigma_color * options.upsample_sigma_color);
+  ParallelRows(H, [&](int row_begin, int row_end) {
+    std::vector<int> candidates;
+    std::vector<double> scores;
+    for (int y = row_begin; y < row_end; ++y) {
+      const double fy = (y + 0.5) * scale - 0.5;
+      const int cy0 = static_cast<int>(std::lround(fy));
+      for (int x = 0; x < W; ++x) {
+        const double fx = (x + 0.5) * scale - 0.5;
+        const int cx0 = static_cast<int>(std::lround(fx));
+        candidates.clear();
+        scores.clear();
+        const float front_depth = front ? front->depth_m.at(x, y) : 0.0f;
+        for (int dy = -r; dy <= r; ++dy) {
+          const int qy = cy0 + dy;
+          if (qy < 0 || qy >= sh) continue;
+          for (int dx = -r; dx <= r; ++dx) {
+            const int qx = WrapColumn(cx0 + dx, sw);
+            const int l = out.solve_label.at(qx, qy);
+            if (l < 0) continue;
+            const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
+            int lx, ly;
+            if (!layer.ToCrop(x, y, W, &lx, &ly)) continue;
+            const float d = layer.depth_m.at(lx, ly);
+            if (!(d > 0)) continue;
+            if (back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance)) continue;
+            double diff2 = 0;
+            for (int c = 0; c < 3; ++c) {
+              const double e = layer.rgb.at(lx, ly, c) - solve_rgb.at(qx, qy, c);
+              diff2 += e * e;
+            }
+            const double ddx = (cx0 + dx) - fx, ddy = qy - fy;
+            // Stretched fragments (depth-edge triangles) almost never win.
+            const double w = std::exp(-(ddx * ddx + ddy * ddy) * 0.5) *
+                             std::exp(-diff2 / 3.0 * inv_two_sigma2) *
+                             std::exp(-kUpsampleStretchWeight * layer.stretch.at(lx, ly));
+            auto it = std::find(candidates.begin(), candidates.end(), l);
+            if (it == candidates.end()) {
+              candidates.push_back(l);
+              scores.push_back(w + 1e-12);
+            } else {
+              scores[it - candidates.begin()] += w;
+            }
+          }
+        }
+        int best = -1;
+        double best_score = -1;
+        for (size_t i = 0; i < candidates.size(); ++i) {
+          if (scores[i] > best_score) {
+            best_score = scores[i];
+            best = candidates[i];
+          }
+        }
+        if (best < 0) {
+          // No nearby label reaches this pixel: take the least stretched warp.
+          float best_stretch = 2.0f;
+          for (int l = 0; l < L; ++l) {
+            const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
+            int lx, ly;
+            if (!layer.ToCrop(x, y, W, &lx, &ly)) continue;
+            const float d = layer.depth_m.at(lx, ly);
+            if (!(d > 0)) continue;
+            if (back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance)) continue;
+            if (layer.stretch.at(lx, ly) < best_stretch) {
+              best_stretch = layer.stretch.at(lx, ly);
+              best = l;
+            }
+          }
+          if (best < 0) continue;
+        }
+        const warp::WarpedLayer& layer = back ? full[best].back : full[best].front;
+        int lx, ly;
+        layer.ToCrop(x, y, W, &lx, &ly);
+        out.label.at(x, y) = static_cast<int16_t>(best);
+        out.depth_m.at(x, y) = layer.depth_m.at(lx, ly);
+        for (int c = 0; c < 3; ++c) out.rgb.at(x, y, c) = layer.rgb.at(lx, ly, c);
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace
+
+std::string StitchOptions::Check() const {
+  if (solve_width <= 0 || solve_height <= 0 || solve_width != 2 * solve_height) {
+    return "solve_width x solve_height: must be positive with width = 2 * height";
+  }
+  if (!(lambda_stretch >= 0 && lambda_parallax >= 0 && lambda_gc >= 0 &&
+        lambda_seam_color >= 0 && lambda_seam_depth >= 0 && lambda_seam_invalid >= 0)) {
+    return "lambda_*: must be >= 0";
+  }
+  if (!(parallax_scale_deg > 0)) return "parallax_scale_deg: must be > 0";
+  if (!(gc_depth_tolerance > 0 && gc_depth_tolerance < 1)) {
+    return "gc_depth_tolerance: must be in (0, 1)";
+  }
+  if (gc_min_support < 1) return "gc_min_support: must be >= 1";
+  if (!(seam_depth_scale > 0)) return "seam_depth_scale: must be > 0";
+  if (!(back_tolerance >= 0 && back_tolerance < 1)) return "back_tolerance: must be in [0, 1)";
+  if (upsample_radius < 0 || upsample_radius > 4) return "upsample_radius: must be in [0, 4]";
+  if (!(upsample_sigma_color > 0)) return "upsample_sigma_color: must be > 0";
+  return solver.Check();
+}
+
+StitchedLayer StitchFront(const std::vector<warp::WarpedView>& full,
+                          const std::vector<warp::WarpedView>& coarse,
+                          const std::vector<ViewGeometry>& views, int pano_width,
+                          const StitchOptions& options) {
+  return StitchLayer(false, full, coarse, views, pano_width, nullptr, options);
+}
+
+StitchedLayer StitchBack(const std::vector<warp::WarpedView>& full,
+                         const std::vector<warp::WarpedView>& coarse,
+                         const std::vector<ViewGeometry>& views, const StitchedLayer& front,
+                         const StitchOptions& options) {
+  if (front.depth_m.empty() || front.solve_depth_m.empty()) {
+    throw std::invalid_argument("stitch: the back stitch needs the stitched front layer");
+  }
+  return StitchLayer(true, full, coarse, views, front.depth_m.width(), &front, options);
+}
+
+}  // namespace casual3d::stitch

@@ -1,0 +1,96 @@
+#pragma once
+
+// Front and back layer stitching (paper Sec. 4.4.2).
+//
+// Every pixel of the panorama picks one source photo (a label) among the
+// photos' warps (reconstruct/warp). The labelling minimises an MRF energy by
+// alpha expansion at a reduced resolution (512x256 in the paper), and the
+// label map is then upsampled to the full resolution by an edge-aware vote.
+// The front panorama is stitched first; its depth constrains the back stitch.
+//
+// The paper's list of terms was lost from its text; the terms here are
+// (spec/stage-panorama.md gives the same with their reasons):
+// Data term of label a at pixel p (kInfiniteCost where a has no warp at p):
+//   lambda_stretch * s_a(p)                          stretched triangles (Eq. 6)
+// + lambda_parallax * min(angle_a(p) / parallax_scale_deg, 1)
+//       angle between the ray from the centre and the ray from photo a's
+//       camera to the same 3D point: smaller means colour and occlusion closer
+//       to what the centre sees
+// + lambda_gc * max(0, 1 - support_a(p) / gc_min_support)
+//       geometric consistency (Fig. 15): support is the number of other photos
+//       whose warp at p has a depth within gc_depth_tolerance of a's depth
+// + back only: kInfiniteCost if d_a(p) < front_depth(p) * (1 - back_tolerance):
+//       a back surface is never in front of the front surface.
+// Seam term between neighbours p, q with labels a != b:
+//   lambda_seam_color * (|c_a(p) - c_b(p)| + |c_a(q) - c_b(q)|) / (2 * 255)   (mean over RGB)
+// + lambda_seam_depth * min(1, (|log(d_a(p) / d_b(p))| + |log(d_a(q) / d_b(q))|) / (2 seam_depth_scale))
+//   and lambda_seam_invalid instead where a or b has no warp at p or q.
+
+#include <string>
+#include <vector>
+
+#include "format/equirect.h"
+#include "format/image.h"
+#include "reconstruct/stitch/alpha_expansion.h"
+#include "reconstruct/warp/warp.h"
+
+namespace casual3d::stitch {
+
+struct StitchOptions {
+  // Sec. 4.4.2: the labelling is solved at this size (width = 2 * height).
+  int solve_width = 512;
+  int solve_height = 256;
+
+  double lambda_stretch = 2.0;        // Cost per unit stretch penalty.
+  double lambda_parallax = 0.5;       // Cost at parallax_scale_deg and beyond.
+  double parallax_scale_deg = 10.0;   // Degrees; > 0.
+  double lambda_gc = 1.0;             // Cost of a pixel with no support; 0 disables GC.
+  double gc_depth_tolerance = 0.03;   // Relative depth agreement for support; (0, 1).
+  int gc_min_support = 2;             // Supporting photos for zero GC cost; >= 1.
+  double lambda_seam_color = 1.0;     // Seam cost per unit mean absolute colour difference.
+  double lambda_seam_depth = 1.0;     // Seam cost of a depth step of seam_depth_scale or more.
+  double seam_depth_scale = 0.05;     // Relative depth step that costs lambda_seam_depth; > 0.
+  double lambda_seam_invalid = 4.0;   // Seam next to a pixel one label cannot show.
+  double back_tolerance = 0.02;       // Back may be this much (relative) in front of the front.
+
+  // Upsampling of labels: a full-resolution pixel chooses among the labels of
+  // the (2 r + 1)^2 solve-resolution pixels around it.
+  int upsample_radius = 1;
+  double upsample_sigma_color = 20.0;  // 8-bit colour units; > 0.
+
+  AlphaExpansionOptions solver;
+
+  std::string Check() const;
+};
+
+// One stitched layer at full resolution.
+struct StitchedLayer {
+  Image8 rgb;           // 3 channels.
+  ImageF depth_m;       // Distance from the centre along the ray; 0 where empty.
+  Image<int16_t> label; // Source photo index, -1 where empty.
+  // The labelling at the solve resolution and its energy (for diagnostics).
+  Image<int16_t> solve_label;
+  ImageF solve_depth_m;  // Depth of the labelling at the solve resolution.
+  double energy = 0.0;
+};
+
+// Where each photo's camera is, in the panorama frame.
+struct ViewGeometry {
+  Vec3d centre;  // Camera centre, panorama frame, metres.
+};
+
+// Stitches the front layer. `full` are the photos' warps at the output size,
+// `coarse` the same photos warped at the solve size (same order).
+StitchedLayer StitchFront(const std::vector<warp::WarpedView>& full,
+                          const std::vector<warp::WarpedView>& coarse,
+                          const std::vector<ViewGeometry>& views, int pano_width,
+                          const StitchOptions& options);
+
+// Stitches the back layer from the photos' back warps, constrained by the
+// stitched front layer (the same output size).
+StitchedLayer StitchBack(const std::vector<warp::WarpedView>& full,
+                         const std::vector<warp::WarpedView>& coarse,
+                         const std::vector<ViewGeometry>& views, const StitchedLayer& front,
+                         const StitchOptions& options);
+
+}  // namespace casual3d::stitch

@@ -1,0 +1,113 @@
+#include "reconstruct/stitch/stitch.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "reconstruct/warp/test_scene.h"
+
+namespace casual3d::stitch {
+namespace {
+
+namespace wt = warp::testing;
+
+struct Capture {
+  std::vector<Image8> rgb;
+  std::vector<ImageF> depth;
+  std::vector<warp::SourceView> views;
+  std::vector<ViewGeometry> geometry;
+};
+
+// Four cameras on a small cross around the centre, all looking forward.
+Capture MakeCapture(const wt::SquareScene& scene) {
+  const Eigen::Vector3d centres[] = {{0.15, 0, 0}, {-0.15, 0, 0}, {0, 0.15, 0}, {0, -0.15, 0}};
+  Capture cap;
+  cap.rgb.resize(4);
+  cap.depth.resize(4);
+  for (int i = 0; i < 4; ++i) {
+    const geometry::Camera cam = wt::MakeCamera(320, 240, 70.0);
+    const geometry::Pose pose = wt::ForwardPose(centres[i]);
+    wt::RenderSquareScene(scene, cam, pose, &cap.depth[i], &cap.rgb[i]);
+    cap.geometry.push_back({{centres[i].x(), centres[i].y(), centres[i].z()}});
+  }
+  for (int i = 0; i < 4; ++i) {
+    cap.views.push_back({&cap.rgb[i], &cap.depth[i], wt::MakeCamera(320, 240, 70.0),
+                         wt::ForwardPose(centres[i])});
+  }
+  return cap;
+}
+
+std::vector<warp::WarpedView> Warp(const Capture& cap, int width) {
+  warp::WarpOptions options;
+  options.pano_width = width;
+  options.pano_height = width / 2;
+  return warp::WarpViews(cap.views, PanoramaFrame(), options, 2);
+}
+
+TEST(StitchTest, FrontAndBackLayersMatchTheScene) {
+  wt::SquareScene scene;
+  Capture cap = MakeCapture(scene);
+  // A floater in photo 0: a blob of wrong, near depth on the background.
+  for (int y = 30; y < 60; ++y)
+    for (int x = 250; x < 290; ++x) cap.depth[0].at(x, y) *= 0.5f;
+
+  StitchOptions options;
+  options.solve_width = 256;
+  options.solve_height = 128;
+  const int W = 1024;
+  const auto full = Warp(cap, W);
+  const auto coarse = Warp(cap, options.solve_width);
+  const StitchedLayer front = StitchFront(full, coarse, cap.geometry, W, options);
+  const StitchedLayer back = StitchBack(full, coarse, cap.geometry, front, options);
+
+  // Front: within the photos' common field of view, the depth is the true
+  // first surface almost everywhere (the floater is rejected by GC).
+  int checked = 0, good = 0, floater = 0;
+  int behind = 0, behind_ok = 0;
+  for (int y = 200; y < 312; ++y) {
+    for (int x = 420; x < 604; ++x) {
+      const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, W, W / 2);
+      const double truth = wt::SquareSceneRadialDepth(scene, d);
+      // Skip pixels within 1.5 pixels of a true depth edge (sampling ambiguity).
+      bool edge = false;
+      for (double oy : {-1.5, 1.5})
+        for (double ox : {-1.5, 1.5}) {
+          const Vec3d e = EquirectPixelToDirection(x + 0.5 + ox, y + 0.5 + oy, W, W / 2);
+          edge |= std::abs(wt::SquareSceneRadialDepth(scene, e) - truth) > 0.1 * truth;
+        }
+      if (edge) continue;
+      const float est = front.depth_m.at(x, y);
+      ASSERT_GT(est, 0) << x << "," << y;
+      ++checked;
+      if (std::abs(est - truth) < 0.01 * truth) ++good;
+      if (est < 0.85 * truth) ++floater;
+      // Back: where the front is the square, the back is the plane wherever
+      // some photo saw behind the square's edge.
+      if (truth < 2.0 && back.depth_m.at(x, y) > 0) {
+        ++behind;
+        if (back.depth_m.at(x, y) > 3.5f) ++behind_ok;
+      }
+      if (back.depth_m.at(x, y) > 0) {
+        EXPECT_GE(back.depth_m.at(x, y), est * 0.97f) << "back in front of front at " << x << "," << y;
+      }
+    }
+  }
+  EXPECT_GT(good, checked * 97 / 100);
+  EXPECT_EQ(floater, 0);
+  EXPECT_GT(behind_ok, 200);
+  EXPECT_EQ(front.label.width(), W);
+  EXPECT_GE(front.energy, 0.0);
+}
+
+TEST(StitchTest, OptionsAreChecked) {
+  StitchOptions options;
+  EXPECT_EQ(options.Check(), "");
+  options.solve_width = 300;
+  EXPECT_NE(options.Check(), "");
+  options = StitchOptions();
+  options.gc_depth_tolerance = 0;
+  EXPECT_NE(options.Check(), "");
+}
+
+}  // namespace
+}  // namespace casual3d::stitch

@@ -1,0 +1,144 @@
+#include "reconstruct/synth/rig.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "reconstruct/synth/procedural_texture.h"
+
+namespace casual3d::synth {
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+// Unit direction for yaw (about +Y, 0 = -Z, positive to the right, +X) and pitch (up).
+Eigen::Vector3d Direction(double yaw_rad, double pitch_rad) {
+  return {std::cos(pitch_rad) * std::sin(yaw_rad), std::sin(pitch_rad),
+          -std::cos(pitch_rad) * std::cos(yaw_rad)};
+}
+
+// World-to-camera pose for a camera at `centre` looking along `forward` with
+// image rows going down (world -Y) and no roll (camera: X right, Y down, Z forward).
+geometry::Pose LookAlong(const Eigen::Vector3d& centre, const Eigen::Vector3d& forward) {
+  const Eigen::Vector3d z = forward.normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitY()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d cam_to_world;
+  cam_to_world.col(0) = x;
+  cam_to_world.col(1) = y;
+  cam_to_world.col(2) = z;
+  geometry::Pose pose;
+  const Eigen::Matrix3d R = cam_to_world.transpose();
+  pose.rotation = Eigen::Quaterniond(R).normalized();
+  pose.translation = -(R * centre);
+  return pose;
+}
+
+}  // namespace
+
+bool RigKindFromName(const std::string& name, RigKind* kind) {
+  if (name == "partial") {
+    *kind = RigKind::kPartial;
+    return true;
+  }
+  if (name == "sphere") {
+    *kind = RigKind::kSphere;
+    return true;
+  }
+  return false;
+}
+
+const char* RigKindName(RigKind kind) { return kind == RigKind::kSphere ? "sphere" : "partial"; }
+
+RigOptions RigOptions::Defaults(RigKind kind) {
+  RigOptions o;
+  o.kind = kind;
+  if (kind == RigKind::kSphere) {
+    o.num_photos = 50;
+    o.fov_x_deg = 110.0;
+  }
+  return o;
+}
+
+std::string RigOptions::Check() const {
+  if (width < 16 || width > 16384) return "width " + std::to_string(width) + " is outside 16..16384";
+  if (height < 16 || height > 16384) {
+    return "height " + std::to_string(height) + " is outside 16..16384";
+  }
+  if (num_photos < 2 || num_photos > 1000) {
+    return "photos " + std::to_string(num_photos) + " is outside 2..1000";
+  }
+  if (!(fov_x_deg > 10.0 && fov_x_deg < 150.0)) return "fov_x_deg must be in (10, 150)";
+  if (!(radius_m >= 0.0 && radius_m <= 2.0)) return "radius_m must be in [0, 2]";
+  if (!(yaw_span_deg >= 0.0 && yaw_span_deg <= 180.0)) return "yaw_span_deg must be in [0, 180]";
+  if (!(pitch_span_deg >= 0.0 && pitch_span_deg <= 120.0)) {
+    return "pitch_span_deg must be in [0, 120]";
+  }
+  if (!(ring_pitch_deg >= 0.0 && ring_pitch_deg <= 60.0)) return "ring_pitch_deg must be in [0, 60]";
+  if (!(jitter_deg >= 0.0 && jitter_deg <= 10.0)) return "jitter_deg must be in [0, 10]";
+  if (!(jitter_m >= 0.0 && jitter_m <= 0.2)) return "jitter_m must be in [0, 0.2]";
+  return "";
+}
+
+Rig MakeRig(const RigOptions& options, const Eigen::Vector3d& centre) {
+  Rig rig;
+  rig.camera.camera_id = 1;
+  rig.camera.model = geometry::CameraModelId::kPinhole;
+  rig.camera.width = options.width;
+  rig.camera.height = options.height;
+  const double f = 0.5 * options.width / std::tan(0.5 * options.fov_x_deg * kDeg);
+  rig.camera.params = {f, f, 0.5 * options.width, 0.5 * options.height};
+
+  // Nominal viewing directions (yaw, pitch) in capture order.
+  std::vector<std::pair<double, double>> directions;
+  const int n = options.num_photos;
+  if (options.kind == RigKind::kPartial) {
+    // A grid about as wide as tall (4 x 4 for 16 photos), swept row by row in
+    // a serpentine as a person would.
+    const int cols = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n)) - 1e-9)));
+    const int rows = (n + cols - 1) / cols;
+    for (int r = 0; r < rows && static_cast<int>(directions.size()) < n; ++r) {
+      const double pitch =
+          rows > 1 ? (0.5 - static_cast<double>(r) / (rows - 1)) * options.pitch_span_deg : 0.0;
+      for (int k = 0; k < cols && static_cast<int>(directions.size()) < n; ++k) {
+        const int c = (r % 2 == 0) ? k : cols - 1 - k;
+        const double yaw =
+            cols > 1 ? (static_cast<double>(c) / (cols - 1) - 0.5) * options.yaw_span_deg : 0.0;
+        directions.emplace_back(yaw, pitch);
+      }
+    }
+  } else {
+    // Two rings; the lower ring is offset by half a step for even coverage.
+    const int upper = (n + 1) / 2, lower = n - upper;
+    for (int i = 0; i < upper; ++i) directions.emplace_back(360.0 * i / upper, options.ring_pitch_deg);
+    for (int i = 0; i < lower; ++i) {
+      directions.emplace_back(360.0 * (i + 0.5) / lower, -options.ring_pitch_deg);
+    }
+  }
+
+  for (int i = 0; i < n; ++i) {
+    const double yaw = directions[i].first * kDeg, pitch = directions[i].second * kDeg;
+    const Eigen::Vector3d radial = Direction(yaw, pitch);
+    // Hand-held jitter: a small random rotation of the viewing direction and
+    // a roll, and a small offset of the centre.
+    auto normal = [&](int k) {
+      return HashToNormal(Hash(options.seed, 0x816, i, 2 * k), Hash(options.seed, 0x816, i, 2 * k + 1));
+    };
+    const double jr = options.jitter_deg * kDeg;
+    const Eigen::Vector3d forward = Direction(yaw + jr * normal(0), pitch + jr * normal(1));
+    const Eigen::Vector3d offset =
+        options.jitter_m * Eigen::Vector3d(normal(2), normal(3), normal(4));
+    const Eigen::Vector3d c = centre + options.radius_m * radial + offset;
+    geometry::Pose pose = LookAlong(c, forward);
+    // Roll about the optical axis (camera Z).
+    const Eigen::Matrix3d roll =
+        Eigen::AngleAxisd(jr * normal(5), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3d R = roll * pose.R();
+    pose.rotation = Eigen::Quaterniond(R).normalized();
+    pose.translation = -(R * c);
+    rig.poses.push_back(pose);
+  }
+  return rig;
+}
+
+}  // namespace casual3d::synth

@@ -1,0 +1,60 @@
+#pragma once
+
+// Capture rigs: where the photos of a synthetic capture are taken from.
+//   partial: a phone held at arm's length and swept over a grid (about 4 x 4)
+//     of directions in front of the user: camera centres on a sphere of
+//     `radius_m` around the rig centre, each camera looking outwards along its
+//     radius, so the grid spans about +-27 degrees of yaw and +-18 of pitch
+//     around forward (-Z); 65 degrees horizontal field of view by default.
+//   sphere: a DSLR turned on a monopod: two rings (pitched up and down by
+//     `ring_pitch_deg`) of photos all around, 110 degrees horizontal field of
+//     view by default, full 360 degree coverage.
+// Both add a small hand-held jitter (seeded) to every orientation and position.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "reconstruct/geometry/camera.h"
+#include "reconstruct/geometry/pose.h"
+
+namespace casual3d::synth {
+
+enum class RigKind { kPartial, kSphere };
+
+// "partial" / "sphere"; false for anything else.
+bool RigKindFromName(const std::string& name, RigKind* kind);
+const char* RigKindName(RigKind kind);
+
+struct RigOptions {
+  RigKind kind = RigKind::kPartial;
+  int width = 1152;          // Photo width, pixels.
+  int height = 864;          // Photo height, pixels.
+  int num_photos = 16;       // > 0; partial: 16 (4 x 4), sphere: 50 (2 x 25).
+  double fov_x_deg = 65.0;   // Horizontal field of view, degrees, (10, 150).
+  double radius_m = 0.3;     // Camera centres' distance from the rig centre, metres, [0, 2].
+  double yaw_span_deg = 54.0;    // partial: yaw range of the grid, degrees.
+  double pitch_span_deg = 36.0;  // partial: pitch range of the grid, degrees.
+  double ring_pitch_deg = 22.0;  // sphere: pitch of the upper (+) and lower (-) ring, degrees.
+  double jitter_deg = 1.0;   // Hand-held rotation jitter (standard deviation), degrees.
+  double jitter_m = 0.01;    // Hand-held position jitter (standard deviation), metres.
+  uint64_t seed = 1;
+
+  // The defaults of a rig kind (size, photo count, field of view).
+  static RigOptions Defaults(RigKind kind);
+  // Empty if valid; otherwise names the field and its valid range.
+  std::string Check() const;
+};
+
+struct Rig {
+  geometry::Camera camera;            // PINHOLE, shared by all photos (camera_id 1).
+  std::vector<geometry::Pose> poses;  // World to camera, in capture order.
+};
+
+// Lays out the rig around `centre` (world, metres); world +Y is up and the rig
+// faces world -Z. Precondition: options.Check() is empty.
+Rig MakeRig(const RigOptions& options, const Eigen::Vector3d& centre);
+
+}  // namespace casual3d::synth

@@ -1,0 +1,255 @@
+#include "reconstruct/synth/synth.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "encoder/master_file.h"
+#include "reconstruct/geometry/colmap_model.h"
+#include "reconstruct/io/exr_io.h"
+#include "reconstruct/io/file_util.h"
+#include "reconstruct/io/image_io.h"
+#include "reconstruct/synth/default_scene.h"
+#include "reconstruct/synth/ground_truth_panorama.h"
+#include "reconstruct/synth/ground_truth_two_layer.h"
+#include "reconstruct/synth/procedural_texture.h"
+#include "reconstruct/synth/render_photo.h"
+#include "reconstruct/synth/sparse_points.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::synth {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+std::string PhotoName(int i) {
+  char buf[16];
+  std::snprintf(buf, sizeof(buf), "%04d", i);
+  return buf;
+}
+
+void UpdateRange(const ImageF& image, int channel, double* lo, double* hi) {
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      const float v = image.at(x, y, channel);
+      if (std::isfinite(v) && v > 0) {
+        *lo = std::min(*lo, static_cast<double>(v));
+        *hi = std::max(*hi, static_cast<double>(v));
+      }
+    }
+}
+
+}  // namespace
+
+RigOptions SynthOptions::ResolvedRig() const {
+  RigOptions r = RigOptions::Defaults(rig);
+  if (width > 0) r.width = width;
+  r.height = height > 0 ? height : (width > 0 ? width * 3 / 4 : r.height);
+  if (num_photos > 0) r.num_photos = num_photos;
+  r.seed = seed;
+  return r;
+}
+
+std::string SynthOptions::Check() const {
+  if (width != 0 && (width < 16 || width > 16384)) {
+    return "--width " + std::to_string(width) + " is outside 16..16384";
+  }
+  if (height != 0 && (height < 16 || height > 16384)) {
+    return "--height " + std::to_string(height) + " is outside 16..16384";
+  }
+  if (num_photos != 0 && (num_photos < 2 || num_photos > 1000)) {
+    return "--photos " + std::to_string(num_photos) + " is outside 2..1000";
+  }
+  if (!(noise_sigma >= 0 && noise_sigma <= 50)) return "--noise must be in [0, 50] (8-bit code values)";
+  if (!(exposure_jitter_stops >= 0 && exposure_jitter_stops <= 3)) {
+    return "--exposure-jitter must be in [0, 3] stops";
+  }
+  if (!(moving_step_m >= 0 && moving_step_m <= 0.2)) return "moving_step_m must be in [0, 0.2] metres";
+  if (panorama_width < 16 || panorama_width > 16384 || panorama_width % 2 != 0) {
+    return "--panorama-width " + std::to_string(panorama_width) + " must be even and in 16..16384";
+  }
+  if (jpeg_quality < 1 || jpeg_quality > 100) {
+    return "--jpeg-quality " + std::to_string(jpeg_quality) + " is outside 1..100";
+  }
+  if (num_threads < 0) return "--threads must be >= 0";
+  RenderOptions render;
+  render.edge_samples = edge_samples;
+  if (std::string why = render.Check(); !why.empty()) return why;
+  SparsePointOptions sparse;
+  sparse.step_px = sparse_step_px;
+  if (std::string why = sparse.Check(); !why.empty()) return why;
+  return ResolvedRig().Check();
+}
+
+CaptureSummary GenerateCapture(const SynthOptions& options, const std::string& dir) {
+  if (std::string why = options.Check(); !why.empty()) throw std::invalid_argument(why);
+  const Clock::time_point start = Clock::now();
+  const RigOptions rig_options = options.ResolvedRig();
+  const Eigen::Vector3d centre = DefaultRigCentre();
+  const Rig rig = MakeRig(rig_options, centre);
+  const Scene scene = BuildDefaultScene(options.seed);
+  const int n = rig_options.num_photos;
+
+  io::CreateDirectories(dir);
+  for (const char* sub : {"images", "depth", "sparse", "ground_truth"}) {
+    io::CreateDirectories(dir + "/" + sub);
+  }
+
+  CaptureSummary summary;
+  summary.num_photos = n;
+  summary.width = rig.camera.width;
+  summary.height = rig.camera.height;
+  double depth_lo = std::numeric_limits<double>::infinity(), depth_hi = 0;
+
+  // Photos and their depth maps.
+  RenderOptions render;
+  render.edge_samples = options.edge_samples;
+  render.num_threads = options.num_threads;
+  std::vector<Scene> scenes;
+  std::vector<std::string> names;
+  std::vector<double> exposures;
+  std::vector<Eigen::Vector3d> offsets;
+  const Clock::time_point photos_start = Clock::now();
+  {
+    util::Progress progress("synth: rendering photos", n);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d offset =
+          options.moving_object ? Eigen::Vector3d(options.moving_step_m * i, 0, 0)
+                                : Eigen::Vector3d::Zero();
+      scenes.push_back(scene.Displaced(offset));
+      offsets.push_back(offset);
+      const PhotoRender r = RenderPhoto(scenes.back(), rig.camera, rig.poses[i], render);
+      DevelopOptions develop;
+      const double u = HashToUnit(Hash(options.seed, 0xE4905E, i));
+      develop.exposure = std::exp2(options.exposure_jitter_stops * (2.0 * u - 1.0));
+      develop.noise_sigma = options.noise_sigma;
+      develop.seed = Hash(options.seed, 0x401, i);
+      exposures.push_back(develop.exposure);
+      const Image8 photo = Develop(r.radiance, develop);
+      names.push_back(PhotoName(i) + ".jpg");
+      io::WriteJpeg(dir + "/images/" + names.back(), photo.view(), {options.jpeg_quality});
+      io::WriteExr(dir + "/depth/" + PhotoName(i) + ".exr", r.depth_m.view(), {"Z"});
+      UpdateRange(r.depth_m, 0, &depth_lo, &depth_hi);
+      progress.Advance();
+    }
+  }
+  summary.seconds_photos = Seconds(photos_start);
+
+  // Ground-truth sparse model.
+  SparsePointOptions sparse;
+  sparse.step_px = options.sparse_step_px;
+  sparse.seed = options.seed;
+  sparse.num_threads = options.num_threads;
+  const geometry::SparseModel model = MakeGroundTruthModel(scenes, rig, names, sparse);
+  geometry::WriteModelText(model, dir + "/sparse");
+  geometry::WriteModelBinary(model, dir + "/sparse");
+  summary.num_points = model.points.size();
+  size_t observations = 0;
+  for (const auto& [id, p] : model.points) observations += p.track.size();
+  summary.mean_track_length =
+      model.points.empty() ? 0.0 : static_cast<double>(observations) / model.points.size();
+
+  // Ground-truth panorama from the rig centre (panorama frame = world axes).
+  const Clock::time_point pano_start = Clock::now();
+  PanoramaFrame frame;
+  for (int k = 0; k < 3; ++k) frame.centre[k] = centre[k];
+  const int pano_w = options.panorama_width, pano_h = options.panorama_width / 2;
+  const GroundTruthPanorama gt =
+      RenderGroundTruthPanorama(scenes.front(), frame, pano_w, pano_h, options.num_threads);
+  {
+    const auto& channel_names = PanoramaChannelNames();
+    io::ExrWriteOptions exr;
+    exr.num_threads = options.num_threads;
+    // Depths exactly (float); colours and normals as half floats (enough for
+    // 8-bit colour and normals to ~1e-3).
+    for (int c = 0; c < kNumPanoramaChannels; ++c) {
+      exr.channel_types.push_back(c == kFrontZ || c == kBackZ ? io::ExrPixelType::kFloat
+                                                              : io::ExrPixelType::kHalf);
+    }
+    io::WriteExr(dir + "/ground_truth/panorama.exr", gt.pixels.view(),
+                 std::vector<std::string>(channel_names.begin(), channel_names.end()), exr);
+  }
+  double pano_lo = std::numeric_limits<double>::infinity(), pano_hi = 0;
+  UpdateRange(gt.pixels, kFrontZ, &pano_lo, &pano_hi);
+  TwoLayerOptions two_layer_options;
+  if (options.write_master) {
+    const TwoLayerPanorama two_layer = GroundTruthToTwoLayer(gt, two_layer_options);
+    const Status status =
+        encoder::WriteMasterFile(two_layer, dir + "/ground_truth/master.exr");
+    if (!status.ok()) throw std::runtime_error(status.ToString());
+    summary.wrote_master = true;
+  }
+  summary.seconds_panorama = Seconds(pano_start);
+  summary.panorama_width = pano_w;
+  summary.panorama_height = pano_h;
+  summary.depth_min_m = std::min(depth_lo, pano_lo);
+  summary.depth_max_m = std::max(depth_hi, pano_hi);
+
+  // capture.json: everything a later stage needs to know (no timings, so that
+  // the bytes are reproducible).
+  nlohmann::ordered_json j;
+  j["format"] = "casual3d-capture";
+  j["version"] = "1.0";
+  j["generator"] = "casual3d synth";
+  j["scene"] = {{"name", "default"},
+                {"depth_min_m", summary.depth_min_m},
+                {"depth_max_m", summary.depth_max_m},
+                {"panorama_depth_min_m", pano_lo},
+                {"panorama_depth_max_m", pano_hi},
+                {"sky_depth", "inf"},
+                {"up", {0, 1, 0}},
+                {"ground_plane_y_m", 0.0}};
+  j["rig"] = RigKindName(rig_options.kind);
+  j["seed"] = options.seed;
+  j["options"] = {{"width", rig_options.width},
+                  {"height", rig_options.height},
+                  {"photos", n},
+                  {"fov_x_deg", rig_options.fov_x_deg},
+                  {"radius_m", rig_options.radius_m},
+                  {"noise_sigma", options.noise_sigma},
+                  {"exposure_jitter_stops", options.exposure_jitter_stops},
+                  {"moving_object", options.moving_object},
+                  {"moving_step_m", options.moving_step_m},
+                  {"panorama_width", pano_w},
+                  {"panorama_height", pano_h},
+                  {"jpeg_quality", options.jpeg_quality},
+                  {"edge_samples", options.edge_samples},
+                  {"sparse_step_px", options.sparse_step_px}};
+  j["camera"] = {{"model", "PINHOLE"},
+                 {"width", rig.camera.width},
+                 {"height", rig.camera.height},
+                 {"params", rig.camera.params}};
+  j["panorama_frame"] = {{"centre", {frame.centre[0], frame.centre[1], frame.centre[2]}},
+                         {"rotation", std::vector<double>(frame.rotation, frame.rotation + 9)}};
+  j["ground_truth"] = {{"panorama", "ground_truth/panorama.exr"},
+                       {"master", options.write_master ? "ground_truth/master.exr" : ""},
+                       {"two_layer_sky_depth_m",
+                        std::max(two_layer_options.sky_depth_m, 2.0 * pano_hi)},
+                       {"tau_dratio", two_layer_options.tau_dratio},
+                       {"link_ratio", two_layer_options.link_ratio}};
+  nlohmann::ordered_json photos = nlohmann::ordered_json::array();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d c = rig.poses[i].Center();
+    photos.push_back({{"name", names[i]},
+                      {"image_id", i + 1},
+                      {"depth", "depth/" + PhotoName(i) + ".exr"},
+                      {"centre", {c.x(), c.y(), c.z()}},
+                      {"exposure", exposures[i]},
+                      {"moving_object_offset_m", {offsets[i].x(), offsets[i].y(), offsets[i].z()}}});
+  }
+  j["photos"] = photos;
+  j["sparse_points"] = summary.num_points;
+  io::WriteFileAtomic(dir + "/capture.json", j.dump(2) + "\n");
+  summary.seconds_total = Seconds(start);
+  return summary;
+}
+
+}  // namespace casual3d::synth

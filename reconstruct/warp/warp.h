@@ -1,0 +1,84 @@
+#pragma once
+
+// Front and back surface warping (paper Sec. 4.4.1).
+//
+// Each photo's depth map is triangulated into a grid mesh (vertices at pixel
+// centres) and rasterized into the central equirectangular panorama of the 3D
+// photo (format/equirect.h). Two depth tests run in one pass:
+//   front: keeps the fragment with the smallest z' = (z + s) / 2,
+//   back:  keeps the fragment with the smallest z'' = (1 - z + s) / 2,
+// where z in [0, 1] grows with the distance from the panorama centre and
+// s in [0, 1] is the stretch penalty of Eq. 6, s = 1 - min(alpha / tau_stretch, 1),
+// with alpha the grazing angle between the triangle and the ray from the
+// photo's own camera. The paper writes the back test as z'' = 1 - z'; applied
+// literally that would prefer the most stretched triangles, so the back test
+// here inverts only the depth and keeps the stretch penalty (spec/stage-panorama.md).
+//
+// Outputs are cropped to the columns and rows the photo covers, so that many
+// photos fit in memory at 8192x4096.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "format/equirect.h"
+#include "format/image.h"
+#include "reconstruct/geometry/camera.h"
+#include "reconstruct/geometry/pose.h"
+
+namespace casual3d::warp {
+
+struct WarpOptions {
+  // Panorama size in pixels; width must be 2 * height (equirectangular).
+  int pano_width = 4096;
+  int pano_height = 2048;
+  // Sec. 4.4.1: grazing angle below which a triangle counts as stretched, degrees.
+  double tau_stretch_deg = 1.66;
+  // Depth normalisation: z = 1 - near_m / r, clamped to [0, 1]; metres, > 0.
+  double near_m = 0.05;
+  // Triangles whose projection spans more than this fraction of the panorama
+  // width are dropped (they wrap around a pole); (0, 0.5].
+  double max_triangle_width_fraction = 0.125;
+
+  // Returns an empty string if valid, else "field value: reason".
+  std::string Check() const;
+};
+
+// One photo with its depth map. The camera must be undistorted (pinhole part
+// is used); depth is metres along the optical axis, same size as the image or
+// a uniformly scaled version of it; non-finite or <= 0 depth means "no depth".
+struct SourceView {
+  const Image8* rgb = nullptr;      // 3 channels, sRGB.
+  const ImageF* depth_m = nullptr;  // 1 channel.
+  geometry::Camera camera;
+  geometry::Pose pose;  // World to camera.
+};
+
+// One warped layer of one photo, cropped. Panorama pixel (x, y) with
+// x = WrapColumn(x0 + cx), y = y0 + cy is stored at crop pixel (cx, cy).
+struct WarpedLayer {
+  int x0 = 0;  // First column (may be any value in [0, pano_width)).
+  int y0 = 0;  // First row.
+  Image8 rgb;       // 3 channels; valid where depth_m > 0.
+  ImageF depth_m;   // Distance from the panorama centre along the ray; 0 = empty.
+  ImageF stretch;   // Stretch penalty s in [0, 1] of the winning fragment.
+
+  int width() const { return depth_m.width(); }
+  int height() const { return depth_m.height(); }
+  // Crop coordinates of panorama pixel (x, y); false if outside the crop.
+  bool ToCrop(int x, int y, int pano_width, int* cx, int* cy) const;
+};
+
+struct WarpedView {
+  WarpedLayer front;
+  WarpedLayer back;
+};
+
+// Warps one view. Throws std::invalid_argument on invalid options or inputs.
+WarpedView WarpView(const SourceView& view, const PanoramaFrame& frame, const WarpOptions& options);
+
+// Warps all views on `num_threads` threads (0: all cores).
+std::vector<WarpedView> WarpViews(const std::vector<SourceView>& views, const PanoramaFrame& frame,
+                                  const WarpOptions& options, int num_threads = 0);
+
+}  // namespace casual3d::warp

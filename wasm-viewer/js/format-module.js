@@ -1,0 +1,193 @@
+// JavaScript face of the format library compiled to WebAssembly
+// (casual3d-format.wasm, src/binding.cc). Works in browsers, workers and Node.
+//
+//   const format = await FormatModule.create();            // browser / worker
+//   const format = await FormatModule.create({ wasmBinary }); // Node: the bytes
+//   const pano = format.parsePanoramaBlob(bytes);
+//   const mesh = format.buildMesh(pano, { maxTriangles: 0 });  // copies out
+//   pano.free();
+//
+// Every failure throws an Error with the library's message.
+
+import createCasual3dFormat from './casual3d-format.js';
+
+/** Copies `count` elements of a typed-array type out of the wasm heap. */
+function copyOut(module, Type, ptr, count) {
+  if (count === 0) return new Type(0);
+  const view = new Type(module.HEAPU8.buffer, ptr, count);
+  return view.slice();
+}
+
+export class FormatModule {
+  constructor(module) {
+    this.m = module;
+  }
+
+  /** Instantiates the wasm module; `options` go to the Emscripten factory. */
+  static async create(options = {}) {
+    return new FormatModule(await createCasual3dFormat(options));
+  }
+
+  /** The library's last error; `what` prefixes messages that do not name their input. */
+  _error(what) {
+    const message = this.m.UTF8ToString(this.m._c3d_last_error());
+    return new Error(what ? `${what}: ${message}` : message);
+  }
+
+  /** Copies bytes into a fresh heap allocation; the caller frees the pointer. */
+  _copyIn(bytes) {
+    const ptr = this.m._malloc(Math.max(1, bytes.length));
+    if (!ptr) throw new Error(`out of memory for ${bytes.length} bytes`);
+    this.m.HEAPU8.set(bytes, ptr);
+    return ptr;
+  }
+
+  _string(s) {
+    const n = this.m.lengthBytesUTF8(s) + 1;
+    const ptr = this.m._malloc(n);
+    this.m.stringToUTF8(s, ptr, n);
+    return ptr;
+  }
+
+  /** A Panorama from a panorama blob (src/panorama_blob.h). */
+  parsePanoramaBlob(bytes) {
+    const ptr = this._copyIn(bytes);
+    try {
+      const p = this.m._c3d_panorama_parse_blob(ptr, bytes.length);
+      if (!p) throw this._error('panorama blob');
+      return new Panorama(this, p);
+    } finally {
+      this.m._free(ptr);
+    }
+  }
+
+  /**
+   * Builds the mesh of a panorama. maxTriangles 0: the full mesh of spec/mesh.md;
+   * > 0: simplified to that budget with the largest relative depth error
+   * maxRelativeError (0: the library's default). Returns plain typed arrays:
+   * {positions, normals, uvs, colors, indices, maxRelativeError}.
+   */
+  buildMesh(pano, { maxTriangles = 0, maxRelativeError = 0 } = {}) {
+    const m = this.m;
+    const handle = m._c3d_build_mesh(pano.ptr, maxTriangles, maxRelativeError);
+    if (!handle) throw this._error('mesh');
+    try {
+      const nv = m._c3d_mesh_num_vertices(handle);
+      const ni = m._c3d_mesh_num_indices(handle);
+      return {
+        positions: copyOut(m, Float32Array, m._c3d_mesh_positions(handle), nv * 3),
+        normals: copyOut(m, Float32Array, m._c3d_mesh_normals(handle), nv * 3),
+        uvs: copyOut(m, Float32Array, m._c3d_mesh_uvs(handle), nv * 2),
+        colors: copyOut(m, Uint8Array, m._c3d_mesh_colors(handle), nv * 3),
+        indices: copyOut(m, Uint32Array, m._c3d_mesh_indices(handle), ni),
+        maxRelativeError: m._c3d_mesh_max_error(handle),
+      };
+    } finally {
+      m._c3d_mesh_free(handle);
+    }
+  }
+
+  /** Opens a package from the bytes of its manifest.json. */
+  openPackage(manifestBytes) {
+    const ptr = this._copyIn(manifestBytes);
+    try {
+      const r = this.m._c3d_reader_open(ptr, manifestBytes.length);
+      if (!r) throw this._error();
+      return new PackageReader(this, r);
+    } finally {
+      this.m._free(ptr);
+    }
+  }
+}
+
+/** A two-layer panorama living in the wasm heap. Call free() when done. */
+export class Panorama {
+  constructor(format, ptr) {
+    this.format = format;
+    this.ptr = ptr;
+  }
+
+  get width() {
+    return this.format.m._c3d_panorama_width(this.ptr);
+  }
+
+  get height() {
+    return this.format.m._c3d_panorama_height(this.ptr);
+  }
+
+  /** Throws if TwoLayerPanorama::Validate() fails. */
+  validate() {
+    if (!this.format.m._c3d_panorama_validate(this.ptr)) throw this.format._error('panorama');
+  }
+
+  /** The colour atlas: {width, height: 2 * panorama height, data: RGBA Uint8Array}. */
+  atlas() {
+    const m = this.format.m;
+    const w = this.width, h = this.height;
+    const ptr = m._c3d_panorama_atlas_rgba(this.ptr);
+    return { width: w, height: 2 * h, data: copyOut(m, Uint8Array, ptr, w * h * 2 * 4) };
+  }
+
+  free() {
+    if (this.ptr) this.format.m._c3d_panorama_free(this.ptr);
+    this.ptr = 0;
+  }
+}
+
+/** A package being read level by level (format/manifest.h, format/tile_codec.h). */
+export class PackageReader {
+  constructor(format, ptr) {
+    this.format = format;
+    this.ptr = ptr;
+  }
+
+  /** Number of levels; level 0 is the finest, the last the coarsest. */
+  get numLevels() {
+    return this.format.m._c3d_reader_num_levels(this.ptr);
+  }
+
+  /** {width, height, tiles: [{x, y, w, h, files: [{kind, path, bytes, sha256, width, height}]}]} */
+  level(level) {
+    const p = this.format.m._c3d_reader_level_json(this.ptr, level);
+    if (!p) throw this.format._error();
+    return JSON.parse(this.format.m.UTF8ToString(p));
+  }
+
+  /** Throws unless `bytes` match the manifest's size and SHA-256 for `path`. */
+  checkFile(path, bytes) {
+    const f = this.format;
+    const sp = f._string(path);
+    const bp = f._copyIn(bytes);
+    try {
+      if (!f.m._c3d_reader_check_file(this.ptr, sp, bp, bytes.length)) throw f._error();
+    } finally {
+      f.m._free(sp);
+      f.m._free(bp);
+    }
+  }
+
+  /** Adds the decoded pixels (RGB or RGBA rows) of image `kind` (0..3) of a tile. */
+  addImage(level, tile, kind, pixels, width, height, channels) {
+    const f = this.format;
+    const ptr = f._copyIn(pixels);
+    try {
+      if (!f.m._c3d_reader_add_image(this.ptr, level, tile, kind, ptr, width, height, channels)) {
+        throw f._error();
+      }
+    } finally {
+      f.m._free(ptr);
+    }
+  }
+
+  /** Finishes and validates the level; returns its Panorama (caller frees). */
+  assemble(level) {
+    const p = this.format.m._c3d_reader_assemble(this.ptr, level);
+    if (!p) throw this.format._error();
+    return new Panorama(this.format, p);
+  }
+
+  free() {
+    if (this.ptr) this.format.m._c3d_reader_free(this.ptr);
+    this.ptr = 0;
+  }
+}

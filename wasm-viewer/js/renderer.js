@@ -1,0 +1,352 @@
+// WebGL2 renderer of a 3D photo mesh (format/mesh.h) with the effects of the
+// paper's Fig. 1 and 11: moving point lights using the normals (nodes with a
+// zero normal, the sky, stay unlit), a water surface rising through the scene
+// and a small inserted object; both are depth-tested against the photo's mesh,
+// so nearer scene geometry hides them correctly.
+//
+// Texturing: bilinear from the colour atlas (front colour panorama above the
+// back one), no mipmaps, no antialiasing: the same sampling as the project's
+// native software renderer, so screenshots can be compared with its renders.
+
+const SCENE_VS = `#version 300 es
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aNormal;
+layout(location = 2) in vec2 aUv;
+uniform mat4 uViewProjection;
+uniform mat4 uModel;  // Translation and uniform scale only.
+out vec3 vPosition;
+out vec3 vNormal;
+out vec2 vUv;
+void main() {
+  vec4 world = uModel * vec4(aPosition, 1.0);
+  vPosition = world.xyz;
+  vNormal = aNormal;
+  vUv = aUv;
+  gl_Position = uViewProjection * world;
+}`;
+
+// Shared lighting: ambient plus point lights with 1/(1 + k d^2) falloff,
+// two-sided (the normal is flipped towards the eye).
+const LIGHTING = `
+uniform int uLightCount;
+uniform vec3 uLightPosition[4];
+uniform vec3 uLightColor[4];
+uniform float uAmbient;
+uniform vec3 uEye;
+vec3 shade(vec3 albedo, vec3 position, vec3 normal) {
+  vec3 n = normalize(normal);
+  if (dot(n, uEye - position) < 0.0) n = -n;
+  vec3 sum = vec3(uAmbient);
+  for (int i = 0; i < 4; ++i) {
+    if (i >= uLightCount) break;
+    vec3 toLight = uLightPosition[i] - position;
+    float d = length(toLight);
+    sum += uLightColor[i] * max(dot(n, toLight / d), 0.0) / (1.0 + 0.05 * d * d);
+  }
+  return albedo * sum;
+}`;
+
+const SCENE_FS = `#version 300 es
+precision highp float;
+in vec3 vPosition;
+in vec3 vNormal;
+in vec2 vUv;
+uniform sampler2D uAtlas;
+${LIGHTING}
+out vec4 fragColor;
+void main() {
+  vec3 albedo = texture(uAtlas, vUv).rgb;
+  vec3 color = albedo;
+  // Unlit where the node has no normal (sky): interpolated length drops below 0.5.
+  if (uLightCount > 0 && length(vNormal) > 0.5) color = shade(albedo, vPosition, vNormal);
+  fragColor = vec4(color, 1.0);
+}`;
+
+const OBJECT_FS = `#version 300 es
+precision highp float;
+in vec3 vPosition;
+in vec3 vNormal;
+in vec2 vUv;
+uniform vec3 uColor;
+${LIGHTING}
+out vec4 fragColor;
+void main() {
+  fragColor = vec4(shade(uColor, vPosition, vNormal), 1.0);
+}`;
+
+const WATER_FS = `#version 300 es
+precision highp float;
+in vec3 vPosition;
+in vec3 vNormal;
+in vec2 vUv;
+uniform float uTime;
+uniform vec3 uEye;
+out vec4 fragColor;
+void main() {
+  // Small moving ripples and a Fresnel-like rise of opacity at grazing angles.
+  vec2 p = vPosition.xz;
+  float ripple = 0.5 + 0.25 * sin(p.x * 3.1 + uTime * 1.7) + 0.25 * sin(p.y * 2.3 - uTime * 1.3);
+  vec3 toEye = normalize(uEye - vPosition);
+  float grazing = 1.0 - abs(toEye.y);
+  vec3 color = mix(vec3(0.05, 0.22, 0.35), vec3(0.35, 0.6, 0.75), ripple * 0.6 + grazing * 0.4);
+  fragColor = vec4(color, 0.55 + 0.35 * grazing);
+}`;
+
+function compile(gl, type, source) {
+  const shader = gl.createShader(type);
+  gl.shaderSource(shader, source);
+  gl.compileShader(shader);
+  if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) {
+    const log = gl.getShaderInfoLog(shader);
+    gl.deleteShader(shader);
+    throw new Error(`shader compilation failed: ${log}`);
+  }
+  return shader;
+}
+
+function program(gl, vs, fs) {
+  const p = gl.createProgram();
+  gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, vs));
+  gl.attachShader(p, compile(gl, gl.FRAGMENT_SHADER, fs));
+  gl.linkProgram(p);
+  if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(`shader link failed: ${gl.getProgramInfoLog(p)}`);
+  const uniforms = {};
+  const n = gl.getProgramParameter(p, gl.ACTIVE_UNIFORMS);
+  for (let i = 0; i < n; ++i) {
+    const name = gl.getActiveUniform(p, i).name.replace(/\[0\]$/, '');
+    uniforms[name] = gl.getUniformLocation(p, name);
+  }
+  return { program: p, uniforms };
+}
+
+/** A cube of edge `size` centred at the origin: positions, normals, indices. */
+function cubeGeometry(size) {
+  const h = size / 2;
+  const faces = [
+    [[1, 0, 0], [0, 1, 0], [0, 0, 1]], [[-1, 0, 0], [0, 1, 0], [0, 0, -1]],
+    [[0, 1, 0], [0, 0, 1], [1, 0, 0]], [[0, -1, 0], [0, 0, -1], [1, 0, 0]],
+    [[0, 0, 1], [1, 0, 0], [0, 1, 0]], [[0, 0, -1], [-1, 0, 0], [0, 1, 0]],
+  ];
+  const positions = [], normals = [], indices = [];
+  for (const [n, a, b] of faces) {
+    const base = positions.length / 3;
+    for (const [s, t] of [[-1, -1], [1, -1], [1, 1], [-1, 1]]) {
+      for (let k = 0; k < 3; ++k) positions.push((n[k] + s * a[k] + t * b[k]) * h);
+      normals.push(...n);
+    }
+    indices.push(base, base + 1, base + 2, base, base + 2, base + 3);
+  }
+  return { positions: new Float32Array(positions), normals: new Float32Array(normals), indices: new Uint32Array(indices) };
+}
+
+/** Effects state; all optional. Positions in metres in the panorama frame. */
+export const DEFAULT_EFFECTS = Object.freeze({
+  lighting: false,        // Moving point lights using the normals.
+  water: false,           // A water surface rising and falling through the scene.
+  waterMinY: -1.6,        // Lowest water level (m, panorama Y).
+  waterMaxY: -0.4,        // Highest water level (m).
+  object: false,          // A small inserted cube.
+  objectPosition: [0.6, -0.4, -2.5],
+  objectSize: 0.3,        // Cube edge (m).
+});
+
+export class Renderer {
+  /** @param {HTMLCanvasElement|OffscreenCanvas} canvas */
+  constructor(canvas, { xrCompatible = false } = {}) {
+    const gl = canvas.getContext('webgl2', {
+      antialias: false, depth: true, alpha: false, preserveDrawingBuffer: true, xrCompatible,
+    });
+    if (!gl) throw new Error('WebGL2 is not available in this browser');
+    this.gl = gl;
+    this.canvas = canvas;
+    this.scene = program(gl, SCENE_VS, SCENE_FS);
+    this.object = program(gl, SCENE_VS, OBJECT_FS);
+    this.water = program(gl, SCENE_VS, WATER_FS);
+    this.mesh = null;
+    this.cube = this._upload(cubeGeometry(1));
+    const r = 1000;  // Water plane half-extent (m); far beyond any scene.
+    this.waterPlane = this._upload({
+      positions: new Float32Array([-r, 0, -r, r, 0, -r, r, 0, r, -r, 0, r]),
+      normals: new Float32Array([0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0]),
+      indices: new Uint32Array([0, 2, 1, 0, 3, 2]),
+    });
+    this.texture = null;
+  }
+
+  _upload({ positions, normals, uvs, indices }) {
+    const gl = this.gl;
+    const vao = gl.createVertexArray();
+    gl.bindVertexArray(vao);
+    const buffers = [];
+    const attribute = (location, data, size) => {
+      const b = gl.createBuffer();
+      gl.bindBuffer(gl.ARRAY_BUFFER, b);
+      gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW);
+      gl.enableVertexAttribArray(location);
+      gl.vertexAttribPointer(location, size, gl.FLOAT, false, 0, 0);
+      buffers.push(b);
+    };
+    attribute(0, positions, 3);
+    attribute(1, normals, 3);
+    if (uvs) attribute(2, uvs, 2);
+    else gl.vertexAttrib2f(2, 0, 0);
+    const ib = gl.createBuffer();
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
+    buffers.push(ib);
+    gl.bindVertexArray(null);
+    return { vao, buffers, count: indices.length };
+  }
+
+  _release(geometry) {
+    if (!geometry) return;
+    this.gl.deleteVertexArray(geometry.vao);
+    for (const b of geometry.buffers) this.gl.deleteBuffer(b);
+  }
+
+  /**
+   * Replaces the photo's mesh and colour atlas.
+   * @param mesh {positions: Float32Array, normals: Float32Array, uvs: Float32Array, indices: Uint32Array}
+   * @param atlas {width, height, data: Uint8Array (RGBA)} or an ImageBitmap
+   */
+  setMesh(mesh, atlas) {
+    const gl = this.gl;
+    const maxSize = gl.getParameter(gl.MAX_TEXTURE_SIZE);
+    if (atlas.width > maxSize || atlas.height > maxSize) {
+      throw new Error(`the colour atlas (${atlas.width}x${atlas.height}) exceeds this GPU's texture limit of ${maxSize}`);
+    }
+    const geometry = this._upload(mesh);
+    const texture = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, texture);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    gl.pixelStorei(gl.UNPACK_PREMULTIPLY_ALPHA_WEBGL, false);
+    gl.pixelStorei(gl.UNPACK_COLORSPACE_CONVERSION_WEBGL, gl.NONE);
+    if (atlas.data) {
+      gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, atlas.width, atlas.height, 0, gl.RGBA, gl.UNSIGNED_BYTE, atlas.data);
+    } else {
+      gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, gl.RGBA, gl.UNSIGNED_BYTE, atlas);
+    }
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.REPEAT);       // Columns wrap at the seam.
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    this._release(this.mesh);
+    if (this.texture) gl.deleteTexture(this.texture);
+    this.mesh = geometry;
+    this.texture = texture;
+  }
+
+  get hasMesh() {
+    return this.mesh !== null;
+  }
+
+  /** Point lights at time t (s): two coloured lights circling the centre. */
+  static lights(timeSec) {
+    const a = timeSec * 0.6;
+    return {
+      positions: [1.5 * Math.cos(a), 0.3, 1.5 * Math.sin(a) - 1.0, -1.2 * Math.cos(a * 1.3), -0.2, -1.2 * Math.sin(a * 1.3) - 1.5],
+      colors: [1.6, 1.3, 0.9, 0.7, 0.9, 1.6],
+    };
+  }
+
+  /**
+   * Draws one view. `viewport` [x, y, w, h] in framebuffer pixels; `framebuffer`
+   * null for the canvas (WebXR passes its layer's framebuffer).
+   */
+  draw({ view, projection, eye, effects = DEFAULT_EFFECTS, timeSec = 0, viewport, framebuffer = null, clear = true }) {
+    const gl = this.gl;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, framebuffer);
+    const [vx, vy, vw, vh] = viewport ?? [0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight];
+    gl.viewport(vx, vy, vw, vh);
+    if (clear) {
+      gl.clearColor(0, 0, 0, 1);
+      gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+    }
+    if (!this.mesh) return;
+    const viewProjection = multiply4(projection, view);
+    gl.enable(gl.DEPTH_TEST);
+    gl.depthFunc(gl.LEQUAL);
+    gl.disable(gl.CULL_FACE);  // The two-layer mesh is seen from both sides.
+    gl.disable(gl.BLEND);
+
+    const lights = Renderer.lights(timeSec);
+    const lightCount = effects.lighting ? 2 : 0;
+    const setCommon = (p, count, model = IDENTITY) => {
+      gl.uniformMatrix4fv(p.uniforms.uViewProjection, false, viewProjection);
+      gl.uniformMatrix4fv(p.uniforms.uModel, false, model);
+      if (p.uniforms.uEye) gl.uniform3fv(p.uniforms.uEye, eye);
+      if (p.uniforms.uLightCount) {
+        gl.uniform1i(p.uniforms.uLightCount, count);
+        gl.uniform3fv(p.uniforms.uLightPosition, new Float32Array([...lights.positions, 0, 0, 0, 0, 0, 0]));
+        gl.uniform3fv(p.uniforms.uLightColor, new Float32Array([...lights.colors, 0, 0, 0, 0, 0, 0]));
+        gl.uniform1f(p.uniforms.uAmbient, count > 0 ? 0.35 : 1.0);
+      }
+    };
+
+    gl.useProgram(this.scene.program);
+    setCommon(this.scene, lightCount);
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, this.texture);
+    gl.uniform1i(this.scene.uniforms.uAtlas, 0);
+    gl.bindVertexArray(this.mesh.vao);
+    gl.drawElements(gl.TRIANGLES, this.mesh.count, gl.UNSIGNED_INT, 0);
+
+    if (effects.object) {
+      // The inserted object is lit by the moving lights if on, else a fixed key light.
+      gl.useProgram(this.object.program);
+      const s = effects.objectSize ?? DEFAULT_EFFECTS.objectSize;
+      const [ox, oy, oz] = effects.objectPosition ?? DEFAULT_EFFECTS.objectPosition;
+      setCommon(this.object, 2, new Float32Array([s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0, ox, oy, oz, 1]));
+      if (!effects.lighting) {
+        // Without the moving lights the object gets a fixed key light above the eye.
+        gl.uniform3fv(this.object.uniforms.uLightPosition, new Float32Array([eye[0] + 1, eye[1] + 2, eye[2] + 1, ...new Array(9).fill(0)]));
+        gl.uniform3fv(this.object.uniforms.uLightColor, new Float32Array([1.3, 1.3, 1.3, ...new Array(9).fill(0)]));
+        gl.uniform1i(this.object.uniforms.uLightCount, 1);
+      }
+      gl.uniform1f(this.object.uniforms.uAmbient, 0.35);
+      gl.uniform3fv(this.object.uniforms.uColor, [0.95, 0.75, 0.1]);
+      gl.bindVertexArray(this.cube.vao);
+      gl.drawElements(gl.TRIANGLES, this.cube.count, gl.UNSIGNED_INT, 0);
+    }
+
+    if (effects.water) {
+      const lo = effects.waterMinY ?? DEFAULT_EFFECTS.waterMinY;
+      const hi = effects.waterMaxY ?? DEFAULT_EFFECTS.waterMaxY;
+      const level = lo + (hi - lo) * (0.5 - 0.5 * Math.cos(timeSec * 0.4));
+      gl.useProgram(this.water.program);
+      setCommon(this.water, 0, new Float32Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, level, 0, 1]));
+      gl.uniform1f(this.water.uniforms.uTime, timeSec);
+      gl.enable(gl.BLEND);
+      gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
+      gl.depthMask(false);  // Transparent: tested against the photo's depth, not written.
+      gl.bindVertexArray(this.waterPlane.vao);
+      gl.drawElements(gl.TRIANGLES, this.waterPlane.count, gl.UNSIGNED_INT, 0);
+      gl.depthMask(true);
+      gl.disable(gl.BLEND);
+    }
+    gl.bindVertexArray(null);
+  }
+
+  dispose() {
+    this._release(this.mesh);
+    this._release(this.cube);
+    this._release(this.waterPlane);
+    if (this.texture) this.gl.deleteTexture(this.texture);
+    this.mesh = null;
+    this.texture = null;
+  }
+}
+
+const IDENTITY = new Float32Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
+
+function multiply4(a, b) {
+  const m = new Float32Array(16);
+  for (let c = 0; c < 4; ++c) {
+    for (let r = 0; r < 4; ++r) {
+      let s = 0;
+      for (let k = 0; k < 4; ++k) s += a[k * 4 + r] * b[c * 4 + k];
+      m[c * 4 + r] = s;
+    }
+  }
+  return m;
+}

@@ -1,0 +1,42 @@
+// Decodes a package's tile images with the browser's own image decoder (WebP
+// included) into exact RGBA pixels, off the main thread (works in workers).
+// createImageBitmap with colour-space conversion and premultiplication off, and
+// an OffscreenCanvas 2D readback: the package's images are opaque RGB (alpha is
+// ignored by the format), so the readback returns the decoded values unchanged.
+
+let canvas = null;
+let context = null;
+
+/**
+ * @param {Uint8Array} bytes the encoded image
+ * @param {string} name used in error messages (the file's path)
+ * @returns {Promise<{width: number, height: number, data: Uint8ClampedArray}>} RGBA
+ */
+export async function decodeImage(bytes, name, type = 'image/webp') {
+  let bitmap;
+  try {
+    bitmap = await createImageBitmap(new Blob([bytes], { type }), {
+      premultiplyAlpha: 'none', colorSpaceConversion: 'none',
+    });
+  } catch {
+    throw new Error(`${name}: not a decodable image (corrupt or truncated file)`);
+  }
+  try {
+    const { width, height } = bitmap;
+    if (!canvas) {
+      canvas = new OffscreenCanvas(width, height);
+      context = canvas.getContext('2d', { willReadFrequently: true, alpha: true });
+      if (!context) throw new Error('this browser offers no 2D OffscreenCanvas to read decoded tiles');
+    }
+    if (canvas.width !== width || canvas.height !== height) {
+      canvas.width = width;
+      canvas.height = height;
+    } else {
+      context.clearRect(0, 0, width, height);
+    }
+    context.drawImage(bitmap, 0, 0);
+    return { width, height, data: context.getImageData(0, 0, width, height).data };
+  } finally {
+    bitmap.close();
+  }
+}

@@ -1,0 +1,180 @@
+// The viewer's decoding worker: fetches a package level by level (coarsest
+// first), checks every file against the manifest's size and SHA-256, decodes
+// tile images with the browser's decoder, assembles and validates each level's
+// two-layer panorama and builds its mesh with the wasm format library, then
+// hands the mesh and colour atlas to the main thread (transferred, not copied).
+//
+// Within a level, the tiles nearest the current view direction are fetched
+// first (the page reports the view with 'view' messages).
+//
+// Messages in:  {type: 'load', id, url, yawDeg, maxLevelWidth, maxTriangles}
+//               {type: 'view', yawDeg}
+// Messages out: {type: 'progress', id, progress: {loadedBytes, totalBytes, level, levels}}
+//               {type: 'level', id, level, levels, width, height, mesh, atlas, timing}
+//               {type: 'error', id, message}
+//               {type: 'done', id, levels, bytes}
+
+import { FormatModule } from './format-module.js';
+import { decodeImage } from './tile-decoder.js';
+
+const FETCH_CONCURRENCY = 6;
+let formatPromise = null;
+let currentId = 0;
+let viewYawDeg = 0;
+
+class Superseded extends Error {}
+
+self.onmessage = (e) => {
+  const msg = e.data;
+  if (msg.type === 'view') {
+    viewYawDeg = msg.yawDeg;
+    return;
+  }
+  if (msg.type !== 'load') return;
+  currentId = msg.id;
+  viewYawDeg = msg.yawDeg ?? 0;
+  load(msg).catch((err) => {
+    if (err instanceof Superseded) return;
+    self.postMessage({ type: 'error', id: msg.id, message: err.message || String(err) });
+  });
+};
+
+async function fetchBytes(url, name) {
+  let response;
+  try {
+    response = await fetch(url);
+  } catch {
+    throw new Error(`${name}: cannot be fetched (network error)`);
+  }
+  if (!response.ok) throw new Error(`${name}: HTTP ${response.status} ${response.statusText || ''}`.trim());
+  try {
+    return new Uint8Array(await response.arrayBuffer());
+  } catch {
+    throw new Error(`${name}: the download was interrupted`);
+  }
+}
+
+/**
+ * Runs `task(item)` over `items` with at most `limit` in flight. On the first
+ * failure no new task starts; it waits for the running ones to settle (so none
+ * touches the reader afterwards) and then throws that failure.
+ */
+async function forEachLimited(items, limit, task) {
+  let next = 0;
+  let failure = null;
+  const runners = Array.from({ length: Math.min(limit, items.length) }, async () => {
+    while (next < items.length && !failure) {
+      try {
+        await task(items[next++]);
+      } catch (err) {
+        failure ??= err;
+      }
+    }
+  });
+  await Promise.all(runners);
+  if (failure) throw failure;
+}
+
+async function load({ id, url, maxLevelWidth, maxTriangles }) {
+  const check = () => {
+    if (id !== currentId) throw new Superseded();
+  };
+  if (!formatPromise) {
+    formatPromise = FormatModule.create().catch((err) => {
+      formatPromise = null;
+      throw new Error(`the viewer's WebAssembly module failed to load: ${err.message || err}`);
+    });
+  }
+  const format = await formatPromise;
+  check();
+  const manifestBytes = await fetchBytes(url, 'manifest.json');
+  check();
+  const reader = format.openPackage(manifestBytes);
+  try {
+    const numLevels = reader.numLevels;
+    // Coarsest first; finer levels while they fit maxLevelWidth.
+    const chosen = [];
+    for (let l = numLevels - 1; l >= 0; --l) {
+      const info = reader.level(l);
+      if (chosen.length > 0 && info.width > maxLevelWidth) break;
+      chosen.push({ level: l, info });
+    }
+    const totalBytes = manifestBytes.length +
+      chosen.reduce((s, c) => s + c.info.tiles.reduce((t, tile) => t + tile.files.reduce((u, f) => u + f.bytes, 0), 0), 0);
+    let loadedBytes = manifestBytes.length;
+    let shown = 0;
+    let lastProgress = 0;
+    const progress = (level, force) => {
+      const now = performance.now();
+      if (!force && now - lastProgress < 50) return;
+      lastProgress = now;
+      self.postMessage({ type: 'progress', id, progress: { loadedBytes, totalBytes, level, levels: numLevels } });
+    };
+    progress(chosen[0].level, true);
+
+    for (const { level, info } of chosen) {
+      const timing = { level, fetchDecodeMs: 0, meshMs: 0 };
+      const t0 = performance.now();
+      try {
+        // Tiles in view first: order by the longitude distance of the tile's
+        // centre column from the view direction (format/equirect.h).
+        const away = (tile) => {
+          const lonDeg = ((tile.x + tile.w / 2) / info.width - 0.5) * 360;
+          const d = Math.abs(lonDeg - viewYawDeg) % 360;
+          return Math.min(d, 360 - d);
+        };
+        const order = info.tiles.map((tile, t) => t).sort((a, b) => away(info.tiles[a]) - away(info.tiles[b]) || a - b);
+        const jobs = [];
+        for (const t of order) info.tiles[t].files.forEach((file, kind) => jobs.push({ t, kind, file }));
+        // Fetch and check in parallel; decode in order of arrival. The reader
+        // accepts images in any order.
+        await forEachLimited(jobs, FETCH_CONCURRENCY, async ({ t, kind, file }) => {
+          const bytes = await fetchBytes(new URL(file.path, url).href, file.path);
+          check();
+          reader.checkFile(file.path, bytes);
+          loadedBytes += bytes.length;
+          const image = await decodeImage(bytes, file.path);
+          check();
+          if (image.width !== file.width || image.height !== file.height) {
+            throw new Error(`${file.path}: ${image.width}x${image.height} pixels, expected ${file.width}x${file.height}`);
+          }
+          reader.addImage(level, t, kind, image.data, image.width, image.height, 4);
+          progress(level, false);
+        });
+        timing.fetchDecodeMs = performance.now() - t0;
+        const t1 = performance.now();
+        const pano = reader.assemble(level);
+        let mesh, atlas;
+        try {
+          // The full mesh has about 2 triangles per node; simplify above the budget.
+          const fullEstimate = 2 * info.width * info.height;
+          mesh = format.buildMesh(pano, { maxTriangles: fullEstimate > maxTriangles ? maxTriangles : 0 });
+          atlas = pano.atlas();
+        } finally {
+          pano.free();
+        }
+        timing.meshMs = performance.now() - t1;
+        check();
+        progress(level, true);
+        self.postMessage(
+          {
+            type: 'level', id, level, levels: numLevels, width: info.width, height: info.height,
+            mesh: { positions: mesh.positions, normals: mesh.normals, uvs: mesh.uvs, indices: mesh.indices },
+            atlas, timing,
+          },
+          [mesh.positions.buffer, mesh.normals.buffer, mesh.uvs.buffer, mesh.indices.buffer, atlas.data.buffer],
+        );
+        ++shown;
+      } catch (err) {
+        if (err instanceof Superseded) throw err;
+        // Keep what is on screen; report and stop refining (finer levels would
+        // be refused by the same damage or cost more to fetch).
+        self.postMessage({ type: 'error', id, message: err.message || String(err) });
+        break;
+      }
+    }
+    if (shown > 0) self.postMessage({ type: 'done', id, levels: shown, bytes: loadedBytes });
+  } finally {
+    reader.free();
+  }
+}

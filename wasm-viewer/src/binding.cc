@@ -1,0 +1,288 @@
+// The C binding of the format library for the WebAssembly viewer: a thin layer
+// that hands bytes and pixels in from JavaScript and results back out through
+// the wasm heap. Every function is exported by name (wasm-viewer/CMakeLists.txt)
+// and wrapped by js/format-module.js; nothing here throws or aborts on bad input.
+//
+// Ownership: objects returned by *_open / *_parse_* / *_assemble / c3d_build_mesh
+// belong to the caller, who frees them with the matching *_free. Pointers
+// returned by accessors stay valid until the object is freed. A function that
+// fails returns 0 (or null) and sets the message read by c3d_last_error().
+
+#include <emscripten/emscripten.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "format/image.h"
+#include "format/manifest.h"
+#include "format/mesh.h"
+#include "format/mesh_builder.h"
+#include "format/mesh_simplify.h"
+#include "format/package_reader.h"
+#include "format/sha256.h"
+#include "format/tile_codec.h"
+#include "format/two_layer.h"
+#include "wasm-viewer/src/panorama_blob.h"
+
+namespace casual3d::viewer {
+namespace {
+
+std::string g_last_error;
+
+void SetError(const std::string& message) { g_last_error = message; }
+void SetError(const Status& status) { g_last_error = status.ToString(); }
+
+// A package being read: its validated manifest and the panorama of the level
+// being assembled.
+struct Reader {
+  std::unique_ptr<PackageReader> reader;
+  int level = -1;  // The level being assembled, -1: none.
+  std::string level_json;
+};
+
+struct Panorama {
+  TwoLayerPanorama pano;
+  std::vector<uint8_t> atlas;  // RGBA, width x 2*height, built on demand.
+};
+
+struct MeshResult {
+  Mesh mesh;
+  double max_error = 0.0;  // Relative depth error bound reported by the simplifier.
+};
+
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace
+}  // namespace casual3d::viewer
+
+using casual3d::viewer::Panorama;
+using casual3d::viewer::Reader;
+using casual3d::viewer::MeshResult;
+using casual3d::viewer::SetError;
+
+extern "C" {
+
+// The message of the last failure ("" if none).
+EMSCRIPTEN_KEEPALIVE const char* c3d_last_error() { return casual3d::viewer::g_last_error.c_str(); }
+
+// --- Panoramas -----------------------------------------------------------------
+
+// Parses a panorama blob (src/panorama_blob.h); null on error.
+EMSCRIPTEN_KEEPALIVE Panorama* c3d_panorama_parse_blob(const uint8_t* data, size_t size) {
+  auto parsed = casual3d::viewer::ParsePanorama(data, size);
+  if (!parsed.ok()) {
+    SetError(parsed.status());
+    return nullptr;
+  }
+  auto* p = new Panorama();
+  p->pano = std::move(parsed).value();
+  return p;
+}
+
+EMSCRIPTEN_KEEPALIVE void c3d_panorama_free(Panorama* p) { delete p; }
+EMSCRIPTEN_KEEPALIVE int c3d_panorama_width(const Panorama* p) { return p->pano.width(); }
+EMSCRIPTEN_KEEPALIVE int c3d_panorama_height(const Panorama* p) { return p->pano.height(); }
+
+// 1 if the panorama passes TwoLayerPanorama::Validate(), else 0 (error set).
+EMSCRIPTEN_KEEPALIVE int c3d_panorama_validate(const Panorama* p) {
+  const casual3d::Status s = p->pano.Validate();
+  if (!s.ok()) SetError(s);
+  return s.ok() ? 1 : 0;
+}
+
+// The colour atlas of format/mesh.h as RGBA (alpha 255): width x 2*height, the
+// front layer's colours above the back layer's. Owned by the panorama.
+EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_panorama_atlas_rgba(Panorama* p) {
+  const casual3d::TwoLayerPanorama& pano = p->pano;
+  const size_t n = static_cast<size_t>(pano.width()) * pano.height();
+  p->atlas.assign(n * 2 * 4, 255);
+  for (int l = 0; l < casual3d::kNumLayers; ++l) {
+    const std::vector<uint8_t>& rgb = pano.layer(l).rgb;
+    uint8_t* out = p->atlas.data() + l * n * 4;
+    for (size_t i = 0; i < n; ++i) {
+      out[4 * i + 0] = rgb[3 * i + 0];
+      out[4 * i + 1] = rgb[3 * i + 1];
+      out[4 * i + 2] = rgb[3 * i + 2];
+    }
+  }
+  return p->atlas.data();
+}
+
+// --- Meshes --------------------------------------------------------------------
+
+// Builds the mesh of spec/mesh.md. max_triangles > 0 simplifies it to that budget
+// with BuildSimplifiedMesh (max_error_rel: the largest relative depth error
+// allowed, 0: the library's default); 0 keeps the full mesh. Null on error.
+EMSCRIPTEN_KEEPALIVE MeshResult* c3d_build_mesh(const Panorama* p, double max_triangles,
+                                                double max_error_rel) {
+  casual3d::MeshBuildOptions options;
+  if (max_triangles > 0) {
+    casual3d::MeshSimplifyOptions simplify;
+    simplify.max_triangles = static_cast<int64_t>(max_triangles);
+    if (max_error_rel > 0) simplify.max_relative_error = max_error_rel;
+    auto simplified = casual3d::BuildSimplifiedMesh(p->pano, simplify);
+    if (!simplified.ok()) {
+      SetError(simplified.status());
+      return nullptr;
+    }
+    auto* r = new MeshResult();
+    r->mesh = std::move(simplified->mesh);
+    r->max_error = simplified->error_bound;
+    return r;
+  }
+  auto mesh = casual3d::BuildMesh(p->pano, options);
+  if (!mesh.ok()) {
+    SetError(mesh.status());
+    return nullptr;
+  }
+  auto* r = new MeshResult();
+  r->mesh = std::move(mesh).value();
+  return r;
+}
+
+EMSCRIPTEN_KEEPALIVE void c3d_mesh_free(MeshResult* m) { delete m; }
+EMSCRIPTEN_KEEPALIVE uint32_t c3d_mesh_num_vertices(const MeshResult* m) {
+  return static_cast<uint32_t>(m->mesh.num_vertices());
+}
+EMSCRIPTEN_KEEPALIVE uint32_t c3d_mesh_num_indices(const MeshResult* m) {
+  return static_cast<uint32_t>(m->mesh.indices.size());
+}
+EMSCRIPTEN_KEEPALIVE const float* c3d_mesh_positions(const MeshResult* m) { return m->mesh.positions.data(); }
+EMSCRIPTEN_KEEPALIVE const float* c3d_mesh_normals(const MeshResult* m) { return m->mesh.normals.data(); }
+EMSCRIPTEN_KEEPALIVE const float* c3d_mesh_uvs(const MeshResult* m) { return m->mesh.uvs.data(); }
+EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_mesh_colors(const MeshResult* m) { return m->mesh.colors.data(); }
+EMSCRIPTEN_KEEPALIVE const uint32_t* c3d_mesh_indices(const MeshResult* m) { return m->mesh.indices.data(); }
+EMSCRIPTEN_KEEPALIVE double c3d_mesh_max_error(const MeshResult* m) { return m->max_error; }
+
+// --- Packages ------------------------------------------------------------------
+
+// Parses and validates manifest.json; null on error.
+EMSCRIPTEN_KEEPALIVE Reader* c3d_reader_open(const char* bytes, size_t size) {
+  auto created = casual3d::PackageReader::Create(std::string_view(bytes, size));
+  if (!created.ok()) {
+    SetError(created.status());  // Its messages name manifest.json and the field.
+    return nullptr;
+  }
+  auto* r = new Reader();
+  r->reader = std::make_unique<casual3d::PackageReader>(std::move(created).value());
+  return r;
+}
+
+EMSCRIPTEN_KEEPALIVE void c3d_reader_free(Reader* r) { delete r; }
+EMSCRIPTEN_KEEPALIVE int c3d_reader_num_levels(const Reader* r) { return r->reader->num_levels(); }
+
+// What a level needs, as JSON: {"width", "height", "tiles": [{"x", "y", "w",
+// "h", "files": [{"kind", "path", "bytes", "sha256", "width", "height"}]}]},
+// kinds in TileImageKind order. Owned by the reader until the next call.
+EMSCRIPTEN_KEEPALIVE const char* c3d_reader_level_json(Reader* r, int level) {
+  using casual3d::viewer::JsonString;
+  const casual3d::Manifest& m = r->reader->manifest();
+  if (level < 0 || level >= static_cast<int>(m.levels.size())) {
+    SetError("level " + std::to_string(level) + " is not in the package");
+    return nullptr;
+  }
+  const casual3d::LevelEntry& L = m.levels[level];
+  std::string j = "{\"width\":" + std::to_string(L.width) + ",\"height\":" + std::to_string(L.height) +
+                  ",\"tiles\":[";
+  for (size_t t = 0; t < L.tiles.size(); ++t) {
+    int x, y, w, h;
+    m.TileRect(level, static_cast<int>(t), &x, &y, &w, &h);
+    j += (t ? ",{" : "{") + std::string("\"x\":") + std::to_string(x) + ",\"y\":" + std::to_string(y) +
+         ",\"w\":" + std::to_string(w) + ",\"h\":" + std::to_string(h) + ",\"files\":[";
+    for (int k = 0; k < casual3d::kNumTileImageKinds; ++k) {
+      const auto kind = static_cast<casual3d::TileImageKind>(k);
+      const std::string& path = L.tiles[t].files[k];
+      const casual3d::FileEntry* f = m.FindFile(path);
+      int iw, ih;
+      casual3d::TileImageSize(kind, w, h, &iw, &ih);
+      j += (k ? ",{" : "{") + std::string("\"kind\":") + JsonString(casual3d::TileImageKindName(kind)) +
+           ",\"path\":" + JsonString(path) + ",\"bytes\":" + std::to_string(f ? f->bytes : 0) +
+           ",\"sha256\":" + JsonString(f ? f->sha256 : "") + ",\"width\":" + std::to_string(iw) +
+           ",\"height\":" + std::to_string(ih) + "}";
+    }
+    j += "]}";
+  }
+  j += "]}";
+  r->level_json = std::move(j);
+  return r->level_json.c_str();
+}
+
+// Checks a fetched file against the manifest's size and SHA-256. 1 if it
+// matches, else 0 with an error naming the file.
+EMSCRIPTEN_KEEPALIVE int c3d_reader_check_file(const Reader* r, const char* path, const uint8_t* data,
+                                               size_t size) {
+  const casual3d::Status s = r->reader->VerifyFile(path, data, size);
+  if (!s.ok()) SetError(s);
+  return s.ok() ? 1 : 0;
+}
+
+// Adds the decoded pixels of image `kind` (TileImageKind; `channels` 3 or 4,
+// tightly packed rows) of tile `tile` of `level`. Adding to another level than
+// the one being assembled starts that level and discards the other. 1 on
+// success, else 0 with the error set.
+EMSCRIPTEN_KEEPALIVE int c3d_reader_add_image(Reader* r, int level, int tile, int kind,
+                                              const uint8_t* pixels, int width, int height,
+                                              int channels) {
+  if (kind < 0 || kind >= casual3d::kNumTileImageKinds || (channels != 3 && channels != 4) ||
+      width <= 0 || height <= 0) {
+    SetError("c3d_reader_add_image: kind, channels or image size out of range");
+    return 0;
+  }
+  if (r->level != level) {
+    const casual3d::Status s = r->reader->BeginLevel(level);
+    if (!s.ok()) {
+      SetError(s);
+      r->level = -1;
+      return 0;
+    }
+    r->level = level;
+  }
+  casual3d::ImageView<const uint8_t> view(pixels, width, height, channels,
+                                          static_cast<std::ptrdiff_t>(width) * channels);
+  const casual3d::Status s =
+      r->reader->AddTileImage(tile, static_cast<casual3d::TileImageKind>(kind), view);
+  if (!s.ok()) {
+    SetError(s);
+    return 0;
+  }
+  return 1;
+}
+
+// Finishes the level whose images were added (every image of every tile) and
+// validates it; returns its panorama (caller frees) or null with the error set.
+EMSCRIPTEN_KEEPALIVE Panorama* c3d_reader_assemble(Reader* r, int level) {
+  if (r->level != level) {
+    SetError("level " + std::to_string(level) + ": no tile images were added");
+    return nullptr;
+  }
+  r->level = -1;
+  auto pano = r->reader->FinishLevel();
+  if (!pano.ok()) {
+    SetError("level " + std::to_string(level) + ": " + pano.status().ToString());
+    return nullptr;
+  }
+  auto* p = new Panorama();
+  p->pano = std::move(pano).value();
+  return p;
+}
+
+}  // extern "C"

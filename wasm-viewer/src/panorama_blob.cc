@@ -1,0 +1,147 @@
+#include "wasm-viewer/src/panorama_blob.h"
+
+#include <cstring>
+
+namespace casual3d::viewer {
+namespace {
+
+constexpr char kPanoMagic[8] = {'C', '3', 'D', 'P', 'A', 'N', 'O', '1'};
+constexpr char kMeshMagic[8] = {'C', '3', 'D', 'M', 'E', 'S', 'H', '1'};
+
+// Both targets (x86-64 and wasm32) are little-endian, so plain copies give the
+// documented byte order.
+static_assert(sizeof(float) == 4 && sizeof(double) == 8, "IEEE-754 sizes expected");
+
+class Writer {
+ public:
+  template <typename T>
+  void Put(const T& v) {
+    const size_t at = bytes_.size();
+    bytes_.resize(at + sizeof(T));
+    std::memcpy(bytes_.data() + at, &v, sizeof(T));
+  }
+  template <typename T>
+  void PutArray(const std::vector<T>& v) {
+    const size_t at = bytes_.size();
+    bytes_.resize(at + v.size() * sizeof(T));
+    if (!v.empty()) std::memcpy(bytes_.data() + at, v.data(), v.size() * sizeof(T));
+  }
+  void PutBytes(const char* p, size_t n) { bytes_.insert(bytes_.end(), p, p + n); }
+  std::vector<uint8_t> Take() { return std::move(bytes_); }
+
+ private:
+  std::vector<uint8_t> bytes_;
+};
+
+class Reader {
+ public:
+  Reader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+  template <typename T>
+  bool Get(T* v) {
+    if (size_ - at_ < sizeof(T)) return false;
+    std::memcpy(v, data_ + at_, sizeof(T));
+    at_ += sizeof(T);
+    return true;
+  }
+  template <typename T>
+  bool GetArray(size_t n, std::vector<T>* v) {
+    if (n > (size_ - at_) / sizeof(T)) return false;
+    v->resize(n);
+    if (n) std::memcpy(v->data(), data_ + at_, n * sizeof(T));
+    at_ += n * sizeof(T);
+    return true;
+  }
+  bool Magic(const char (&m)[8]) {
+    if (size_ - at_ < 8 || std::memcmp(data_ + at_, m, 8) != 0) return false;
+    at_ += 8;
+    return true;
+  }
+  bool AtEnd() const { return at_ == size_; }
+
+ private:
+  const uint8_t* data_;
+  size_t size_;
+  size_t at_ = 0;
+};
+
+}  // namespace
+
+std::vector<uint8_t> SerializePanorama(const TwoLayerPanorama& pano) {
+  Writer w;
+  w.PutBytes(kPanoMagic, 8);
+  w.Put(static_cast<uint32_t>(pano.width()));
+  w.Put(static_cast<uint32_t>(pano.height()));
+  for (double c : pano.frame().centre) w.Put(c);
+  for (double r : pano.frame().rotation) w.Put(r);
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& L = pano.layer(l);
+    w.PutArray(L.present);
+    w.PutArray(L.rgb);
+    w.PutArray(L.depth_m);
+    w.PutArray(L.normal);
+    w.PutArray(L.label);
+    w.PutArray(L.links);
+  }
+  return w.Take();
+}
+
+StatusOr<TwoLayerPanorama> ParsePanorama(const uint8_t* data, size_t size) {
+  Reader r(data, size);
+  if (!r.Magic(kPanoMagic)) return InvalidData("panorama blob: bad magic (expected C3DPANO1)");
+  uint32_t width = 0, height = 0;
+  if (!r.Get(&width) || !r.Get(&height)) return InvalidData("panorama blob: truncated header");
+  if (width == 0 || height == 0 || width > kMaxBlobSide || height > kMaxBlobSide ||
+      uint64_t{width} * height > kMaxBlobPixels) {
+    return LimitExceeded("panorama blob: size " + std::to_string(width) + "x" +
+                         std::to_string(height) + " is empty or beyond the limit");
+  }
+  TwoLayerPanorama pano(static_cast<int>(width), static_cast<int>(height));
+  for (double& c : pano.frame().centre) {
+    if (!r.Get(&c)) return InvalidData("panorama blob: truncated frame");
+  }
+  for (double& c : pano.frame().rotation) {
+    if (!r.Get(&c)) return InvalidData("panorama blob: truncated frame");
+  }
+  const size_t n = size_t{width} * height;
+  for (int l = 0; l < kNumLayers; ++l) {
+    LayerData& L = pano.layer(l);
+    if (!r.GetArray(n, &L.present) || !r.GetArray(3 * n, &L.rgb) || !r.GetArray(n, &L.depth_m) ||
+        !r.GetArray(3 * n, &L.normal) || !r.GetArray(n, &L.label) || !r.GetArray(n, &L.links)) {
+      return InvalidData("panorama blob: truncated layer " + std::to_string(l));
+    }
+  }
+  if (!r.AtEnd()) return InvalidData("panorama blob: trailing bytes");
+  return pano;
+}
+
+std::vector<uint8_t> SerializeMesh(const Mesh& mesh) {
+  Writer w;
+  w.PutBytes(kMeshMagic, 8);
+  w.Put(static_cast<uint32_t>(mesh.num_vertices()));
+  w.Put(static_cast<uint32_t>(mesh.indices.size()));
+  w.PutArray(mesh.positions);
+  w.PutArray(mesh.normals);
+  w.PutArray(mesh.uvs);
+  w.PutArray(mesh.colors);
+  w.PutArray(mesh.indices);
+  return w.Take();
+}
+
+StatusOr<Mesh> ParseMesh(const uint8_t* data, size_t size) {
+  Reader r(data, size);
+  if (!r.Magic(kMeshMagic)) return InvalidData("mesh blob: bad magic (expected C3DMESH1)");
+  uint32_t nv = 0, ni = 0;
+  if (!r.Get(&nv) || !r.Get(&ni)) return InvalidData("mesh blob: truncated header");
+  Mesh mesh;
+  if (!r.GetArray(size_t{nv} * 3, &mesh.positions) || !r.GetArray(size_t{nv} * 3, &mesh.normals) ||
+      !r.GetArray(size_t{nv} * 2, &mesh.uvs) || !r.GetArray(size_t{nv} * 3, &mesh.colors) ||
+      !r.GetArray(ni, &mesh.indices) || !r.AtEnd()) {
+    return InvalidData("mesh blob: truncated or trailing bytes");
+  }
+  for (uint32_t i : mesh.indices) {
+    if (i >= nv) return InvalidData("mesh blob: index " + std::to_string(i) + " out of range");
+  }
+  return mesh;
+}
+
+}  // namespace casual3d::viewer

@@ -1,0 +1,286 @@
+// Browser test of the viewer in Debian's headless Chromium (SwiftShader WebGL2),
+// driven by playwright-core:
+//  - a page with <casual3d-viewer> loads a package served on 127.0.0.1 and
+//    reports its first frame (time and bytes fetched before it are printed);
+//  - it renders from three camera positions (centre and two parallax offsets);
+//    each frame matches the native software renderer's image of the same mesh
+//    (reconstruct/render/, via viewer_test_tool) with PSNR >= 30 dB;
+//  - effects are geometry-aware: an object behind the near sphere is hidden, one
+//    in front of it shows; water covers the floor but not the sphere's top;
+//  - a package with a corrupted tile shows the error message, keeps the coarser
+//    level on screen and the page stays responsive.
+// Screenshots go to $CASUAL3D_BINARY_DIR/wasm-viewer/browser-test/.
+// Exits 77 (ctest: skipped) when Chromium is not installed.
+
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { after, before, test } from 'node:test';
+
+import { BINARY_DIR, DIST_DIR, runTool } from './node-support.mjs';
+import { chromiumArgs, startServer, viewerPage } from './static-server.mjs';
+
+const CHROMIUM = process.env.CASUAL3D_CHROMIUM ?? '/usr/bin/chromium';
+if (!fs.existsSync(CHROMIUM)) {
+  console.log(`SKIP: ${CHROMIUM} is not installed (apt-get install chromium); the browser test needs it`);
+  process.exit(77);
+}
+let chromium;
+try {
+  ({ chromium } = await import('playwright-core'));
+} catch {
+  console.error('error: the npm package playwright-core is missing; run `npm ci` in wasm-viewer/ (scripts/setup.sh does)');
+  process.exit(1);
+}
+
+const W = 640, H = 400;
+const OUT = path.join(BINARY_DIR, 'wasm-viewer', 'browser-test');
+const CAMERAS = [
+  { yawDeg: 10, pitchDeg: -10, fovDeg: 75, position: [0, 0, 0] },
+  { yawDeg: 20, pitchDeg: -5, fovDeg: 60, position: [0.2, 0.05, 0] },
+  { yawDeg: -30, pitchDeg: 15, fovDeg: 90, position: [-0.1, -0.1, 0.15] },
+];
+
+let tmp, server, browser, page, metrics = {};
+
+function readPpm(file) {
+  const buf = fs.readFileSync(file);
+  const header = buf.subarray(0, 64).toString('latin1').match(/^P6\s+(\d+)\s+(\d+)\s+255\s/);
+  assert.ok(header, `${file}: not a binary PPM`);
+  return { width: Number(header[1]), height: Number(header[2]), data: buf.subarray(header[0].length) };
+}
+
+/** PSNR (dB) of WebGL RGBA (bottom row first) against RGB (top row first). */
+function psnr(glRgba, rgb, width, height) {
+  let se = 0;
+  for (let y = 0; y < height; ++y) {
+    const gy = height - 1 - y;
+    for (let x = 0; x < width; ++x) {
+      for (let c = 0; c < 3; ++c) {
+        const d = glRgba[(gy * width + x) * 4 + c] - rgb[(y * width + x) * 3 + c];
+        se += d * d;
+      }
+    }
+  }
+  const mse = se / (width * height * 3);
+  return mse === 0 ? Infinity : 10 * Math.log10((255 * 255) / mse);
+}
+
+/** The canvas' pixels (RGBA, bottom row first) after the next frame. */
+async function readFrame() {
+  const b64 = await page.evaluate(async () => {
+    const v = document.getElementById('v').viewer;
+    await v.nextFrame();
+    const gl = v.renderer.gl;
+    const px = new Uint8Array(gl.drawingBufferWidth * gl.drawingBufferHeight * 4);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.readPixels(0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    let s = '';
+    for (let i = 0; i < px.length; i += 0x8000) s += String.fromCharCode.apply(null, px.subarray(i, i + 0x8000));
+    return btoa(s);
+  });
+  return new Uint8Array(Buffer.from(b64, 'base64'));
+}
+
+function waitForEvent(type, timeoutMs = 120000) {
+  return page.waitForFunction((t) => window.__events.some((e) => e.type === t), type, { timeout: timeoutMs, polling: 100 });
+}
+
+before(async () => {
+  fs.mkdirSync(OUT, { recursive: true });
+  tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-browser-'));
+  const good = path.join(tmp, 'room');
+  metrics.package = JSON.parse(runTool('viewer_test_tool', ['package', 'room', '1024', '512', good, '256', '3']));
+  // A copy whose finest level has one damaged colour tile (bytes flipped mid-file).
+  const bad = path.join(tmp, 'bad');
+  fs.cpSync(good, bad, { recursive: true });
+  const manifest = JSON.parse(fs.readFileSync(path.join(bad, 'manifest.json'), 'utf8'));
+  const damaged = manifest.levels[0].tiles[1].color;
+  const bytes = fs.readFileSync(path.join(bad, damaged));
+  for (let i = 40; i < 80; ++i) bytes[i] ^= 0x5a;
+  fs.writeFileSync(path.join(bad, damaged), bytes);
+  metrics.damagedFile = damaged;
+
+  server = await startServer({ '/viewer/': DIST_DIR, '/pkg/': good, '/bad/': bad }, {
+    '/index.html': viewerPage('/pkg/manifest.json', { width: W, height: H, maxLevelWidth: 1024 }),
+    '/bad.html': viewerPage('/bad/manifest.json', { width: W, height: H, maxLevelWidth: 1024 }),
+    '/missing.html': viewerPage('/nothing-here/manifest.json', { width: W, height: H }),
+    '/favicon.ico': '',
+  });
+  browser = await chromium.launch({ executablePath: CHROMIUM, args: chromiumArgs() });
+  page = await browser.newPage({ viewport: { width: W, height: H }, deviceScaleFactor: 1 });
+  page.on('pageerror', (e) => console.log(`page error: ${e.message}`));
+  page.on('console', (m) => { if (m.type() === 'error') console.log(`console: ${m.text()}`); });
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.close();
+  if (tmp) fs.rmSync(tmp, { recursive: true, force: true });
+  console.log(`METRICS ${JSON.stringify(metrics)}`);
+});
+
+test('loads a package and reports the first frame', async () => {
+  const start = server.log.length;
+  await page.goto(`${server.url}/index.html`);
+  await waitForEvent('firstframe');
+  await waitForEvent('load');
+  const events = await page.evaluate(() => window.__events);
+  const errors = events.filter((e) => e.type === 'error');
+  assert.equal(errors.length, 0, `unexpected errors: ${JSON.stringify(errors)}`);
+  const first = events.find((e) => e.type === 'firstframe');
+  const levels = events.filter((e) => e.type === 'level').map((e) => e.detail.level);
+  assert.deepEqual(levels, [2, 1, 0], 'levels arrive coarsest first');
+  const firstT = first.t;
+  // Bytes the server sent before the first frame: package files and viewer code.
+  const served = server.log.slice(start);
+  const t0 = served[0].t;
+  const beforeFirst = served.filter((r) => r.t - t0 <= firstT);
+  metrics.timeToFirstFrameMs = Math.round(first.detail.timeToFirstFrameMs);
+  metrics.packageBytesBeforeFirstFrame = first.detail.bytesBeforeFirstFrame;
+  metrics.allBytesBeforeFirstFrame = beforeFirst.reduce((s, r) => s + r.bytes, 0);
+  metrics.loadMs = Math.round(events.find((e) => e.type === 'load').t);
+  assert.ok(first.detail.bytesBeforeFirstFrame > 0 && first.detail.bytesBeforeFirstFrame <= 300 * 1024,
+    `package bytes before the first frame: ${first.detail.bytesBeforeFirstFrame}`);
+  await page.screenshot({ path: path.join(OUT, 'loaded.png') });
+});
+
+test('renders like the native renderer from three cameras (PSNR >= 30 dB)', async () => {
+  const specs = CAMERAS.map((c) => [c.yawDeg, c.pitchDeg, c.fovDeg, ...c.position].join(','));
+  runTool('viewer_test_tool', ['render', path.join(tmp, 'room'), '0', String(W), String(H), path.join(OUT, 'reference'), ...specs]);
+  metrics.psnrDb = [];
+  for (let i = 0; i < CAMERAS.length; ++i) {
+    await page.evaluate((c) => document.getElementById('v').setCamera(c), CAMERAS[i]);
+    const frame = await readFrame();
+    await page.screenshot({ path: path.join(OUT, `viewer_${i}.png`) });
+    const ref = readPpm(path.join(OUT, `reference_${i}.ppm`));
+    assert.equal(ref.width, W);
+    const db = psnr(frame, ref.data, W, H);
+    metrics.psnrDb.push(Number(db.toFixed(2)));
+    assert.ok(db >= 30, `camera ${i}: PSNR ${db.toFixed(2)} dB < 30 dB`);
+  }
+  // The three views differ (the cameras really moved).
+  assert.ok(new Set(metrics.psnrDb).size === CAMERAS.length);
+});
+
+test('effects: inserted object and water are occluded by nearer geometry', async () => {
+  const setup = async (effects) => {
+    await page.evaluate((e) => {
+      const v = document.getElementById('v').viewer;
+      v.setEffectsTime(0);
+      v.setEffects(e);
+      v.setCamera({ yawDeg: 14, pitchDeg: -10, fovDeg: 60, position: [0, 0, 0] });
+    }, effects);
+    return readFrame();
+  };
+  const none = { lighting: false, water: false, object: false };
+  const plain = await setup(none);
+  // The room's sphere: centre (0.4, -0.3, -1.6), radius 0.6. A cube right behind
+  // it (from the centre) must be invisible; the same cube in front must show.
+  const behind = await setup({ ...none, object: true, objectPosition: [0.4, -0.3, -2.6], objectSize: 0.3 });
+  const front = await setup({ ...none, object: true, objectPosition: [0.22, -0.165, -0.88], objectSize: 0.15 });
+  await page.screenshot({ path: path.join(OUT, 'effect_object.png') });
+  const changed = (a, b) => { let n = 0; for (let i = 0; i < a.length; i += 4) if (Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) > 6) ++n; return n; };
+  metrics.objectBehindChangedPixels = changed(plain, behind);
+  metrics.objectFrontChangedPixels = changed(plain, front);
+  assert.equal(metrics.objectBehindChangedPixels, 0, 'a cube behind the sphere is hidden');
+  assert.ok(metrics.objectFrontChangedPixels > 500, 'a cube in front of the sphere is visible');
+  // Water at y = -1.2 m: the floor (y = -1.5) is under water, the sphere (y >= -0.9) is not.
+  const water = await setup({ ...none, water: true, waterMinY: -1.2, waterMaxY: -1.2 });
+  await page.screenshot({ path: path.join(OUT, 'effect_water.png') });
+  const project = await page.evaluate(() => {
+    const v = document.getElementById('v').viewer;
+    const cam = v.camera;
+    const aspect = v.canvas.width / v.canvas.height;
+    const view = cam.viewMatrix(), proj = cam.projectionMatrix(aspect);
+    const toPixel = (p) => {
+      const mv = [0, 1, 2, 3].map((r) => view[r] * p[0] + view[4 + r] * p[1] + view[8 + r] * p[2] + view[12 + r]);
+      const c = [0, 1, 2, 3].map((r) => proj[r] * mv[0] + proj[4 + r] * mv[1] + proj[8 + r] * mv[2] + proj[12 + r] * mv[3]);
+      return [Math.round((c[0] / c[3] * 0.5 + 0.5) * v.canvas.width), Math.round((c[1] / c[3] * 0.5 + 0.5) * v.canvas.height)];
+    };
+    return { sphereTop: toPixel([0.4, 0.2, -1.6]), floor: toPixel([0.6, -1.5, -2.4]) };
+  });
+  const at = (img, [x, y]) => { const i = (y * W + x) * 4; return [img[i], img[i + 1], img[i + 2]]; };
+  const diff = (a, b) => Math.abs(a[0] - b[0]) + Math.abs(a[1] - b[1]) + Math.abs(a[2] - b[2]);
+  metrics.waterSphereTopDiff = diff(at(plain, project.sphereTop), at(water, project.sphereTop));
+  metrics.waterFloorDiff = diff(at(plain, project.floor), at(water, project.floor));
+  assert.ok(metrics.waterSphereTopDiff <= 6, 'the sphere above the water is untouched');
+  assert.ok(metrics.waterFloorDiff > 30, 'the floor below the water is covered');
+  const lit = await setup({ ...none, lighting: true, object: true, water: true, waterMinY: -1.4, waterMaxY: -1.4 });
+  await page.screenshot({ path: path.join(OUT, 'effect_all.png') });
+  assert.ok(changed(plain, lit) > W * H * 0.2, 'lighting changes the image');
+  await setup(none);
+});
+
+test('a corrupted tile shows an error, keeps the coarser level and the page responsive', async () => {
+  await page.goto(`${server.url}/bad.html`);
+  await waitForEvent('error');
+  const state = await page.evaluate(async () => {
+    const el = document.getElementById('v');
+    const t = performance.now();
+    await el.viewer.nextFrame();  // Still rendering.
+    return {
+      message: el.errorMessage, stats: el.viewer.stats, frameMs: performance.now() - t,
+      levels: window.__events.filter((e) => e.type === 'level').map((e) => e.detail.level),
+    };
+  });
+  metrics.corruptMessage = state.message;
+  assert.match(state.message, new RegExp(metrics.damagedFile.replace(/[.]/g, '\\.')), 'the message names the file');
+  assert.match(state.message, /SHA-256 does not match|checksum/);
+  assert.deepEqual(state.levels, [2, 1], 'the coarser levels were shown');
+  assert.ok(state.frameMs < 5000, `a frame took ${state.frameMs} ms`);
+  // The page still answers input: drag to turn the view.
+  const before = await page.evaluate(() => document.getElementById('v').getCamera().yawDeg);
+  await page.mouse.move(300, 200);
+  await page.mouse.down();
+  await page.mouse.move(200, 200, { steps: 5 });
+  await page.mouse.up();
+  const afterYaw = await page.evaluate(() => document.getElementById('v').getCamera().yawDeg);
+  assert.ok(afterYaw > before + 5, `dragging turned the view (${before} -> ${afterYaw})`);
+  await page.screenshot({ path: path.join(OUT, 'corrupt.png') });
+});
+
+test('a missing package shows a fatal error message', async () => {
+  await page.goto(`${server.url}/missing.html`);
+  await waitForEvent('error');
+  const state = await page.evaluate(() => ({
+    message: document.getElementById('v').errorMessage,
+    error: window.__events.find((e) => e.type === 'error').detail,
+  }));
+  assert.equal(state.error.fatal, true);
+  assert.match(state.message, /^manifest\.json: HTTP 404/);
+});
+
+test('`casual3d view` serves a package the browser shows', async (t) => {
+  const casual3d = path.join(BINARY_DIR, 'cli', 'casual3d');
+  if (!fs.existsSync(casual3d)) return t.skip('casual3d is not built');
+  const { spawn } = await import('node:child_process');
+  const proc = spawn(casual3d, ['view', path.join(tmp, 'room'), '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
+  try {
+    const url = await new Promise((resolve, reject) => {
+      let out = '';
+      proc.stdout.on('data', (d) => {
+        out += d;
+        const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
+        if (m) resolve(m[0]);
+      });
+      proc.on('exit', (code) => reject(new Error(`casual3d view exited with ${code}`)));
+    });
+    await page.goto(url);
+    await page.waitForFunction(() => {
+      const el = document.querySelector('casual3d-viewer');
+      return el && el.viewer && el.viewer.stats.loadMs !== undefined;
+    }, null, { timeout: 120000, polling: 200 });
+    const state = await page.evaluate(() => {
+      const el = document.querySelector('casual3d-viewer');
+      return { error: el.errorMessage, level: el.viewer.stats.level, triangles: el.viewer.stats.triangles };
+    });
+    assert.equal(state.error, '');
+    assert.equal(state.level, 0);
+    assert.ok(state.triangles > 100000);
+    await page.screenshot({ path: path.join(OUT, 'casual3d_view.png') });
+  } finally {
+    proc.kill('SIGINT');
+  }
+});

@@ -1,0 +1,64 @@
+// The wasm mesh builder and simplifier give the same meshes as the native ones:
+// byte-identical vertices (positions, normals, uvs, colours) and indices. Native meshes come
+// from viewer_mesh_dump (tools/mesh_dump.cc), which also writes the panorama
+// blob the wasm side builds from, so both start from identical bytes.
+//
+//   node --test wasm-viewer/test/mesh_equivalence.test.mjs   (env CASUAL3D_BINARY_DIR)
+
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { test } from 'node:test';
+
+import { compareArrays, loadFormatModule, parseMeshBlob, runTool } from './node-support.mjs';
+
+const CASES = [
+  ['room', 64, 32],          // Depth edges and a back layer behind the sphere.
+  ['room', 257, 130],        // Odd width: seam column handling.
+  ['room-nosphere', 96, 48], // Fully linked, front only.
+  ['sphere', 128, 64],       // Poles and the seam on a closed surface.
+  ['test', 200, 100],        // Sky (zero normals), a near object, back-layer ring.
+  ['room', 1024, 512],       // A realistic size.
+];
+
+const format = await loadFormatModule();
+const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-mesh-eq-'));
+process.on('exit', () => fs.rmSync(dir, { recursive: true, force: true }));
+
+for (const [kind, w, h] of CASES) {
+  test(`wasm mesh == native mesh: ${kind} ${w}x${h}`, () => {
+    const info = JSON.parse(runTool('viewer_mesh_dump', [kind, String(w), String(h), dir]));
+    const base = path.join(dir, `${kind}_${w}x${h}`);
+    const native = parseMeshBlob(fs.readFileSync(`${base}.mesh`));
+    const nativeSimplified = parseMeshBlob(fs.readFileSync(`${base}.smesh`));
+    const pano = format.parsePanoramaBlob(fs.readFileSync(`${base}.pano`));
+    let wasm, wasmSimplified;
+    try {
+      pano.validate();
+      wasm = format.buildMesh(pano);
+      wasmSimplified = format.buildMesh(pano, { maxTriangles: info.budget });
+    } finally {
+      pano.free();
+    }
+    assert.ok(native.indices.length > 0, 'the native mesh has triangles');
+    assert.ok(nativeSimplified.indices.length < native.indices.length, 'simplification removed triangles');
+    for (const [name, a, b] of [['full', wasm, native], ['simplified', wasmSimplified, nativeSimplified]]) {
+      for (const field of ['positions', 'normals', 'uvs', 'colors', 'indices']) {
+        const r = compareArrays(a[field], b[field]);
+        assert.ok(r.sameLength, `${name} ${field}: ${a[field].length} (wasm) vs ${b[field].length} (native) elements`);
+        assert.equal(r.differing, 0, `${name} ${field}: ${r.differing} elements differ, largest difference ${r.maxAbs}`);
+      }
+    }
+  });
+}
+
+test('wasm panorama blob parser refuses damaged input', () => {
+  assert.throws(() => format.parsePanoramaBlob(new Uint8Array([1, 2, 3])), /bad magic/);
+  runTool('viewer_mesh_dump', ['room', '16', '8', dir]);
+  const bytes = fs.readFileSync(path.join(dir, 'room_16x8.pano'));
+  assert.throws(() => format.parsePanoramaBlob(bytes.subarray(0, bytes.length - 5)), /truncated/);
+  const huge = Buffer.from(bytes);
+  huge.writeUInt32LE(1 << 20, 8);
+  assert.throws(() => format.parsePanoramaBlob(huge), /beyond the limit/);
+});

@@ -1,0 +1,57 @@
+// The wasm package reader and mesh builder (the browser's path, here with a
+// wasm libwebp decoder) give the same mesh as the native reader (libwebp) and
+// mesh builder on a synthetic package: positions, normals, uvs and indices
+// byte-identical (depth, normals and links are lossless), colours within 2
+// levels (the colour images are lossy WebP and the two decoders are different
+// builds of libwebp; measured difference printed).
+
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { test } from 'node:test';
+
+import { compareArrays, loadFormatModule, parseMeshBlob, runTool } from './node-support.mjs';
+import { readPackageLevel } from './node-package.mjs';
+
+const format = await loadFormatModule();
+const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-pkg-eq-'));
+process.on('exit', () => fs.rmSync(dir, { recursive: true, force: true }));
+const pkg = path.join(dir, 'pkg');
+runTool('viewer_test_tool', ['package', 'test', '1024', '512', pkg, '256', '2']);
+
+for (const level of [1, 0]) {
+  test(`package level ${level}: wasm reader + mesh == native reader + mesh`, async () => {
+    const base = path.join(dir, `native_${level}`);
+    runTool('viewer_test_tool', ['mesh', pkg, String(level), base]);
+    const native = parseMeshBlob(fs.readFileSync(`${base}.mesh`));
+    const { pano } = await readPackageLevel(format, pkg, level);
+    let wasm;
+    try {
+      wasm = format.buildMesh(pano);
+    } finally {
+      pano.free();
+    }
+    assert.ok(native.indices.length > 1000);
+    for (const field of ['positions', 'normals', 'uvs', 'indices']) {
+      const r = compareArrays(wasm[field], native[field]);
+      assert.ok(r.sameLength, `${field}: ${wasm[field].length} vs ${native[field].length} elements`);
+      assert.equal(r.differing, 0, `${field}: ${r.differing} elements differ (largest ${r.maxAbs})`);
+    }
+    const colors = compareArrays(wasm.colors, native.colors);
+    assert.ok(colors.sameLength);
+    console.log(`level ${level}: ${native.indices.length / 3} triangles; colours differing: ${colors.differing}, largest difference ${colors.maxAbs}`);
+    assert.ok(colors.maxAbs <= 2, `colours differ by up to ${colors.maxAbs}`);
+  });
+}
+
+test('a damaged tile is refused with a message naming it', async () => {
+  const bad = path.join(dir, 'bad');
+  fs.cpSync(pkg, bad, { recursive: true });
+  const manifest = JSON.parse(fs.readFileSync(path.join(bad, 'manifest.json'), 'utf8'));
+  const file = manifest.levels[1].tiles[0].depth;
+  const bytes = fs.readFileSync(path.join(bad, file));
+  fs.writeFileSync(path.join(bad, file), bytes.subarray(0, bytes.length - 10));
+  await assert.rejects(readPackageLevel(format, bad, 1), new RegExp(file.replace(/\./g, '\\.')));
+  assert.throws(() => format.openPackage(new TextEncoder().encode('{"format": "casual3d", "version": "9.0"}')), /manifest\.json/);
+});

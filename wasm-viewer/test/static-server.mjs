@@ -1,0 +1,78 @@
+// A tiny static HTTP server for the viewer's browser tests and benchmarks:
+// serves `routes` (URL prefix -> folder) on 127.0.0.1 with the MIME types the
+// viewer needs (application/wasm included) and counts the bytes it sends.
+
+import fs from 'node:fs';
+import http from 'node:http';
+import path from 'node:path';
+
+const MIME = {
+  '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8', '.json': 'application/json',
+  '.wasm': 'application/wasm', '.webp': 'image/webp', '.png': 'image/png', '.ts': 'text/plain',
+};
+
+/**
+ * @param {Record<string, string>} routes e.g. {'/viewer/': distDir, '/pkg/': packageDir}
+ * @param {Record<string, string>} pages exact paths served from memory (e.g. '/index.html')
+ * @returns {Promise<{url: string, close: () => Promise<void>, log: {path: string, bytes: number, t: number}[]}>}
+ */
+export async function startServer(routes, pages = {}) {
+  const log = [];
+  const server = http.createServer((req, res) => {
+    const urlPath = decodeURIComponent(new URL(req.url, 'http://x').pathname);
+    const send = (code, type, body) => {
+      res.writeHead(code, { 'Content-Type': type, 'Content-Length': body.length, 'Cache-Control': 'no-store' });
+      res.end(body);
+      log.push({ path: urlPath, bytes: body.length, t: performance.now() });
+    };
+    if (pages[urlPath] !== undefined) return send(200, MIME['.html'], Buffer.from(pages[urlPath]));
+    for (const [prefix, dir] of Object.entries(routes)) {
+      if (!urlPath.startsWith(prefix)) continue;
+      const rel = urlPath.slice(prefix.length);
+      if (rel.split('/').some((s) => s === '..')) return send(400, 'text/plain', Buffer.from('bad path'));
+      const file = path.join(dir, rel);
+      if (!fs.existsSync(file) || !fs.statSync(file).isFile()) break;
+      return send(200, MIME[path.extname(file)] ?? 'application/octet-stream', fs.readFileSync(file));
+    }
+    send(404, 'text/plain', Buffer.from('not found'));
+  });
+  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+  const { port } = server.address();
+  return {
+    url: `http://127.0.0.1:${port}`,
+    log,
+    close: () => new Promise((resolve) => { server.closeAllConnections?.(); server.close(() => resolve()); }),
+  };
+}
+
+/**
+ * The flags that give headless Chromium WebGL2 on SwiftShader (TOOLCHAIN.md).
+ * Playwright itself starts the browser with a fresh, temporary profile (it
+ * refuses --user-data-dir in launch()).
+ */
+export function chromiumArgs() {
+  return [
+    '--headless=new', '--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run',
+    '--disable-quic',
+  ];
+}
+
+/** A page embedding one viewer element; events are recorded in window.__events. */
+export function viewerPage(src, { width = 640, height = 400, maxLevelWidth = 4096, attributes = '' } = {}) {
+  return `<!DOCTYPE html><html><head><meta charset="utf-8">
+<style>html,body{margin:0;background:#222}casual3d-viewer{width:${width}px;height:${height}px}</style>
+<script>
+  window.__events = [];
+  window.__t0 = performance.now();
+  for (const type of ['progress', 'level', 'firstframe', 'load', 'error']) {
+    document.addEventListener(type, (e) => {
+      if (e.target && e.target.localName === 'casual3d-viewer') {
+        window.__events.push({ type, t: performance.now() - window.__t0, detail: e.detail });
+      }
+    }, true);
+  }
+</script>
+<script type="module" src="/viewer/casual3d-viewer.js"></script>
+</head><body><casual3d-viewer id="v" src="${src}" max-level-width="${maxLevelWidth}" ${attributes}></casual3d-viewer></body></html>`;
+}

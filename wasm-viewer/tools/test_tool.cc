@@ -1,0 +1,167 @@
+// viewer_test_tool: native helpers of the viewer's browser test and benchmark.
+//
+//   viewer_test_tool package <room|room-nosphere|sphere|test> <width> <height> <out_dir>
+//                            [tile_size] [levels]
+//     Writes a web package of a procedural two-layer panorama (encoder/).
+//   viewer_test_tool render <package_dir> <level> <width> <height> <out_prefix>
+//                           <yaw,pitch,fov,x,y,z>...
+//     Reads the package natively (libwebp), builds the mesh of `level` and
+//     renders it with the native software renderer (reconstruct/render/) from
+//     each WebGL-style camera (degrees, metres): <out_prefix>_<i>.ppm (binary
+//     RGB, for comparisons) and <out_prefix>_<i>.png (for looking at).
+//   viewer_test_tool mesh <package_dir> <level> <out_base>
+//     Reads the package natively and writes <out_base>.pano and <out_base>.mesh
+//     (src/panorama_blob.h): the decoded panorama and its native mesh.
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "encoder/package_writer.h"
+#include "encoder/webp_codec.h"
+#include "format/file_source.h"
+#include "format/mesh_builder.h"
+#include "format/package_reader.h"
+#include "format/package_test_scene.h"
+#include "format/testing/test_panoramas.h"
+#include "reconstruct/render/mesh_renderer.h"
+#include "wasm-viewer/src/panorama_blob.h"
+
+namespace {
+
+int Fail(const std::string& message) {
+  std::fprintf(stderr, "viewer_test_tool: error: %s\n", message.c_str());
+  return 1;
+}
+
+bool MakePanorama(const std::string& kind, int w, int h, casual3d::TwoLayerPanorama* pano) {
+  namespace t = casual3d::testing;
+  if (kind == "room") {
+    *pano = t::MakeRoomPanorama(w, h);
+  } else if (kind == "room-nosphere") {
+    t::RoomOptions options;
+    options.with_sphere = false;
+    *pano = t::MakeRoomPanorama(w, h, options);
+  } else if (kind == "sphere") {
+    *pano = t::MakeSpherePanorama(w, h, 3.0f);
+  } else if (kind == "test") {
+    *pano = t::MakePackageTestPanorama(w, h);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+int Package(int argc, char** argv) {
+  if (argc < 6) return Fail("usage: viewer_test_tool package <kind> <width> <height> <out_dir> [tile_size] [levels]");
+  casual3d::TwoLayerPanorama pano;
+  if (!MakePanorama(argv[2], std::atoi(argv[3]), std::atoi(argv[4]), &pano)) {
+    return Fail(std::string("unknown panorama kind '") + argv[2] + "'");
+  }
+  casual3d::encoder::PackageOptions options;
+  if (argc > 6) options.tile_size = std::atoi(argv[6]);
+  if (argc > 7) options.levels = std::atoi(argv[7]);
+  options.generator = "viewer_test_tool";
+  casual3d::encoder::PackageStats stats;
+  auto files = casual3d::encoder::EncodePackage(pano, options, &stats);
+  if (!files.ok()) return Fail(files.status().ToString());
+  const casual3d::Status s = casual3d::encoder::WritePackageFolder(*files, argv[5]);
+  if (!s.ok()) return Fail(s.ToString());
+  std::printf("{\"total_bytes\": %llu, \"manifest_bytes\": %llu, \"level_bytes\": [",
+              static_cast<unsigned long long>(stats.total_bytes),
+              static_cast<unsigned long long>(stats.manifest_bytes));
+  for (size_t i = 0; i < stats.level_bytes.size(); ++i) {
+    std::printf("%s%llu", i ? ", " : "", static_cast<unsigned long long>(stats.level_bytes[i]));
+  }
+  std::printf("]}\n");
+  return 0;
+}
+
+bool WriteFile(const std::string& path, const std::vector<uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  return static_cast<bool>(out);
+}
+
+int DumpMesh(int argc, char** argv) {
+  if (argc != 5) return Fail("usage: viewer_test_tool mesh <package_dir> <level> <out_base>");
+  casual3d::ReadOptions read;
+  read.level = std::atoi(argv[3]);
+  casual3d::FolderFileSource source(argv[2]);
+  casual3d::encoder::WebpImageDecoder decoder;
+  auto pano = casual3d::ReadPackage(source, decoder, read);
+  if (!pano.ok()) return Fail(std::string(argv[2]) + ": " + pano.status().ToString());
+  auto mesh = casual3d::BuildMesh(*pano);
+  if (!mesh.ok()) return Fail(mesh.status().ToString());
+  const std::string base = argv[4];
+  if (!WriteFile(base + ".pano", casual3d::viewer::SerializePanorama(*pano)) ||
+      !WriteFile(base + ".mesh", casual3d::viewer::SerializeMesh(*mesh))) {
+    return Fail(base + ": cannot write the blobs");
+  }
+  std::printf("{\"vertices\": %zu, \"triangles\": %zu}\n", mesh->num_vertices(), mesh->num_triangles());
+  return 0;
+}
+
+int Render(int argc, char** argv) {
+  if (argc < 8) {
+    return Fail("usage: viewer_test_tool render <package_dir> <level> <width> <height> <out_prefix> <yaw,pitch,fov,x,y,z>...");
+  }
+  casual3d::ReadOptions read;
+  read.level = std::atoi(argv[3]);
+  const int width = std::atoi(argv[4]), height = std::atoi(argv[5]);
+  const std::string prefix = argv[6];
+  casual3d::FolderFileSource source(argv[2]);
+  casual3d::encoder::WebpImageDecoder decoder;
+  auto pano = casual3d::ReadPackage(source, decoder, read);
+  if (!pano.ok()) return Fail(std::string(argv[2]) + ": " + pano.status().ToString());
+  auto mesh = casual3d::BuildMesh(*pano);
+  if (!mesh.ok()) return Fail(mesh.status().ToString());
+  // The colour atlas of format/mesh.h: front colours above back colours.
+  const int pw = pano->width(), ph = pano->height();
+  casual3d::Image8 atlas(pw, 2 * ph, 3);
+  for (int l = 0; l < casual3d::kNumLayers; ++l) {
+    const std::vector<uint8_t>& rgb = pano->layer(l).rgb;
+    std::copy(rgb.begin(), rgb.end(), atlas.data() + static_cast<size_t>(l) * pw * ph * 3);
+  }
+  for (int i = 7; i < argc; ++i) {
+    casual3d::render::GlCamera camera;
+    char comma;
+    std::istringstream in(argv[i]);
+    in >> camera.yaw_deg >> comma >> camera.pitch_deg >> comma >> camera.fov_y_deg >> comma >>
+        camera.position[0] >> comma >> camera.position[1] >> comma >> camera.position[2];
+    if (!in) return Fail(std::string("camera '") + argv[i] + "': expected yaw,pitch,fov,x,y,z");
+    const casual3d::render::PinholeView view = casual3d::render::ViewFromGlCamera(camera, width, height);
+    const casual3d::render::RenderResult result = casual3d::render::RenderMesh(*mesh, static_cast<const casual3d::Image8&>(atlas).view(), view);
+    const std::string base = prefix + "_" + std::to_string(i - 7);
+    std::ofstream ppm(base + ".ppm", std::ios::binary);
+    ppm << "P6\n" << width << " " << height << "\n255\n";
+    ppm.write(reinterpret_cast<const char*>(result.color.data()), static_cast<std::streamsize>(result.color.size()));
+    if (!ppm) return Fail(base + ".ppm: cannot write");
+    cv::Mat rgb(height, width, CV_8UC3, const_cast<uint8_t*>(result.color.data()));
+    cv::Mat bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    if (!cv::imwrite(base + ".png", bgr)) return Fail(base + ".png: cannot write");
+  }
+  std::printf("{\"vertices\": %zu, \"triangles\": %zu}\n", mesh->num_vertices(), mesh->num_triangles());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    if (argc >= 2 && std::string(argv[1]) == "package") return Package(argc, argv);
+    if (argc >= 2 && std::string(argv[1]) == "render") return Render(argc, argv);
+    if (argc >= 2 && std::string(argv[1]) == "mesh") return DumpMesh(argc, argv);
+  } catch (const std::exception& e) {
+    return Fail(e.what());
+  }
+  return Fail("usage: viewer_test_tool <package|render|mesh> ...");
+}
