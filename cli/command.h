@@ -46,4 +46,7 @@ void AddValidateCommand(CLI::App& app);
 // `casual3d export <package> --glb out.glb [--draco]` (cli/export_command.cc).
 void AddExportCommand(CLI::App& app);
 
+// `casual3d evaluate <capture> <3d-photo>... [-o report.html]` (cli/evaluate_command.cc).
+void AddEvaluateCommand(CLI::App& app);
+
 }  // namespace casual3d::cli

@@ -37,16 +37,16 @@ namespace {
 constexpr uint64_t kMaxSingleFileBytes = uint64_t{4} << 30;
 
 struct ExportOptions {
-  std::string input;      // Package folder, single-file package or master file.
-  std::string glb;        // Output .glb path.
-  int level = 0;          // Package level of detail (0 = full resolution).
+  std::string input;         // Package folder, single-file package or master file.
+  std::string glb;           // Output .glb path.
+  int level = 0;             // Package level of detail (0 = full resolution).
   bool no_simplify = false;  // true: the full mesh of BuildMesh.
   MeshSimplifyOptions simplify_options;
   std::string texture = "jpeg";  // "jpeg" or "png".
   encoder::GltfExportOptions gltf;
-  bool lit = false;       // Use a lit (PBR) material instead of KHR_materials_unlit.
+  bool lit = false;  // Use a lit (PBR) material instead of KHR_materials_unlit.
   bool no_normals = false;
-  int num_threads = 0;    // Tile decoding threads; 0 = all cores.
+  int num_threads = 0;  // Tile decoding threads; 0 = all cores.
 };
 
 [[noreturn]] void Fail(const std::string& message) { throw std::runtime_error(message); }
@@ -87,8 +87,9 @@ TwoLayerPanorama LoadPanorama(const ExportOptions& opts) {
 
   if (fs::is_directory(st)) {
     if (!fs::exists(fs::path(input) / "manifest.json")) {
-      Fail(input + ": not a package folder (no manifest.json); pass a package folder, a .c3d "
-                   "file or a master .exr file");
+      Fail(input +
+           ": not a package folder (no manifest.json); pass a package folder, a .c3d "
+           "file or a master .exr file");
     }
     return read_package(FolderFileSource(input));
   }
@@ -110,8 +111,9 @@ TwoLayerPanorama LoadPanorama(const ExportOptions& opts) {
     const uint64_t size = fs::file_size(input, ec);
     if (ec) Fail(input + ": cannot read its size (" + ec.message() + ")");
     if (size > kMaxSingleFileBytes) {
-      Fail(input + ": " + std::to_string(size) + " bytes, more than the 4 GiB a single-file "
-                   "package may have here; unpack it into a folder");
+      Fail(input + ": " + std::to_string(size) +
+           " bytes, more than the 4 GiB a single-file "
+           "package may have here; unpack it into a folder");
     }
     std::vector<uint8_t> bytes(static_cast<size_t>(size));
     in.seekg(0);
@@ -121,8 +123,9 @@ TwoLayerPanorama LoadPanorama(const ExportOptions& opts) {
     if (!source.ok()) Fail(input + ": " + source.status().ToString());
     return read_package(**source);
   }
-  Fail(input + ": neither a package folder, a single-file package (.c3d) nor a master file "
-               "(.exr)");
+  Fail(input +
+       ": neither a package folder, a single-file package (.c3d) nor a master file "
+       "(.exr)");
 }
 
 void RunExport(ExportOptions& opts) {
@@ -145,16 +148,18 @@ void RunExport(ExportOptions& opts) {
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
     return std::string(buf);
   };
+  // Three stages: read, build the mesh, encode and write.
+  util::Progress progress("export", 3);
   const TwoLayerPanorama pano = LoadPanorama(opts);
+  progress.Advance();
   util::LogInfo("read " + opts.input + ": " + std::to_string(pano.width()) + "x" +
                 std::to_string(pano.height()) + " panorama" + since(start));
   const auto mesh_start = std::chrono::steady_clock::now();
 
   Mesh mesh;
   if (!opts.no_simplify) {
-    opts.simplify_options.max_pixels =
-        std::max<int64_t>(opts.simplify_options.max_pixels,
-                          static_cast<int64_t>(pano.width()) * pano.height());
+    opts.simplify_options.max_pixels = std::max<int64_t>(
+        opts.simplify_options.max_pixels, static_cast<int64_t>(pano.width()) * pano.height());
     opts.simplify_options.validate_input = false;  // The readers validated it.
     auto simplified = BuildSimplifiedMesh(pano, opts.simplify_options);
     if (!simplified.ok()) Fail(opts.input + ": " + simplified.status().ToString());
@@ -167,26 +172,28 @@ void RunExport(ExportOptions& opts) {
     }
     util::LogInfo("simplified " + std::to_string(simplified->full_triangles) + " to " +
                   std::to_string(simplified->mesh.num_triangles()) +
-                  " triangles, relative depth error at most " +
-                  Number(simplified->error_bound) + since(mesh_start));
+                  " triangles, relative depth error at most " + Number(simplified->error_bound) +
+                  since(mesh_start));
     mesh = std::move(simplified->mesh);
   } else {
     MeshBuildOptions build;
-    build.max_pixels = std::max<int64_t>(build.max_pixels,
-                                         static_cast<int64_t>(pano.width()) * pano.height());
+    build.max_pixels =
+        std::max<int64_t>(build.max_pixels, static_cast<int64_t>(pano.width()) * pano.height());
     build.validate_input = false;
     auto full = BuildMesh(pano, build);
     if (!full.ok()) Fail(opts.input + ": " + full.status().ToString());
     mesh = std::move(full).value();
   }
   if (mesh.num_triangles() == 0) Fail(opts.input + ": the 3D photo has no triangles to export");
+  progress.Advance();
 
   encoder::GltfExportStats stats;
   const auto write_start = std::chrono::steady_clock::now();
   const Status written =
       encoder::ExportGlb(mesh, encoder::BuildColourAtlas(pano), opts.gltf, opts.glb, &stats);
-  util::LogInfo("encoded and wrote the GLB" + since(write_start));
   if (!written.ok()) Fail(written.message());
+  util::LogInfo("encoded and wrote the GLB" + since(write_start));
+  progress.Finish();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   char line[512];
@@ -197,11 +204,8 @@ void RunExport(ExportOptions& opts) {
                 stats.texture_height, opts.texture == "png" ? "PNG" : "JPEG",
                 Megabytes(stats.texture_bytes).c_str(), Megabytes(stats.mesh_bytes).c_str(),
                 opts.gltf.draco ? " (Draco)" : "", Megabytes(stats.file_bytes).c_str(), seconds);
-  if (util::GetLogOptions().json) {
-    util::LogInfo(line);
-  } else {
-    std::printf("%s\n", line);
-  }
+  // The result goes to stdout (logs and progress go to stderr).
+  std::printf("%s\n", line);
 }
 
 }  // namespace
@@ -224,8 +228,7 @@ void AddExportCommand(CLI::App& app) {
                   "Largest relative depth error of the simplification (0.01 = 1%)")
       ->capture_default_str()
       ->check(CLI::Range(1e-6, 0.5));
-  cmd->add_flag("--no-simplify", opts->no_simplify,
-                "Export the full mesh, one vertex per node");
+  cmd->add_flag("--no-simplify", opts->no_simplify, "Export the full mesh, one vertex per node");
   cmd->add_option("--level", opts->level, "Package level of detail to read (0 = full resolution)")
       ->capture_default_str()
       ->check(CLI::Range(0, 64));

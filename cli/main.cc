@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   casual3d::cli::AddInfoCommand(app);
   casual3d::cli::AddValidateCommand(app);
   casual3d::cli::AddExportCommand(app);
+  casual3d::cli::AddEvaluateCommand(app);
 
   app.parse_complete_callback([&] {
     casual3d::util::SetLogOptions({g_options.verbose, g_options.json});

@@ -6,6 +6,8 @@
 #include <string>
 
 #include "cli/command.h"
+#include "reconstruct/io/image_io.h"
+#include "reconstruct/pipeline/ground_truth_eval.h"
 #include "reconstruct/pipeline/panorama_stage.h"
 
 namespace casual3d::cli {
@@ -16,6 +18,7 @@ void AddPanoramaCommand(CLI::App& app) {
     std::string depth_dir;
     std::string output;
     pipeline::PanoramaStageOptions options;
+    std::string ground_truth;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -42,6 +45,8 @@ void AddPanoramaCommand(CLI::App& app) {
   cmd->add_option("--sky-depth", args->options.sky_depth_m,
                   "Depth for pixels without depth (sky), metres; 0 = automatic")
       ->capture_default_str();
+  cmd->add_option("--ground-truth", args->ground_truth,
+                  "A synthetic capture's ground_truth/panorama.exr (same size) to compare with");
   cmd->add_option("--threads", args->options.num_threads, "Worker threads; 0 = all cores")
       ->capture_default_str();
   cmd->callback([args] {
@@ -49,7 +54,8 @@ void AddPanoramaCommand(CLI::App& app) {
     options.stitch.solve_height = options.stitch.solve_width / 2;
     const std::string depth_dir = args->depth_dir.empty() ? args->workspace : args->depth_dir;
     pipeline::PanoramaStageReport r;
-    pipeline::RunPanoramaStage(args->workspace, depth_dir, args->output, options, &r);
+    const TwoLayerPanorama pano =
+        pipeline::RunPanoramaStage(args->workspace, depth_dir, args->output, options, &r);
     std::printf(
         "panorama: %d photos -> %dx%d, front coverage %.3f, back nodes %ld (+%ld hallucinated), "
         "sky nodes %ld\n"
@@ -60,6 +66,18 @@ void AddPanoramaCommand(CLI::App& app) {
         r.normals.sky_nodes, r.seconds_load, r.seconds_warp, r.seconds_stitch_front,
         r.seconds_stitch_back, r.seconds_fuse, r.seconds_normals, r.seconds_write,
         r.seconds_total);
+    if (!args->ground_truth.empty()) {
+      Image8 map;
+      const pipeline::GroundTruthComparison c =
+          pipeline::CompareWithGroundTruthFile(pano, args->ground_truth, &map);
+      io::WritePng(args->output + "/preview/ground_truth_comparison.png", map);
+      std::printf(
+          "ground truth: front within 3%%: %.4f of %ld covered pixels (coverage %.4f); back node "
+          "behind %.4f of %ld second-surface pixels near depth edges; front links across depth "
+          "edges: %ld of %ld (%.5f)\n",
+          c.FrontAccuracy(), c.front_covered, c.FrontCoverage(), c.BackNearEdges(),
+          c.back_edge_pixels, c.edge_pairs_linked, c.edge_pairs, c.LinksAcrossEdges());
+    }
   });
 }
 

@@ -7,6 +7,7 @@
 #include "cli/command.h"
 #include "cli/viewer_assets.h"
 #include "reconstruct/pipeline/pipeline.h"
+#include "reconstruct/util/log.h"
 
 namespace casual3d::cli {
 
@@ -52,6 +53,10 @@ void AddReconstructCommand(CLI::App& app) {
                 "Ablation: without the geometric-consistency filter and stitching cost");
   cmd->add_flag("--front-only", args->front_only, "Ablation: front layer only, no back layer");
   cmd->add_flag("--debug", args->debug, "Write colour-mapped PNGs of the dense intermediates");
+  cmd->add_option("--holdout-every", args->options.holdout_every,
+                  "Register every photo but build the 3D photo without photos 0, N, 2N, ... "
+                  "(sorted names; listed in report.json) for `casual3d evaluate`; 0 = none")
+      ->capture_default_str();
   cmd->add_option("--quality", args->options.color_quality, "WebP quality of colour tiles, 0..100")
       ->capture_default_str();
   cmd->add_option("--threads", args->options.num_threads, "Worker threads; 0 = all cores")
@@ -74,7 +79,15 @@ void AddReconstructCommand(CLI::App& app) {
     options.panorama.pano_width = args->pano_width;
     options.panorama.back_layer = !args->front_only;
     if (args->no_gc_filter) options.panorama.stitch.lambda_gc = 0.0;
-    options.finish_web_package = [](const std::string& web_dir) { WriteViewerPage(web_dir); };
+    options.finish_web_package = [](const std::string& web_dir) {
+      // As `casual3d encode`: without a built viewer the package is still
+      // complete and valid; say how to get the page.
+      try {
+        WriteViewerPage(web_dir);
+      } catch (const std::exception& e) {
+        util::LogWarning(std::string(e.what()) + "; wrote the package without index.html");
+      }
+    };
     const pipeline::PipelineReport report =
         pipeline::RunPipeline(args->input, args->output, options);
     for (const pipeline::StageRun& run : report.stages) {

@@ -91,6 +91,9 @@ void AddSparseCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--threads", s.num_threads, "Threads for COLMAP (0: all cores)")
       ->capture_default_str();
+  cmd->add_option("--init-tri-angle", s.init_min_tri_angle_deg,
+                  "Smallest triangulation angle of COLMAP's initial pair, degrees [0.5, 60]")
+      ->capture_default_str();
   cmd->add_option("--min-registered", s.min_registered_fraction,
                   "Fail if fewer than this fraction of the photos register [0, 1]")
       ->capture_default_str();

@@ -131,7 +131,8 @@ std::optional<fs::path> ResolveUnder(const fs::path& root, const std::vector<std
   const fs::path real = fs::canonical(p, ec);
   if (ec || !fs::is_regular_file(real, ec)) return std::nullopt;
   const std::string r = real_root.string(), f = real.string();
-  if (f.size() <= r.size() || f.compare(0, r.size(), r) != 0 || f[r.size()] != '/') return std::nullopt;
+  if (f.size() <= r.size() || f.compare(0, r.size(), r) != 0 || f[r.size()] != '/')
+    return std::nullopt;
   return real;
 }
 
@@ -154,8 +155,8 @@ void SendSimple(int fd, int code, const char* reason, const std::string& body) {
 }
 
 std::string OkHeader(const std::string& type, uintmax_t length) {
-  return "HTTP/1.1 200 OK\r\nContent-Type: " + type + "\r\nContent-Length: " +
-         std::to_string(length) +
+  return "HTTP/1.1 200 OK\r\nContent-Type: " + type +
+         "\r\nContent-Length: " + std::to_string(length) +
          "\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\n"
          "Access-Control-Allow-Origin: *\r\nConnection: close\r\n\r\n";
 }
@@ -212,7 +213,8 @@ class Server {
         const std::string html = ViewerPageHtml(package_dir_.filename().string() + " - casual3d",
                                                 std::string(kViewerSubdir) + "/");
         const std::string head = OkHeader("text/html; charset=utf-8", html.size());
-        SendAll(fd, head.data(), head.size()) && !head_only && SendAll(fd, html.data(), html.size());
+        SendAll(fd, head.data(), head.size()) && !head_only &&
+            SendAll(fd, html.data(), html.size());
         return;
       }
     }
@@ -258,10 +260,12 @@ void RunView(const ViewOptions& options) {
   std::error_code ec;
   const fs::path package_dir = fs::absolute(options.package).lexically_normal();
   if (!fs::is_directory(package_dir, ec)) {
-    throw std::runtime_error(options.package + ": not a folder; pass a package folder written by casual3d encode");
+    throw std::runtime_error(options.package +
+                             ": not a folder; pass a package folder written by casual3d encode");
   }
   if (!fs::is_regular_file(package_dir / "manifest.json", ec)) {
-    throw std::runtime_error(options.package + ": no manifest.json; pass a package folder written by casual3d encode");
+    throw std::runtime_error(
+        options.package + ": no manifest.json; pass a package folder written by casual3d encode");
   }
   if (options.port < 0 || options.port > 65535) {
     throw std::runtime_error("--port " + std::to_string(options.port) + " is outside 0..65535");
@@ -269,23 +273,26 @@ void RunView(const ViewOptions& options) {
   const fs::path viewer_dir = FindViewerDir();
 
   const int listen_fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (listen_fd < 0) throw std::runtime_error(std::string("cannot create a socket: ") + std::strerror(errno));
+  if (listen_fd < 0)
+    throw std::runtime_error(std::string("cannot create a socket: ") + std::strerror(errno));
   const int one = 1;
   setsockopt(listen_fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);  // Never exposed beyond this machine.
   addr.sin_port = htons(static_cast<uint16_t>(options.port));
-  if (bind(listen_fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) != 0 || listen(listen_fd, 64) != 0) {
+  if (bind(listen_fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) != 0 ||
+      listen(listen_fd, 64) != 0) {
     const std::string reason = std::strerror(errno);
     close(listen_fd);
-    throw std::runtime_error("--port " + std::to_string(options.port) + ": cannot listen on 127.0.0.1 (" +
-                             reason + "); pick another port or --port 0");
+    throw std::runtime_error("--port " + std::to_string(options.port) +
+                             ": cannot listen on 127.0.0.1 (" + reason +
+                             "); pick another port or --port 0");
   }
   socklen_t len = sizeof(addr);
   getsockname(listen_fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  std::printf("casual3d: serving %s at http://127.0.0.1:%d/ (Ctrl-C to stop)\n", package_dir.c_str(),
-              ntohs(addr.sin_port));
+  std::printf("casual3d: serving %s at http://127.0.0.1:%d/ (Ctrl-C to stop)\n",
+              package_dir.c_str(), ntohs(addr.sin_port));
   std::fflush(stdout);
 
   auto server = std::make_shared<Server>(package_dir, viewer_dir);
@@ -293,7 +300,8 @@ void RunView(const ViewOptions& options) {
     const int fd = accept4(listen_fd, nullptr, nullptr, SOCK_CLOEXEC);
     if (fd < 0) {
       if (errno == EINTR || errno == ECONNABORTED || errno == EMFILE || errno == ENFILE) {
-        if (errno == EMFILE || errno == ENFILE) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        if (errno == EMFILE || errno == ENFILE)
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
         continue;
       }
       const std::string reason = std::strerror(errno);

@@ -45,7 +45,8 @@ void WriteFileAtomically(const fs::path& path, const std::string& bytes) {
     if (!out) {
       std::error_code ignored;
       fs::remove(tmp, ignored);
-      throw std::runtime_error(path.string() + ": cannot write (check the folder exists and is writable)");
+      throw std::runtime_error(path.string() +
+                               ": cannot write (check the folder exists and is writable)");
     }
   }
   std::error_code ec;
@@ -68,11 +69,20 @@ std::string HtmlEscape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -82,7 +92,8 @@ std::string HtmlEscape(const std::string& s) {
 
 fs::path FindViewerDir() {
   std::vector<fs::path> candidates;
-  if (const char* env = std::getenv("CASUAL3D_VIEWER_DIR"); env && *env) candidates.emplace_back(env);
+  if (const char* env = std::getenv("CASUAL3D_VIEWER_DIR"); env && *env)
+    candidates.emplace_back(env);
   const fs::path exe_dir = ExecutableDir();
   if (!exe_dir.empty()) candidates.push_back(exe_dir / ".." / "share" / "casual3d" / "viewer");
 #ifdef CASUAL3D_VIEWER_BUILD_DIR
@@ -93,9 +104,8 @@ fs::path FindViewerDir() {
     if (HoldsViewer(dir)) return dir.lexically_normal();
     searched += (searched.empty() ? "" : ", ") + dir.lexically_normal().string();
   }
-  throw std::runtime_error("the web viewer files (" + std::string(kViewerEntry) +
-                           ") are not in " + searched +
-                           "; build the wasm-viewer target or set CASUAL3D_VIEWER_DIR");
+  throw std::runtime_error("the web viewer files (" + std::string(kViewerEntry) + ") are not in " +
+                           searched + "; build the wasm-viewer target or set CASUAL3D_VIEWER_DIR");
 }
 
 std::string ViewerPageHtml(const std::string& title, const std::string& viewer_url_prefix) {
@@ -106,8 +116,12 @@ std::string ViewerPageHtml(const std::string& title, const std::string& viewer_u
          "<head>\n"
          "<meta charset=\"utf-8\">\n"
          "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-         "<title>" + t + "</title>\n"
-         "<script type=\"module\" src=\"" + p + kViewerEntry + "\"></script>\n"
+         "<title>" +
+         t +
+         "</title>\n"
+         "<script type=\"module\" src=\"" +
+         p + kViewerEntry +
+         "\"></script>\n"
          "<style>html,body{margin:0;height:100%;background:#000}"
          "casual3d-viewer{display:block;width:100%;height:100%}</style>\n"
          "</head>\n"
@@ -130,9 +144,11 @@ void WriteViewerPage(const fs::path& package_dir) {
     if (!entry.is_regular_file()) continue;
     WriteFileAtomically(target / entry.path().filename(), ReadFile(entry.path()));
   }
-  if (ec) throw std::runtime_error(source.string() + ": cannot list the viewer files: " + ec.message());
+  if (ec)
+    throw std::runtime_error(source.string() + ": cannot list the viewer files: " + ec.message());
   std::string title = fs::absolute(package_dir).lexically_normal().filename().string();
-  if (title.empty()) title = fs::absolute(package_dir).lexically_normal().parent_path().filename().string();
+  if (title.empty())
+    title = fs::absolute(package_dir).lexically_normal().parent_path().filename().string();
   WriteFileAtomically(package_dir / "index.html", ViewerPageHtml(title + " - casual3d", "viewer/"));
 }
 

@@ -1,5 +1,6 @@
 #include "cli/viewer_assets.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -8,8 +9,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace casual3d::cli {
 namespace {
@@ -54,7 +53,8 @@ TEST_F(ViewerAssetsTest, CopiesTheViewerAndWritesTheIndexPage) {
   EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-viewer.js"), "export {};\n");
   EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-format.wasm").size(), 8u);
   const std::string html = Read(root_ / "package" / "index.html");
-  EXPECT_NE(html.find("<script type=\"module\" src=\"viewer/casual3d-viewer.js\"></script>"), std::string::npos);
+  EXPECT_NE(html.find("<script type=\"module\" src=\"viewer/casual3d-viewer.js\"></script>"),
+            std::string::npos);
   EXPECT_NE(html.find("<casual3d-viewer src=\"manifest.json\""), std::string::npos);
   EXPECT_NE(html.find("<title>package - casual3d</title>"), std::string::npos);
   // No temporary files are left behind.
@@ -91,7 +91,8 @@ TEST_F(ViewerAssetsTest, NamesThePlacesSearchedWhenTheViewerIsMissing) {
     // A built viewer in the build tree may legitimately be found instead.
     SUCCEED();
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find((root_ / "empty").string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find((root_ / "empty").string()), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("CASUAL3D_VIEWER_DIR"), std::string::npos) << e.what();
   }
 }

@@ -16,17 +16,18 @@
 #include <sstream>
 #include <utility>
 
-// libjpeg's header needs <cstdio> first.
-#include <jpeglib.h>
-#include <png.h>
-
+// (<jpeglib.h> needs <cstdio>, included above.)
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
 #include <draco/mesh/mesh.h>
+#include <jpeglib.h>
+#include <png.h>
+
 // The one translation unit that compiles tinygltf's implementation (see
 // gltf_tinygltf.h for why it is not taken from libtinygltf.so).
 #define TINYGLTF_IMPLEMENTATION
 #include "encoder/gltf_tinygltf.h"
+#include "format/colour_atlas.h"
 
 namespace casual3d::encoder {
 namespace {
@@ -146,7 +147,7 @@ struct JpegJob {
   std::jmp_buf jump;
   char message[JMSG_LENGTH_MAX] = {};
   unsigned char* out = nullptr;
-  unsigned long out_size = 0;  // NOLINT(runtime/int): libjpeg's type.
+  unsigned long out_size = 0;       // NOLINT(runtime/int): libjpeg's type.
   const uint8_t* pixels = nullptr;  // Tightly packed RGB rows.
   int width = 0, height = 0, quality = 0;
 };
@@ -279,8 +280,7 @@ Status DracoCompress(const ExportMesh& in, const GltfExportOptions& options,
   draco::Encoder encoder;
   const int speed = 10 - options.draco_compression_level;
   encoder.SetSpeedOptions(speed, speed);
-  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION,
-                                   options.draco_position_bits);
+  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, options.draco_position_bits);
   encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.draco_normal_bits);
   encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD,
                                    options.draco_texcoord_bits);
@@ -313,7 +313,9 @@ Status DracoCompress(const ExportMesh& in, const GltfExportOptions& options,
         return InternalError("Draco round trip: unreadable attribute value");
       }
     }
-    (*attribute_ids)[id == position_id ? "POSITION" : id == normal_id ? "NORMAL" : "TEXCOORD_0"] =
+    (*attribute_ids)[id == position_id ? "POSITION"
+                     : id == normal_id ? "NORMAL"
+                                       : "TEXCOORD_0"] =
         static_cast<int>(mesh.attribute(id)->unique_id());
     return Status::Ok();
   };
@@ -371,23 +373,8 @@ int AddFloatAccessor(tinygltf::Model* model, int view, const std::vector<float>&
 
 }  // namespace
 
-Image8 BuildColourAtlas(const TwoLayerPanorama& pano) {
-  const int w = pano.width(), h = pano.height();
-  Image8 atlas(w, 2 * h, 3);
-  for (int layer = 0; layer < kNumLayers; ++layer) {
-    const LayerData& own = pano.layer(layer);
-    const LayerData& other = pano.layer(1 - layer);
-    for (int y = 0; y < h; ++y) {
-      uint8_t* out = atlas.row(y + layer * h);
-      for (int x = 0; x < w; ++x) {
-        const size_t i = pano.index(x, y);
-        const LayerData* src = own.present[i] ? &own : other.present[i] ? &other : nullptr;
-        if (src) std::memcpy(out + 3 * x, &src->rgb[3 * i], 3);
-      }
-    }
-  }
-  return atlas;
-}
+// The one atlas of format/colour_atlas.h, whose fill rule the mesh's uvs rely on.
+Image8 BuildColourAtlas(const TwoLayerPanorama& pano) { return ::casual3d::BuildColourAtlas(pano, 3); }
 
 Status GltfExportOptions::Check() const {
   if (texture_format != TextureFormat::kPng && texture_format != TextureFormat::kJpeg) {
@@ -458,9 +445,11 @@ Status CheckMeshForExport(const Mesh& mesh) {
   return Status::Ok();
 }
 
-StatusOr<std::vector<uint8_t>> EncodeGlb(const Mesh& mesh, const Image8& atlas,
-                                         const GltfExportOptions& options,
-                                         GltfExportStats* stats) {
+namespace {
+
+// EncodeGlb's work; the GLB as a string (what the glTF serializer gives).
+StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
+                                      const GltfExportOptions& options, GltfExportStats* stats) {
   CASUAL3D_RETURN_IF_ERROR(options.Check());
   CASUAL3D_RETURN_IF_ERROR(CheckMeshForExport(mesh));
   if (atlas.empty() || (atlas.channels() != 3 && atlas.channels() != 4)) {
@@ -513,8 +502,8 @@ StatusOr<std::vector<uint8_t>> EncodeGlb(const Mesh& mesh, const Image8& atlas,
   // primitive restart in some APIs, so it is avoided).
   const bool short_indices = max_index < 65535;
   tinygltf::Accessor index_accessor;
-  index_accessor.componentType = short_indices ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
-                                               : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  index_accessor.componentType =
+      short_indices ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
   index_accessor.count = stored.indices.size();
   index_accessor.type = TINYGLTF_TYPE_SCALAR;
   if (options.draco) {
@@ -540,12 +529,13 @@ StatusOr<std::vector<uint8_t>> EncodeGlb(const Mesh& mesh, const Image8& atlas,
       return AddFloatAccessor(&model, view, data, components, bounds);
     };
     primitive.attributes["POSITION"] = add_attribute(stored.positions, 3, true);
-    if (!stored.normals.empty()) primitive.attributes["NORMAL"] = add_attribute(stored.normals, 3, false);
+    if (!stored.normals.empty())
+      primitive.attributes["NORMAL"] = add_attribute(stored.normals, 3, false);
     primitive.attributes["TEXCOORD_0"] = add_attribute(stored.uvs, 2, false);
     if (short_indices) {
       std::vector<uint16_t> narrow(stored.indices.begin(), stored.indices.end());
-      index_accessor.bufferView = AddBufferView(&model, narrow.data(), narrow.size() * 2,
-                                                kElementArrayBuffer);
+      index_accessor.bufferView =
+          AddBufferView(&model, narrow.data(), narrow.size() * 2, kElementArrayBuffer);
       mesh_bytes += narrow.size() * 2;
     } else {
       index_accessor.bufferView = AddBufferView(&model, stored.indices.data(),
@@ -610,7 +600,7 @@ StatusOr<std::vector<uint8_t>> EncodeGlb(const Mesh& mesh, const Image8& atlas,
                                      /*writeBinary=*/true)) {
     return InternalError("glTF serializer failed");
   }
-  const std::string glb = stream.str();
+  std::string glb = stream.str();
   if (stats) {
     stats->num_vertices = num_vertices;
     stats->num_triangles = stored.indices.size() / 3;
@@ -620,12 +610,20 @@ StatusOr<std::vector<uint8_t>> EncodeGlb(const Mesh& mesh, const Image8& atlas,
     stats->mesh_bytes = mesh_bytes;
     stats->file_bytes = glb.size();
   }
+  return glb;
+}
+
+}  // namespace
+
+StatusOr<std::vector<uint8_t>> EncodeGlb(const Mesh& mesh, const Image8& atlas,
+                                         const GltfExportOptions& options, GltfExportStats* stats) {
+  CASUAL3D_ASSIGN_OR_RETURN(std::string glb, EncodeGlbString(mesh, atlas, options, stats));
   return std::vector<uint8_t>(glb.begin(), glb.end());
 }
 
 Status ExportGlb(const Mesh& mesh, const Image8& atlas, const GltfExportOptions& options,
                  const std::string& path, GltfExportStats* stats) {
-  CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> glb, EncodeGlb(mesh, atlas, options, stats));
+  CASUAL3D_ASSIGN_OR_RETURN(std::string glb, EncodeGlbString(mesh, atlas, options, stats));
 
   // Atomic write: a temporary file in the target's folder (same file system),
   // renamed over the target only once complete and flushed.

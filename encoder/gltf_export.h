@@ -81,8 +81,11 @@ struct GltfExportOptions {
   int draco_position_bits = 14;
   int draco_normal_bits = 10;
   int draco_texcoord_bits = 14;
-  // Draco compression level, 0 (fastest, largest) .. 10 (slowest, smallest).
-  int draco_compression_level = 7;
+  // Draco compression level, 0..10 (Draco's encoding speed is 10 - level).
+  // Higher levels try costlier predictors, which do not always pay off: on the
+  // 4096x2048 synthetic panorama's simplified mesh (990k triangles), level 6
+  // gave 1.16 MB, level 4 1.33 MB, level 7 1.82 MB and level 10 1.78 MB.
+  int draco_compression_level = 6;
 
   // Returns InvalidArgument naming the first field out of range.
   Status Check() const;

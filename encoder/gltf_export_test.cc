@@ -1,17 +1,20 @@
 #include "encoder/gltf_export.h"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <csetjmp>
+#include <cstdio>  // Before <jpeglib.h>, which needs FILE.
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
-
-#include <csetjmp>
 
 #include <jpeglib.h>
 #include <png.h>
@@ -51,9 +54,9 @@ Mesh MakeSphereBand(int columns, int rows, int unlit_rows) {
         mesh.normals.insert(mesh.normals.end(), {0.0f, 0.0f, 0.0f});
       } else {
         // Not unit length on purpose: the exporter must normalize.
-        mesh.normals.insert(mesh.normals.end(), {static_cast<float>(-2.0 * d.x + 0.5),
-                                                 static_cast<float>(-2.0 * d.y),
-                                                 static_cast<float>(-2.0 * d.z)});
+        mesh.normals.insert(mesh.normals.end(),
+                            {static_cast<float>(-2.0 * d.x + 0.5), static_cast<float>(-2.0 * d.y),
+                             static_cast<float>(-2.0 * d.z)});
       }
       mesh.uvs.insert(mesh.uvs.end(), {static_cast<float>((i + 0.5) / (columns + 1)),
                                        static_cast<float>((j + 0.5) / (2.0 * (rows + 1)))});
@@ -99,7 +102,9 @@ struct JpegError {
   jpeg_error_mgr base;
   std::jmp_buf jump;
 };
-void JpegErrorExit(j_common_ptr cinfo) { std::longjmp(reinterpret_cast<JpegError*>(cinfo->err)->jump, 1); }
+void JpegErrorExit(j_common_ptr cinfo) {
+  std::longjmp(reinterpret_cast<JpegError*>(cinfo->err)->jump, 1);
+}
 
 bool DecodeImage(tinygltf::Image* image, const int, std::string* err, std::string*, int, int,
                  const unsigned char* bytes, int size, void*) {
@@ -413,7 +418,8 @@ TEST(GltfExportTest, DracoGlbDecodesToTheMeshWithinQuantization) {
     dpos->GetMappedValue(draco::PointIndex(i), xyz);
     dnrm->GetMappedValue(draco::PointIndex(i), n);
     duv->GetMappedValue(draco::PointIndex(i), uv);
-    for (int k = 0; k < 3; ++k) lo[k] = std::min<double>(lo[k], xyz[k]), hi[k] = std::max<double>(hi[k], xyz[k]);
+    for (int k = 0; k < 3; ++k)
+      lo[k] = std::min<double>(lo[k], xyz[k]), hi[k] = std::max<double>(hi[k], xyz[k]);
     size_t best = 0;
     double best_d = 1e30;
     for (size_t v = 0; v < mesh.num_vertices(); ++v) {
@@ -643,7 +649,8 @@ TEST(GltfExportTest, SimplifiedMeshMeetsTheTriangleBudget) {
   simplify.max_triangles = 12000;
   auto simplified = BuildSimplifiedMesh(pano, simplify);
   ASSERT_TRUE(simplified.ok()) << simplified.status().ToString();
-  ASSERT_TRUE(simplified->budget_met) << simplified->mesh.num_triangles() << " of " << simplified->full_triangles;
+  ASSERT_TRUE(simplified->budget_met)
+      << simplified->mesh.num_triangles() << " of " << simplified->full_triangles;
   GltfExportOptions options;
   options.draco = true;
   GltfExportStats stats;
@@ -695,8 +702,8 @@ TEST_F(GltfExportFileTest, WritesAtomicallyAndReplaces) {
 
 TEST_F(GltfExportFileTest, FailsCleanlyWhenTheFolderIsMissing) {
   const fs::path out = dir_ / "missing" / "photo.glb";
-  const Status s = ExportGlb(MakeSphereBand(4, 2, 0), MakeAtlas(8, 8), GltfExportOptions(),
-                             out.string());
+  const Status s =
+      ExportGlb(MakeSphereBand(4, 2, 0), MakeAtlas(8, 8), GltfExportOptions(), out.string());
   EXPECT_EQ(s.code(), StatusCode::kIoError);
   EXPECT_NE(s.message().find(out.string()), std::string::npos) << s.message();
   EXPECT_FALSE(fs::exists(out));

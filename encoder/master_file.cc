@@ -8,6 +8,7 @@
 #include <exception>
 #include <filesystem>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include <Imath/ImathMatrix.h>
@@ -70,6 +71,9 @@ std::vector<float>& FloatArray(LayerData& layer, int channel) {
   return channel == 0 ? layer.depth_m : layer.normal;
 }
 
+// OpenEXR (de)compresses blocks of scanlines on this many threads.
+int NumThreads() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+
 std::string TempPathFor(const std::string& path) {
   static std::atomic<int> counter{0};
   return path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
@@ -95,7 +99,7 @@ void WriteExr(const TwoLayerPanorama& pano, const std::string& path) {
     for (const FloatChannel& c : kFloatChannels)
       header.channels().insert(std::string(kLayerPrefix[l]) + c.name, Imf::Channel(Imf::FLOAT));
   }
-  Imf::OutputFile file(path.c_str(), header);
+  Imf::OutputFile file(path.c_str(), header, NumThreads());
 
   // UINT channels need 32-bit source data: convert one strip at a time.
   const size_t strip_pixels = static_cast<size_t>(w) * kStripRows;
@@ -142,7 +146,7 @@ bool ParseVersion(const std::string& s, int* major, int* minor) {
 }
 
 StatusOr<TwoLayerPanorama> ReadExr(const std::string& path) {
-  Imf::InputFile file(path.c_str());
+  Imf::InputFile file(path.c_str(), NumThreads());
   const Imf::Header& header = file.header();
   const auto* format = header.findTypedAttribute<Imf::StringAttribute>("casual3d.format");
   if (format == nullptr || format->value() != kFormatName)

@@ -33,7 +33,7 @@ inline Vec3d LonLatToDirection(double lon_rad, double lat_rad) {
 // `d` need not be unit length; the zero vector maps to (0, 0).
 inline void DirectionToLonLat(const Vec3d& d, double* lon_rad, double* lat_rad) {
   const double horizontal = std::sqrt(d.x * d.x + d.z * d.z);
-  *lon_rad = std::atan2(d.x, -d.z);
+  *lon_rad = std::atan2(d.x, 0.0 - d.z);  // 0 - z: atan2(0, -0.0) would give pi.
   *lat_rad = std::atan2(d.y, horizontal);
 }
 

@@ -247,6 +247,7 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes) {
   json::ParseLimits limits;
   limits.max_bytes = kMaxManifestBytes;
   limits.max_depth = 16;
+  limits.max_values = 1u << 20;  // Bounds memory (about 100 MB) on hostile input.
   StatusOr<Value> parsed = json::Parse(bytes, limits);
   if (!parsed.ok())
     return Status(parsed.status().code(), "manifest.json: " + parsed.status().message());
@@ -272,8 +273,14 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes) {
       ok = i == dot || (version[i] >= '0' && version[i] <= '9');
     if (!ok) return fail(InvalidData("version: \"" + version.substr(0, 20) +
                                      "\" is not \"major.minor\""));
-    m.version_major = std::stoi(version.substr(0, dot));
-    m.version_minor = std::stoi(version.substr(dot + 1));
+    // At most 11 characters, so each part has at most 9 digits and fits an int.
+    auto number = [&](size_t begin, size_t end) {
+      int v = 0;
+      for (size_t i = begin; i < end; ++i) v = v * 10 + (version[i] - '0');
+      return v;
+    };
+    m.version_major = number(0, dot);
+    m.version_minor = number(dot + 1, version.size());
     if (m.version_major != kPackageVersionMajor)
       return fail(UnsupportedVersion("version " + version +
                                      " is not supported (this reader reads 1.x)"));

@@ -157,26 +157,73 @@ int CountQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back
   return counter.count;
 }
 
-Mesh MeshAssembler::Finish() {
-  const int w = pano_.width(), h = pano_.height();
-  const size_t nodes = static_cast<size_t>(w) * h * 2;
-  std::vector<uint32_t> vertex_of(nodes, 0);  // 0: unused, else index + 1.
-  std::vector<uint32_t> seam_vertex_of(2 * static_cast<size_t>(h), 0);
-  for (NodeRef r : refs_) {
-    const uint32_t node = r & ~kSeamBit;
-    if (r & kSeamBit) {
-      seam_vertex_of[2 * ((node >> 1) / w) + (node & 1)] = 1;
-    } else {
-      vertex_of[node] = 1;
+void MeshAssembler::ChooseAtlasHalves() {
+  const std::vector<uint8_t>& front_present = pano_.layer(kFront).present;
+  const std::vector<uint8_t>& back_present = pano_.layer(kBack).present;
+  for (size_t t = 0; t + 2 < refs_.size(); t += 3) {
+    NodeRef* tri = &refs_[t];
+    const unsigned layers = (tri[0] & 1u) + (tri[1] & 1u) + (tri[2] & 1u);
+    if (layers == 0 || layers == 3) continue;  // One layer: its own half.
+    // Vertices whose colour the other half would not show at their pixel:
+    // a front node where a back node exists (sampled in the back half), a
+    // back node where a front node exists (sampled in the front half).
+    int wrong_in_back = 0, wrong_in_front = 0;
+    for (int k = 0; k < 3; ++k) {
+      const size_t pixel = (tri[k] & kNodeMask) >> 1;
+      if (tri[k] & 1u) {
+        wrong_in_front += front_present[pixel] ? 1 : 0;
+      } else {
+        wrong_in_back += back_present[pixel] ? 1 : 0;
+      }
+    }
+    const NodeRef half = wrong_in_back <= wrong_in_front ? 1u : 0u;
+    for (int k = 0; k < 3; ++k) {
+      if ((tri[k] & 1u) != half) tri[k] |= kOtherHalfBit;
     }
   }
+}
+
+Mesh MeshAssembler::Finish() {
+  ChooseAtlasHalves();
+  const int w = pano_.width(), h = pano_.height();
+  // Vertex keys: node * 2 + (1 if its uv is in the other layer's half).
+  const size_t keys = static_cast<size_t>(w) * h * 2 * 2;
+  // Used keys as a bitmap with a running count per 64-bit word: the vertex
+  // index of a key is its rank among used keys (6 MB for 4096 x 2048 instead
+  // of a 128 MB index table).
+  const size_t words = (keys + 63) / 64;
+  std::vector<uint64_t> used(words, 0);
+  // Seam copies by (row, layer, other half): index + 1; 0: unused.
+  std::vector<uint32_t> seam_vertex_of(4 * static_cast<size_t>(h), 0);
+  auto key_of = [](NodeRef r) -> uint32_t {
+    return ((r & kNodeMask) << 1) | ((r & kOtherHalfBit) ? 1u : 0u);
+  };
+  auto seam_slot = [w](NodeRef r) -> size_t {
+    const uint32_t node = r & kNodeMask;
+    return 4 * static_cast<size_t>((node >> 1) / w) + 2 * (node & 1) +
+           ((r & kOtherHalfBit) ? 1 : 0);
+  };
+  for (NodeRef r : refs_) {
+    if (r & kSeamBit) {
+      seam_vertex_of[seam_slot(r)] = 1;
+    } else {
+      const uint32_t key = key_of(r);
+      used[key >> 6] |= uint64_t{1} << (key & 63);
+    }
+  }
+  std::vector<uint32_t> used_before(words);
   uint32_t count = 0;
-  for (uint32_t& v : vertex_of) {
-    if (v) v = ++count;
+  for (size_t i = 0; i < words; ++i) {
+    used_before[i] = count;
+    count += static_cast<uint32_t>(__builtin_popcountll(used[i]));
   }
   for (uint32_t& v : seam_vertex_of) {
     if (v) v = ++count;
   }
+  auto vertex_of = [&](uint32_t key) {
+    const uint64_t below = used[key >> 6] & ((uint64_t{1} << (key & 63)) - 1);
+    return used_before[key >> 6] + static_cast<uint32_t>(__builtin_popcountll(below));
+  };
 
   // Direction tables (Sec. 3 of spec/mesh.md): longitude per column and
   // latitude per row at pixel centres, with the deterministic sine/cosine.
@@ -203,7 +250,7 @@ Mesh MeshAssembler::Finish() {
   mesh.uvs.reserve(2 * static_cast<size_t>(count));
   mesh.colors.reserve(3 * static_cast<size_t>(count));
   // Vertices are appended in index order: regular nodes, then seam copies.
-  auto emit = [&](int x, int y, int layer, bool seam) {
+  auto emit = [&](int x, int y, int layer, int half, bool seam) {
     const LayerData& d = pano_.layer(layer);
     const size_t i = pano_.index(x, y);
     const double depth = d.depth_m[i];
@@ -216,25 +263,28 @@ Mesh MeshAssembler::Finish() {
       mesh.colors.push_back(d.rgb[3 * i + c]);
     }
     mesh.uvs.push_back(u_of[seam ? w : x]);
-    mesh.uvs.push_back(v_of[2 * y + layer]);
+    mesh.uvs.push_back(v_of[2 * y + half]);
   };
-  size_t node = 0;
+  size_t key = 0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      for (int l = 0; l < kNumLayers; ++l, ++node) {
-        if (vertex_of[node]) emit(x, y, l, false);
+      for (int l = 0; l < kNumLayers; ++l) {
+        for (int other = 0; other < 2; ++other, ++key) {
+          if ((used[key >> 6] >> (key & 63)) & 1) emit(x, y, l, l ^ other, false);
+        }
       }
     }
   }
   for (int y = 0; y < h; ++y) {
     for (int l = 0; l < kNumLayers; ++l) {
-      if (seam_vertex_of[2 * y + l]) emit(0, y, l, true);
+      for (int other = 0; other < 2; ++other) {
+        if (seam_vertex_of[4 * y + 2 * l + other]) emit(0, y, l, l ^ other, true);
+      }
     }
   }
   // References become indices in place (both are 32-bit).
   for (NodeRef& r : refs_) {
-    const uint32_t n = r & ~kSeamBit;
-    r = ((r & kSeamBit) ? seam_vertex_of[2 * ((n >> 1) / w) + (n & 1)] : vertex_of[n]) - 1;
+    r = (r & kSeamBit) ? seam_vertex_of[seam_slot(r)] - 1 : vertex_of(key_of(r));
   }
   mesh.indices = std::move(refs_);
   refs_ = std::vector<NodeRef>();
@@ -276,10 +326,15 @@ Status CheckMeshInput(const TwoLayerPanorama& pano, int64_t max_pixels, bool val
 StatusOr<Mesh> BuildMesh(const TwoLayerPanorama& pano, const MeshBuildOptions& options) {
   CASUAL3D_RETURN_IF_ERROR(options.Check());
   CASUAL3D_RETURN_IF_ERROR(CheckMeshInput(pano, options.max_pixels, options.validate_input));
-  const size_t pixels = static_cast<size_t>(pano.width()) * pano.height();
   MeshAssembler assembler(pano);
-  // About two triangles per pixel when the front layer is fully linked.
-  assembler.Reserve(2 * pixels + 1024);
+  // Counting first costs less than growing a vector of hundreds of megabytes.
+  size_t triangles = 0;
+  for (int y = 0; y + 1 < pano.height(); ++y) {
+    for (int x = 0; x < pano.width(); ++x) {
+      triangles += CountQuadTriangles(pano, x, y, options.include_back_layer, 0u);
+    }
+  }
+  assembler.Reserve(triangles);
   for (int y = 0; y + 1 < pano.height(); ++y) {
     for (int x = 0; x < pano.width(); ++x) {
       AddQuadTriangles(pano, x, y, options.include_back_layer, 0u, &assembler);

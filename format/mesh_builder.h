@@ -39,8 +39,11 @@ struct MeshBuildOptions {
   Status Check() const;
 };
 
-// Builds the mesh of spec/mesh.md: one vertex per node used by a triangle (plus
-// seam duplicates), triangles counter-clockwise seen from the centre. Errors:
+// Builds the mesh of spec/mesh.md: one vertex per node used by a triangle, plus
+// a copy with its uv in the other layer's atlas half where a triangle joining
+// front and back nodes needs it, plus seam copies; triangles counter-clockwise
+// seen from the centre. Every triangle's uvs lie in one half of the atlas
+// (format/colour_atlas.h). Errors:
 // options out of range (kInvalidArgument), panorama larger than
 // options.max_pixels (kLimitExceeded), width below 2 (kInvalidArgument), or
 // an invalid panorama (the status of Validate()).
@@ -52,8 +55,13 @@ Status CheckMeshInput(const TwoLayerPanorama& pano, int64_t max_pixels, bool val
 
 // A reference to a node used while assembling a mesh: (pixel index * 2 + layer),
 // with bit 31 set for the seam copy of a column-0 node (u = 1 + 0.5 / width).
+// MeshAssembler::Finish sets bit 30 internally on references whose uv lies in
+// the other layer's half of the atlas (spec/mesh.md Sec. 4.4); callers never
+// set it.
 using NodeRef = uint32_t;
 constexpr NodeRef kSeamBit = 0x80000000u;
+constexpr NodeRef kOtherHalfBit = 0x40000000u;
+constexpr NodeRef kNodeMask = 0x3fffffffu;
 inline NodeRef MakeNodeRef(const TwoLayerPanorama& p, int x, int y, int layer, bool seam) {
   return static_cast<NodeRef>(p.index(x, y) * 2 + layer) | (seam ? kSeamBit : 0u);
 }
@@ -77,12 +85,18 @@ class MeshAssembler {
   // The triangles added so far, 3 references each.
   const std::vector<NodeRef>& refs() const { return refs_; }
 
-  // Vertices: every referenced regular node in (row, column, layer) order, then
-  // every referenced seam copy in (row, layer) order. Triangles keep the order
-  // in which they were added. Leaves the assembler empty.
+  // Chooses each triangle's atlas half (spec/mesh.md Sec. 4.4), then builds
+  // the vertices: every referenced (node, atlas half) in (row, column, layer,
+  // own half before other half) order, then every referenced seam copy in
+  // (row, layer, half) order. Triangles keep the order in which they were
+  // added. Leaves the assembler empty.
   Mesh Finish();
 
  private:
+  // Marks with kOtherHalfBit the references of every triangle that joins
+  // front and back nodes whose layer is not the triangle's atlas half.
+  void ChooseAtlasHalves();
+
   const TwoLayerPanorama& pano_;
   std::vector<NodeRef> refs_;
 };

@@ -6,6 +6,7 @@
 #include <set>
 #include <tuple>
 
+#include "format/colour_atlas.h"
 #include "format/equirect.h"
 #include "format/testing/mesh_checksum.h"
 #include "format/testing/test_panoramas.h"
@@ -16,15 +17,28 @@ namespace {
 struct NodeId {
   int x, y, layer;
   bool seam;
+  int half;  // The atlas half its uv points into.
 };
 
-// Recovers the node of a vertex from its atlas uv (spec/mesh.md Sec. 3).
-NodeId NodeOfVertex(const Mesh& m, uint32_t v, int w, int h) {
+// Recovers the node of a vertex: its pixel and atlas half from the uv
+// (spec/mesh.md Sec. 3), its layer from the distance of its position to the
+// centre where both layers have a node at that pixel.
+NodeId NodeOfVertex(const TwoLayerPanorama& p, const Mesh& m, uint32_t v) {
+  const int w = p.width(), h = p.height();
   const double u = m.uvs[2 * v] * static_cast<double>(w) - 0.5;
   const double t = m.uvs[2 * v + 1] * 2.0 * h - 0.5;
   const int ux = static_cast<int>(std::lround(u));
   const int row = static_cast<int>(std::lround(t));
-  return {ux % w, row % h, row / h, ux >= w};
+  const int x = ux % w, y = row % h;
+  const size_t i = p.index(x, y);
+  const float* q = &m.positions[3 * v];
+  const double r = std::sqrt(double{q[0]} * q[0] + double{q[1]} * q[1] + double{q[2]} * q[2]);
+  int layer = p.layer(kFront).present[i] ? kFront : kBack;
+  if (p.layer(kFront).present[i] && p.layer(kBack).present[i] &&
+      std::abs(r - p.layer(kBack).depth_m[i]) < std::abs(r - p.layer(kFront).depth_m[i])) {
+    layer = kBack;
+  }
+  return {x, y, layer, ux >= w, row / h};
 }
 
 // Sets a node with depth d and a normal facing the centre.
@@ -54,6 +68,22 @@ TwoLayerPanorama FrontOnly(int w, int h, F depth) {
   return p;
 }
 
+// The number of vertices whose colour differs from the atlas texel at their
+// uv (format/colour_atlas.h), i.e. where atlas texturing shows another colour
+// than the node's at the vertex itself.
+int CountVerticesWithOtherAtlasColour(const TwoLayerPanorama& p, const Mesh& m) {
+  const Image8 atlas = BuildColourAtlas(p);
+  int wrong = 0;
+  for (size_t v = 0; v < m.num_vertices(); ++v) {
+    const int x = static_cast<int>(std::lround(m.uvs[2 * v] * p.width() - 0.5)) % p.width();
+    const int y = static_cast<int>(std::lround(m.uvs[2 * v + 1] * 2.0 * p.height() - 0.5));
+    bool same = true;
+    for (int c = 0; c < 3; ++c) same = same && atlas.at(x, y, c) == m.colors[3 * v + c];
+    wrong += same ? 0 : 1;
+  }
+  return wrong;
+}
+
 bool Linked(const TwoLayerPanorama& p, const NodeId& a, const NodeId& b) {
   for (int d = 0; d < kNumDirections; ++d) {
     int nx, ny;
@@ -71,10 +101,24 @@ void CheckTriangles(const TwoLayerPanorama& p, const Mesh& m) {
   const int w = p.width(), h = p.height();
   for (size_t t = 0; t < m.num_triangles(); ++t) {
     NodeId n[3];
-    for (int k = 0; k < 3; ++k) n[k] = NodeOfVertex(m, m.indices[3 * t + k], w, h);
+    for (int k = 0; k < 3; ++k) n[k] = NodeOfVertex(p, m, m.indices[3 * t + k]);
     int links = 0;
     for (int k = 0; k < 3; ++k) links += Linked(p, n[k], n[(k + 1) % 3]);
     ASSERT_EQ(links, 2) << "triangle " << t;
+    // One atlas half per triangle (spec/mesh.md Sec. 4.4): its layer's if it
+    // has one layer.
+    EXPECT_EQ(n[0].half, n[1].half) << "triangle " << t;
+    EXPECT_EQ(n[0].half, n[2].half) << "triangle " << t;
+    if (n[0].layer == n[1].layer && n[0].layer == n[2].layer) {
+      EXPECT_EQ(n[0].half, n[0].layer) << "triangle " << t;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = m.indices[3 * t + k];
+      const size_t i = p.index(n[k].x, n[k].y);
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(m.colors[3 * v + c], p.layer(n[k].layer).rgb[3 * i + c]) << "vertex " << v;
+      }
+    }
     for (int k = 0; k < 3; ++k) {
       const NodeId& a = n[k];
       const NodeId& b = n[(k + 1) % 3];
@@ -104,12 +148,12 @@ TEST(MeshBuilderTest, FullyLinkedGridGivesTwoTrianglesPerQuadAndSeamCopies) {
   CheckTriangles(p, *mesh);
   // Vertex order: (row, column, layer), then seam copies by row.
   for (uint32_t v = 0; v < 32; ++v) {
-    const NodeId n = NodeOfVertex(*mesh, v, 8, 4);
+    const NodeId n = NodeOfVertex(p, *mesh, v);
     EXPECT_EQ(n.y * 8 + n.x, static_cast<int>(v));
     EXPECT_FALSE(n.seam);
   }
   for (uint32_t v = 32; v < 36; ++v) {
-    const NodeId n = NodeOfVertex(*mesh, v, 8, 4);
+    const NodeId n = NodeOfVertex(p, *mesh, v);
     EXPECT_TRUE(n.seam);
     EXPECT_EQ(n.x, 0);
     EXPECT_EQ(n.y, static_cast<int>(v - 32));
@@ -181,7 +225,7 @@ TEST(MeshBuilderTest, ThreeLinkedCornersGiveOneTriangle) {
   std::set<std::tuple<int, int, int, int, int, int>> tris;
   for (size_t t = 0; t < mesh->num_triangles(); ++t) {
     NodeId n[3];
-    for (int k = 0; k < 3; ++k) n[k] = NodeOfVertex(*mesh, mesh->indices[3 * t + k], 8, 2);
+    for (int k = 0; k < 3; ++k) n[k] = NodeOfVertex(p, *mesh, mesh->indices[3 * t + k]);
     tris.insert({n[0].x, n[0].y, n[1].x, n[1].y, n[2].x, n[2].y});
   }
   EXPECT_TRUE(tris.count({4, 0, 4, 1, 5, 0}));
@@ -210,8 +254,27 @@ TEST(MeshBuilderTest, BackLayerFillsDisocclusion) {
   ASSERT_TRUE(mesh.ok());
   // The background sheet closes over all 8 x 3 quads; the object adds 1 x 3.
   EXPECT_EQ(mesh->num_triangles(), 8u * 3 * 2 + 3 * 2);
-  EXPECT_EQ(mesh->num_vertices(), 32u + 8 + 4);
+  // 32 front and 8 back nodes; the front nodes of columns 2 and 5 that
+  // triangles join to back nodes also have a copy in the back half of the
+  // atlas (which shows their colour there: no back node at their pixels);
+  // 4 seam copies.
+  EXPECT_EQ(mesh->num_vertices(), 32u + 8 + 8 + 4);
   CheckTriangles(p, *mesh);
+  EXPECT_EQ(CountVerticesWithOtherAtlasColour(p, *mesh), 0);
+  // Vertex order: (row, column, layer, own half first). Row 0: (0..2, 0)
+  // front, the back-half copy of (2, 0), (3, 0) front and back, (4, 0) front
+  // and back, (5, 0) front and its copy, (6, 0), (7, 0).
+  const int want[][4] = {{0, 0, kFront, kFront}, {1, 0, kFront, kFront}, {2, 0, kFront, kFront},
+                         {2, 0, kFront, kBack},  {3, 0, kFront, kFront}, {3, 0, kBack, kBack},
+                         {4, 0, kFront, kFront}, {4, 0, kBack, kBack},   {5, 0, kFront, kFront},
+                         {5, 0, kFront, kBack},  {6, 0, kFront, kFront}, {7, 0, kFront, kFront}};
+  for (uint32_t v = 0; v < 12; ++v) {
+    const NodeId n = NodeOfVertex(p, *mesh, v);
+    EXPECT_EQ(n.x, want[v][0]) << "vertex " << v;
+    EXPECT_EQ(n.y, want[v][1]) << "vertex " << v;
+    EXPECT_EQ(n.layer, want[v][2]) << "vertex " << v;
+    EXPECT_EQ(n.half, want[v][3]) << "vertex " << v;
+  }
 
   MeshBuildOptions front_only;
   front_only.include_back_layer = false;
@@ -220,6 +283,49 @@ TEST(MeshBuilderTest, BackLayerFillsDisocclusion) {
   // Quads 2 and 4 straddle the depth edges and stay open.
   EXPECT_EQ(front->num_triangles(), 5u * 3 * 2 + 3 * 2);
   EXPECT_EQ(front->num_vertices(), 32u + 4);
+}
+
+// One quad (spec/mesh.md Sec. 4.4): the corner-B triangle (B front, A back,
+// D front) of quad (0, 0), with back nodes also at B and, if `back_at_d`, at D,
+// so that either atlas half shows some vertex another node's colour.
+TwoLayerPanorama CrossLayerQuad(bool back_at_d) {
+  TwoLayerPanorama p(4, 2);
+  for (int x = 0; x < 2; ++x) {
+    for (int y = 0; y < 2; ++y) SetNode(&p, kFront, x, y, 2.0f);
+  }
+  SetNode(&p, kBack, 0, 0, 3.0f);
+  SetNode(&p, kBack, 1, 0, 3.0f);
+  if (back_at_d) SetNode(&p, kBack, 1, 1, 3.0f);
+  auto link = [&](int l, int x, int y, Direction d, Link to) {
+    uint8_t& links = p.layer(l).links[p.index(x, y)];
+    links = SetLink(links, d, to);
+  };
+  link(kFront, 1, 0, kLeft, Link::kBack);  // B front <-> A back.
+  link(kBack, 0, 0, kRight, Link::kFront);
+  link(kFront, 1, 0, kDown, Link::kFront);  // B front <-> D front.
+  link(kFront, 1, 1, kUp, Link::kFront);
+  return p;
+}
+
+TEST(MeshBuilderTest, CrossLayerTriangleTakesTheHalfWithFewerWrongVertices) {
+  for (bool back_at_d : {false, true}) {
+    SCOPED_TRACE(back_at_d ? "back node at D" : "no back node at D");
+    const TwoLayerPanorama p = CrossLayerQuad(back_at_d);
+    ASSERT_TRUE(p.Validate().ok()) << p.Validate().ToString();
+    auto mesh = BuildMesh(p);
+    ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
+    ASSERT_EQ(mesh->num_triangles(), 1u);
+    ASSERT_EQ(mesh->num_vertices(), 3u);
+    CheckTriangles(p, *mesh);
+    // Back half: B front is wrong (a back node at B); front half: A back is
+    // wrong (a front node at A), and D front too if D has a back node. A tie
+    // takes the back half.
+    const int want_half = back_at_d ? kFront : kBack;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(NodeOfVertex(p, *mesh, mesh->indices[k]).half, want_half);
+    }
+    EXPECT_EQ(CountVerticesWithOtherAtlasColour(p, *mesh), 1);
+  }
 }
 
 TEST(MeshBuilderTest, ProceduralRoomMeshIsConsistentAndDeterministic) {
@@ -232,6 +338,9 @@ TEST(MeshBuilderTest, ProceduralRoomMeshIsConsistentAndDeterministic) {
   EXPECT_EQ(a->indices, b->indices);
   EXPECT_EQ(a->uvs, b->uvs);
   CheckTriangles(p, *a);
+  // Back nodes exist only behind the sphere, so every front node joined to
+  // a back node sits where the back half shows its own colour.
+  EXPECT_EQ(CountVerticesWithOtherAtlasColour(p, *a), 0);
   // Nearly every quad is closed by the front or back sheet; the sphere adds its own.
   EXPECT_GT(a->num_triangles(), 2u * 96 * 47);
   EXPECT_LT(a->num_triangles(), 2u * 96 * 47 + 400);
@@ -301,8 +410,8 @@ TEST(MeshBuilderTest, GoldenChecksum) {
   auto mesh = BuildMesh(testing::MakeBlocksPanorama());
   ASSERT_TRUE(mesh.ok());
   EXPECT_EQ(mesh->num_triangles(), 309166u);
-  EXPECT_EQ(mesh->num_vertices(), 156880u);
-  EXPECT_EQ(testing::MeshChecksum(*mesh), 0xd3093ee1021d7926ull);
+  EXPECT_EQ(mesh->num_vertices(), 159715u);  // 2835 atlas-half copies.
+  EXPECT_EQ(testing::MeshChecksum(*mesh), 0x826f4abbec0b7206ull);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "format/package_reader.h"
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <thread>

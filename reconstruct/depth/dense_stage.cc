@@ -134,6 +134,7 @@ Status MrfTermOptions::Check() const {
   if (!(lambda_near >= 0 && lambda_near <= 100)) return InvalidArgument("lambda_near outside [0, 100]");
   if (!(sigma_color > 0 && sigma_color <= 10)) return InvalidArgument("mrf sigma_color outside (0, 10]");
   if (!(color_floor >= 0 && color_floor <= 1)) return InvalidArgument("mrf color_floor outside [0, 1]");
+  if (!(far_bias >= 0 && far_bias <= 1)) return InvalidArgument("mrf far_bias outside [0, 1]");
   if (truncation_labels < 1 || truncation_labels > 4096)
     return InvalidArgument("truncation_labels outside [1, 4096]");
   if (max_iterations < 1 || max_iterations > 1000) return InvalidArgument("mrf max_iterations outside [1, 1000]");
@@ -287,7 +288,8 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
         const float wp = vol.photo_weight.data()[p];
         const float* c = vol.cost.data() + p * L;
         float* u = mrf.unary.data() + p * L;
-        for (int k = 0; k < L; ++k) u[k] = wp * c[k];
+        const float bias = static_cast<float>(options.mrf.far_bias) * (1.0f - wp) / (L - 1);
+        for (int k = 0; k < L; ++k) u[k] = wp * c[k] + bias * static_cast<float>(L - 1 - k);
         if (near_term) {
           // Eq. 4: labels nearer than the envelope (k < label of n_i) pay lambda_near.
           const double kn = grid.LabelOf(envelope.data()[p]);

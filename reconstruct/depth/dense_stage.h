@@ -36,8 +36,13 @@ namespace casual3d::depth {
 struct MrfTermOptions {
   double lambda_smooth = 0.25;  // Sec. 4.3.1: lambda_smooth. [0, 100].
   double lambda_near = 1.0;     // Sec. 4.3.2: lambda_near (Eq. 4). [0, 100].
-  double sigma_color = 0.06;    // w_color = exp(-|c_i - c_j|^2 / (2 sigma^2)), colour in [0, 1]. (0, 10].
+  double sigma_color = 0.04;    // w_color = exp(-|c_i - c_j|^2 / (2 sigma^2)), colour in [0, 1]. (0, 10].
   double color_floor = 0.02;    // Lower bound of w_color, so strong edges still regularise a little. [0, 1].
+  // Our addition (spec/stage-dense.md): textureless pixels (sky, blank walls)
+  // carry no photo-consistency evidence; a small cost far_bias * (1 - w_photo)
+  // * (1 - k / (L - 1)) on label k leans them away from the camera rather than
+  // letting the smoothness term extend nearby near objects over them. [0, 1].
+  double far_bias = 0.02;
   int truncation_labels = 8;    // w_depth = min(|k_i - k_j|, T) / T, labels (inverse depth). [1, 4096].
   int max_iterations = 8;       // TRW-S passes. [1, 1000].
   bool refine_sublabel = true;  // Parabola fit of E_photo around the chosen label.

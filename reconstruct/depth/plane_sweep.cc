@@ -56,7 +56,7 @@ void BoxMean(const float* in, float* out, int w, int h, int r, float* tmp, float
 // A = K_n R_rel K_ref^-1 and b = K_n t_rel (Hartley & Zisserman, Sec. 13.1).
 struct NeighborWarp {
   const DenseView* view = nullptr;
-  std::vector<float> a;  // A * (u, v, 1) per reference pixel, 3 floats each.
+  float a[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   float b[3] = {0, 0, 0};
 };
 
@@ -137,7 +137,7 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
     vol.photo_weight.data()[i] = var / (var + tsig2);
   }
 
-  // Homography parts per neighbour.
+  // Homography parts per neighbour: A (3x3, float) and b.
   const Eigen::Matrix3d kinv_ref = ref.camera.KInverse();
   std::vector<NeighborWarp> warps(neighbors.size());
   for (size_t j = 0; j < neighbors.size(); ++j) {
@@ -147,17 +147,10 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
     const Eigen::Matrix3d a = nb.camera.K() * r_rel * kinv_ref;
     const Eigen::Vector3d b = nb.camera.K() * t_rel;
     warps[j].view = &nb;
-    warps[j].a.resize(3 * n);
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) {
-        const Eigen::Vector3d p = a * Eigen::Vector3d(x + 0.5, y + 0.5, 1.0);
-        float* dst = &warps[j].a[3 * (static_cast<size_t>(y) * w + x)];
-        dst[0] = static_cast<float>(p[0]);
-        dst[1] = static_cast<float>(p[1]);
-        dst[2] = static_cast<float>(p[2]);
-      }
+    for (int rr = 0; rr < 3; ++rr) {
+      for (int c = 0; c < 3; ++c) warps[j].a[rr][c] = static_cast<float>(a(rr, c));
+      warps[j].b[rr] = static_cast<float>(b[rr]);
     }
-    for (int c = 0; c < 3; ++c) warps[j].b[c] = static_cast<float>(b[c]);
   }
 
   // Plane-major scratch volume: each plane is written by one thread.
@@ -166,46 +159,101 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
   const int best_k = std::min(options.best_k, num_nb);
   std::atomic<int> next_plane(0);
   auto worker = [&]() {
-    std::vector<float> j_img(n), jj(n), ij(n), mean_j(n), mean_jj(n), mean_ij(n), t(n), a(w);
+    // Horizontal window sums of J, J^2 and I*J (one image each), one warped row,
+    // the vertical accumulators, and the per-neighbour costs of one plane.
+    std::vector<float> hj(n), hjj(n), hij(n), jrow(w), acc_j(w), acc_jj(w), acc_ij(w);
     std::vector<float> nb_cost(n * num_nb);
     for (;;) {
       const int k = next_plane.fetch_add(1);
       if (k >= num_labels) break;
       const float inv_d = static_cast<float>(vol.InvDepthOfLabel(k));
       for (int j = 0; j < num_nb; ++j) {
-        const DenseView& nb = *warps[j].view;
-        const int nw = nb.gray.width(), nh = nb.gray.height();
-        const float* src = nb.gray.data();
-        const float* pa = warps[j].a.data();
-        const float b0 = warps[j].b[0] * inv_d, b1 = warps[j].b[1] * inv_d,
-                    b2 = warps[j].b[2] * inv_d;
+        const NeighborWarp& wp = warps[j];
+        const int nw = wp.view->gray.width(), nh = wp.view->gray.height();
+        const float* src = wp.view->gray.data();
         float* cost = nb_cost.data() + static_cast<size_t>(j) * n;
-        // Warp the neighbour into the reference through the plane.
-        for (size_t i = 0; i < n; ++i) {
-          const float pz = pa[3 * i + 2] + b2;
-          float u = -1e9f, v = -1e9f;
-          if (pz > 1e-9f) {
-            const float iz = 1.0f / pz;
-            u = (pa[3 * i] + b0) * iz - 0.5f;
-            v = (pa[3 * i + 1] + b1) * iz - 0.5f;
+        // Warp row by row (x_n ~ A (u, v, 1) + b / d is affine in u along a
+        // row) and take horizontal window sums right away.
+        for (int y = 0; y < h; ++y) {
+          const float v = y + 0.5f;
+          const float* gi_row = gi + static_cast<size_t>(y) * w;
+          float* cost_row = cost + static_cast<size_t>(y) * w;
+          const float px0 = wp.a[0][1] * v + wp.a[0][2] + wp.b[0] * inv_d + wp.a[0][0] * 0.5f;
+          const float py0 = wp.a[1][1] * v + wp.a[1][2] + wp.b[1] * inv_d + wp.a[1][0] * 0.5f;
+          const float pz0 = wp.a[2][1] * v + wp.a[2][2] + wp.b[2] * inv_d + wp.a[2][0] * 0.5f;
+          for (int x = 0; x < w; ++x) {
+            // One rounding per coordinate (no accumulated drift along the row).
+            const float px = px0 + wp.a[0][0] * x;
+            const float py = py0 + wp.a[1][0] * x;
+            const float pz = pz0 + wp.a[2][0] * x;
+            float val = 0.0f;
+            bool inside = false;
+            if (pz > 1e-9f) {
+              const float iz = 1.0f / pz;
+              const float u = px * iz - 0.5f, vv = py * iz - 0.5f;
+              inside = u >= -0.5f && vv >= -0.5f && u <= nw - 0.5f && vv <= nh - 0.5f;
+              if (inside) val = Bilinear(src, nw, nh, u, vv);
+            }
+            cost_row[x] = inside ? 0.0f : kInvalidCost;
+            jrow[x] = val;
           }
-          const bool inside = u >= -0.5f && v >= -0.5f && u <= nw - 0.5f && v <= nh - 0.5f;
-          cost[i] = inside ? 0.0f : kInvalidCost;
-          const float val = inside ? Bilinear(src, nw, nh, u, v) : 0.0f;
-          j_img[i] = val;
-          jj[i] = val * val;
-          ij[i] = val * gi[i];
+          float* dj = hj.data() + static_cast<size_t>(y) * w;
+          float* djj = hjj.data() + static_cast<size_t>(y) * w;
+          float* dij = hij.data() + static_cast<size_t>(y) * w;
+          float sj = 0.0f, sjj = 0.0f, sij = 0.0f;
+          for (int x = 0; x < std::min(r, w); ++x) {
+            sj += jrow[x];
+            sjj += jrow[x] * jrow[x];
+            sij += jrow[x] * gi_row[x];
+          }
+          for (int x = 0; x < w; ++x) {
+            if (x + r < w) {
+              const float a = jrow[x + r];
+              sj += a;
+              sjj += a * a;
+              sij += a * gi_row[x + r];
+            }
+            if (x - r - 1 >= 0) {
+              const float a = jrow[x - r - 1];
+              sj -= a;
+              sjj -= a * a;
+              sij -= a * gi_row[x - r - 1];
+            }
+            dj[x] = sj;
+            djj[x] = sjj;
+            dij[x] = sij;
+          }
         }
-        BoxMean(j_img.data(), mean_j.data(), w, h, r, t.data(), a.data(), inv_count.data());
-        BoxMean(jj.data(), mean_jj.data(), w, h, r, t.data(), a.data(), inv_count.data());
-        BoxMean(ij.data(), mean_ij.data(), w, h, r, t.data(), a.data(), inv_count.data());
-        for (size_t i = 0; i < n; ++i) {
-          const float mj = mean_j[i];
-          const float var_j = std::max(0.0f, mean_jj[i] - mj * mj);
-          const float cov = mean_ij[i] - mean_i[i] * mj;
-          const float ncc = cov * inv_std_i[i] / std::sqrt(var_j + eps);
-          const float c = std::min(1.0f, std::max(0.0f, 1.0f - ncc));
-          cost[i] = cost[i] == 0.0f ? c : kInvalidCost;
+        // Vertical window sums over whole rows (contiguous, vectorisable),
+        // fused with the ZNCC.
+        std::fill(acc_j.begin(), acc_j.end(), 0.0f);
+        std::fill(acc_jj.begin(), acc_jj.end(), 0.0f);
+        std::fill(acc_ij.begin(), acc_ij.end(), 0.0f);
+        auto add_row = [&](int yy, float sign) {
+          const size_t o = static_cast<size_t>(yy) * w;
+          for (int x = 0; x < w; ++x) {
+            acc_j[x] += sign * hj[o + x];
+            acc_jj[x] += sign * hjj[o + x];
+            acc_ij[x] += sign * hij[o + x];
+          }
+        };
+        for (int y = 0; y < std::min(r, h); ++y) add_row(y, 1.0f);
+        for (int y = 0; y < h; ++y) {
+          if (y + r < h) add_row(y + r, 1.0f);
+          if (y - r - 1 >= 0) add_row(y - r - 1, -1.0f);
+          const size_t o = static_cast<size_t>(y) * w;
+          const float* ic = inv_count.data() + o;
+          const float* mi = mean_i.data() + o;
+          const float* isi = inv_std_i.data() + o;
+          float* c = cost + o;
+          for (int x = 0; x < w; ++x) {
+            const float mj = acc_j[x] * ic[x];
+            const float var_j = std::max(0.0f, acc_jj[x] * ic[x] - mj * mj);
+            const float cov = acc_ij[x] * ic[x] - mi[x] * mj;
+            const float ncc = cov * isi[x] / std::sqrt(var_j + eps);
+            const float e = std::min(1.0f, std::max(0.0f, 1.0f - ncc));
+            c[x] = c[x] == 0.0f ? e : kInvalidCost;
+          }
         }
       }
       // Occlusion-robust aggregation: mean of the best_k valid neighbours.
@@ -223,9 +271,9 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
         }
         const int kk = std::min(best_k, m);
         std::partial_sort(c, c + kk, c + m);
-        float s = 0.0f;
-        for (int q = 0; q < kk; ++q) s += c[q];
-        plane[i] = s / kk;
+        float sum = 0.0f;
+        for (int q = 0; q < kk; ++q) sum += c[q];
+        plane[i] = sum / kk;
       }
     }
   };

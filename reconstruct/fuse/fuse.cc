@@ -14,7 +14,10 @@ float DepthRatio(float a, float b) { return a < b ? a / b : b / a; }
 
 class Graph {
  public:
-  Graph(TwoLayerPanorama* pano, float tau) : pano_(*pano), tau_(tau) {}
+  Graph(TwoLayerPanorama* pano, const FuseOptions& options)
+      : pano_(*pano), tau_(static_cast<float>(options.tau_dratio)),
+        tau_grazing_(static_cast<float>(options.tau_grazing)),
+        smooth_tolerance_(static_cast<float>(options.smooth_tolerance)) {}
 
   bool present(int layer, size_t i) const { return pano_.layer(layer).present[i] != 0; }
   float depth(int layer, size_t i) const { return pano_.layer(layer).depth_m[i]; }
@@ -54,16 +57,42 @@ class Graph {
     // Most similar first; ties keep the (front, front), (front, back), ... order.
     std::stable_sort(pairs, pairs + count,
                      [](const Pair& a, const Pair& b) { return a.ratio > b.ratio; });
-    if (!(pairs[0].ratio > tau_)) return;
+    if (!OneSurface(x, y, d, nx, ny, pairs[0].lp, pairs[0].lq, pairs[0].ratio)) return;
     Connect(p, pairs[0].lp, d, q, pairs[0].lq);
     if (pairs[0].lp != pairs[0].lq) return;  // A crossing pair leaves no non-crossing partner.
     const int other = 1 - pairs[0].lp;
     for (int k = 1; k < count; ++k) {
       if (pairs[k].lp == other && pairs[k].lq == other) {
-        if (pairs[k].ratio > tau_) Connect(p, other, d, q, other);
+        if (OneSurface(x, y, d, nx, ny, other, other, pairs[k].ratio)) {
+          Connect(p, other, d, q, other);
+        }
         break;
       }
     }
+  }
+
+  // Whether node lp at (x, y) and node lq at its neighbour (nx, ny) in
+  // direction d show one surface (see FuseOptions).
+  bool OneSurface(int x, int y, Direction d, int nx, int ny, int lp, int lq, float ratio) const {
+    if (ratio > tau_) return true;
+    if (!(ratio > tau_grazing_)) return false;
+    const size_t p = pano_.index(x, y), q = pano_.index(nx, ny);
+    const float step = std::log(depth(lq, q) / depth(lp, p));
+    int ox, oy;
+    if (pano_.Neighbour(x, y, Opposite(d), &ox, &oy)) {  // The step before p.
+      const size_t o = pano_.index(ox, oy);
+      if (present(lp, o) && std::abs(step - std::log(depth(lp, p) / depth(lp, o))) <= smooth_tolerance_) {
+        return true;
+      }
+    }
+    int rx, ry;
+    if (pano_.Neighbour(nx, ny, d, &rx, &ry)) {  // The step after q.
+      const size_t r = pano_.index(rx, ry);
+      if (present(lq, r) && std::abs(step - std::log(depth(lq, r) / depth(lq, q))) <= smooth_tolerance_) {
+        return true;
+      }
+    }
+    return false;
   }
 
   void ConnectAround(int x, int y) {
@@ -80,7 +109,7 @@ class Graph {
   }
 
   TwoLayerPanorama& pano_;
-  float tau_;
+  float tau_, tau_grazing_, smooth_tolerance_;
 };
 
 void ClearNode(LayerData* layer, size_t i) {
@@ -99,6 +128,10 @@ std::string FuseOptions::Check() const {
   if (!(tau_dratio > 0 && tau_dratio < 1)) {
     return "tau_dratio " + std::to_string(tau_dratio) + ": must be in (0, 1)";
   }
+  if (!(tau_grazing > 0 && tau_grazing <= tau_dratio)) {
+    return "tau_grazing " + std::to_string(tau_grazing) + ": must be in (0, tau_dratio]";
+  }
+  if (!(smooth_tolerance >= 0)) return "smooth_tolerance: must be >= 0";
   if (!(expansion_fraction >= 0 && expansion_fraction <= 0.25)) {
     return "expansion_fraction: must be in [0, 0.25]";
   }
@@ -164,7 +197,7 @@ TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options, FuseSt
   }
 
   // Step 2: connectivity of every edge (right and down cover all of them).
-  Graph graph(&pano, tau);
+  Graph graph(&pano, options);
   for (int y = 0; y < H; ++y) {
     for (int x = 0; x < W; ++x) {
       graph.ConnectEdge(x, y, kRight);

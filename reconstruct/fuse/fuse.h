@@ -9,8 +9,9 @@
 //      here is d(f)/d(b) > tau.)
 //   2. Recompute connectivity: for each pair of 4-neighbouring pixels, all
 //      front/back node pairs are sorted by depth ratio, most similar first; the
-//      most similar pair is linked if its ratio exceeds tau, and the other pair
-//      too if it does not cross the first (front-front with back-back).
+//      most similar pair is linked if it is one surface (ratio above tau, or
+//      above tau_grazing and smooth), and the other pair too if it does not
+//      cross the first (front-front with back-back).
 //   3. Grow the back layer ring by ring: a node without a link towards a
 //      neighbour spawns a candidate there with the mean depth and colour of its
 //      spawners; the candidate is kept where the neighbour has a front node
@@ -31,8 +32,19 @@
 namespace casual3d::fuse {
 
 struct FuseOptions {
-  // Sec. 4.4.3: depth ratio (min / max) above which two nodes are one surface; (0, 1).
-  double tau_dratio = 0.75;
+  // Depth ratio (min / max) above which two nodes are one surface; (0, 1).
+  // Sec. 4.4.3 uses 0.75 at 8192 px; at that ratio, edges of up to 33% in
+  // depth (a tree 10 m in front of a wall at 12 m) would be closed and get no
+  // back layer, so the default is 0.9 and 0.75 applies to smooth surfaces
+  // only (tau_grazing).
+  double tau_dratio = 0.9;
+  // Neighbours whose depth ratio lies in (tau_grazing, tau_dratio] are linked
+  // when the depths continue smoothly along the grid axis (a surface seen at a
+  // grazing angle, such as the ground towards the horizon): the log-depth step
+  // p -> q differs by at most smooth_tolerance from the step before p or after
+  // q in the same layer. (0, tau_dratio].
+  double tau_grazing = 0.75;
+  double smooth_tolerance = 0.02;  // In log depth; >= 0.
   // Rings of back-layer growth, as a fraction of the panorama width
   // (0.01 at 4096 px: 41 rings, enough for about 10 cm of head motion with a
   // foreground at 1 m); >= 0.

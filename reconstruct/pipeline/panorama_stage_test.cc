@@ -7,6 +7,7 @@
 
 #include "encoder/master_file.h"
 #include "reconstruct/io/exr_io.h"
+#include "reconstruct/pipeline/ground_truth_eval.h"
 #include "reconstruct/synth/synth.h"
 
 namespace casual3d::pipeline {
@@ -24,7 +25,7 @@ fs::path TempDir(const std::string& name) {
 // Runs the panorama stage on a small synthetic capture with its ground-truth
 // depth maps and compares the front layer with the ground-truth panorama.
 void CheckAgainstGroundTruth(synth::RigKind rig, int photos, double min_within_3pct,
-                             double min_coverage) {
+                             double min_coverage, double min_back_near_edges) {
   const fs::path dir = TempDir(rig == synth::RigKind::kSphere ? "pano_sphere" : "pano_partial");
   synth::SynthOptions synth_options;
   synth_options.rig = rig;
@@ -68,16 +69,24 @@ void CheckAgainstGroundTruth(synth::RigKind rig, int photos, double min_within_3
               covered, static_cast<double>(covered) / finite);
   EXPECT_GE(frac, min_within_3pct);
   EXPECT_GE(static_cast<double>(covered) / finite, min_coverage);
+  const GroundTruthComparison c =
+      CompareWithGroundTruthFile(pano, (dir / "ground_truth" / "panorama.exr").string());
+  EXPECT_EQ(c.front_covered, covered);
+  EXPECT_EQ(c.front_within_3pct, within);
+  std::printf("back behind %.4f of %ld edge pixels; links across edges %ld of %ld\n",
+              c.BackNearEdges(), c.back_edge_pixels, c.edge_pairs_linked, c.edge_pairs);
+  EXPECT_GE(c.BackNearEdges(), min_back_near_edges);
+  EXPECT_LE(c.LinksAcrossEdges(), 0.01);
   fs::remove_all(dir);
 }
 
 TEST(PanoramaStageTest, PartialCaptureWithGroundTruthDepthMatchesGroundTruthPanorama) {
-  CheckAgainstGroundTruth(synth::RigKind::kPartial, 16, 0.95, 0.05);
+  CheckAgainstGroundTruth(synth::RigKind::kPartial, 16, 0.95, 0.05, 0.5);
 }
 
 TEST(PanoramaStageTest, SphereCaptureWithGroundTruthDepthMatchesGroundTruthPanorama) {
   // The sphere rig's two rings see latitudes up to about +-60 degrees: 70% of the sphere.
-  CheckAgainstGroundTruth(synth::RigKind::kSphere, 50, 0.95, 0.70);
+  CheckAgainstGroundTruth(synth::RigKind::kSphere, 50, 0.95, 0.70, 0.7);
 }
 
 TEST(PanoramaStageTest, MissingDepthMapIsAClearError) {

@@ -11,7 +11,9 @@
 #include "encoder/master_file.h"
 #include "encoder/package_writer.h"
 #include "format/sha256.h"
+#include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/io/file_util.h"
+#include "reconstruct/pipeline/holdout.h"
 #include "reconstruct/util/log.h"
 
 namespace casual3d::pipeline {
@@ -132,6 +134,7 @@ std::string PipelineOptions::Check() const {
   }
   if (!(color_quality >= 0 && color_quality <= 100)) return "color_quality: must be in [0, 100]";
   if (num_threads < 0) return "num_threads: must be >= 0";
+  if (holdout_every < 0 || holdout_every > 1000) return "holdout_every: must be in [0, 1000]";
   Status s = sparse.Check();
   if (!s.ok()) return s.message();
   s = dense.Check();
@@ -166,7 +169,24 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
   }
   keys[0] = HashHex(std::string(kStageVersions[0]) + "\n" + fs::absolute(input).string() + "\n" +
                     InputFingerprint(input) + SparseOptionsText(options.sparse));
-  keys[1] = HashHex(std::string(kStageVersions[1]) + "\n" + keys[0] + "\n" + DenseOptionsText(options.dense));
+  keys[1] = HashHex(std::string(kStageVersions[1]) + "\n" + keys[0] + "\n" + DenseOptionsText(options.dense) +
+                    (options.holdout_every > 0 ? "\nholdout " + std::to_string(options.holdout_every) : ""));
+  // The dense and panorama stages read the training workspace (holdout.h)
+  // when photos are held out, written once the sparse output exists.
+  std::vector<std::string> holdout;
+  fs::path train_dir;
+  const auto input_workspace = [&]() -> fs::path {
+    if (options.holdout_every <= 0) return dirs[0];
+    if (train_dir.empty()) {
+      std::vector<std::string> names;
+      for (const auto& [id, image] : geometry::ReadModel((dirs[0] / "sparse").string()).images)
+        names.push_back(image.name);
+      holdout = HoldoutNames(names, options.holdout_every);
+      train_dir = work / "train";
+      WriteTrainingWorkspace(dirs[0].string(), holdout, train_dir.string());
+    }
+    return train_dir;
+  };
   keys[2] = HashHex(std::string(kStageVersions[2]) + "\n" + keys[1] + "\n" +
                     PanoramaOptionsText(options.panorama));
   keys[3] = HashHex(std::string(kStageVersions[3]) + "\n" + keys[2] + "\n" +
@@ -213,7 +233,8 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
       }
       case Stage::kDense: {
         RunIntoFolder(dirs[s], key_paths[s], keys[s], [&](const fs::path& tmp) {
-          const depth::DenseReport r = depth::RunDenseStage(dirs[0].string(), tmp.string(), options.dense);
+          const depth::DenseReport r =
+              depth::RunDenseStage(input_workspace().string(), tmp.string(), options.dense);
           stage_json["dense"] = {{"photos", r.photos.size()}, {"seconds", r.seconds_total}};
         });
         break;
@@ -221,7 +242,8 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
       case Stage::kPanorama: {
         RunIntoFolder(dirs[s], key_paths[s], keys[s], [&](const fs::path& tmp) {
           PanoramaStageReport r;
-          RunPanoramaStage(dirs[0].string(), dirs[1].string(), tmp.string(), options.panorama, &r);
+          RunPanoramaStage(input_workspace().string(), dirs[1].string(), tmp.string(), options.panorama,
+                           &r);
           stage_json["panorama"] = {{"width", r.width},
                                     {"front_coverage", r.front_coverage},
                                     {"back_nodes", r.fuse.back_nodes_in - r.fuse.back_nodes_redundant +
@@ -276,6 +298,11 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
     j["stages"].push_back({{"stage", r.stage}, {"cached", r.cached}, {"ran", r.ran}, {"seconds", r.seconds}});
   }
   j["results"] = stage_json;
+  if (options.holdout_every > 0 && fs::exists(dirs[0] / "sparse", ec)) {
+    input_workspace();
+    j["holdout_every"] = options.holdout_every;
+    j["holdout"] = holdout;
+  }
   io::WriteFileAtomic((root / "report.json").string(), j.dump(2) + "\n");
   return report;
 }

@@ -43,6 +43,10 @@ struct PipelineOptions {
   Stage from = Stage::kSparse;
   Stage to = Stage::kEncode;
   bool force = false;  // Recompute the selected stages even if cached.
+  // Held-out views (holdout.h): > 0 registers every photo but builds the 3D
+  // photo without photos 0, n, 2n, ... of the sorted names (listed in
+  // report.json as "holdout"), for `casual3d evaluate`. [0, 1000]; 0 = none.
+  int holdout_every = 0;
   int num_threads = 0; // 0 = all cores; passed to every stage.
   // Called with OUT/web after the package is written there (the command-line
   // program adds the viewer page and its files); may be empty.

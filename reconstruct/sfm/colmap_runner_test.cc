@@ -9,7 +9,6 @@
 
 #include <gtest/gtest.h>
 
-#include "reconstruct/sfm/exif.h"
 
 namespace casual3d::sfm {
 namespace {
@@ -84,20 +83,6 @@ TEST_F(RunColmapTest, FindColmapExplainsHowToInstall) {
   }
   const std::string fake = FakeColmap("exit 0");
   EXPECT_EQ(FindColmap(fake), fake);
-}
-
-TEST(ExifFocalTest, ThirtyFiveMillimetreEquivalentUsesTheDiagonal) {
-  ExifInfo exif;
-  exif.focal_35mm = 28;  // iPhone X wide camera.
-  // 4032x3024 has a 5040 px diagonal: 28 * 5040 / 43.267 = 3261.6 px, and the
-  // same field of view at a 1265x949 working size.
-  EXPECT_NEAR(FocalPixelsFromExif(exif, 4032, 3024, 4032), 3261.6, 0.1);
-  EXPECT_NEAR(FocalPixelsFromExif(exif, 1265, 949, 4032), 3261.6 * 1265 / 4032, 0.5);
-  ExifInfo no_35;
-  no_35.focal_mm = 4.0;
-  no_35.focal_plane_px_per_mm = 800;  // 3200 px at the stored size of 4000 px.
-  EXPECT_NEAR(FocalPixelsFromExif(no_35, 1000, 750, 4000), 800.0, 1e-9);
-  EXPECT_EQ(FocalPixelsFromExif(ExifInfo{}, 1000, 750, 1000), 0.0);
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include <dirent.h>
 
 #include <algorithm>
+
+#include <Eigen/SVD>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -190,9 +192,36 @@ PoseComparison ComparePoses(const std::map<std::string, geometry::Pose>& estimat
     throw std::runtime_error("pose comparison: only " + std::to_string(names.size()) +
                              " photos in common; need 3");
   }
-  if (!geometry::EstimateSimilarity(src, dst, &c.alignment)) {
-    throw std::runtime_error("pose comparison: camera centres are degenerate (collinear)");
+  // Rotation: the chordal L2 mean of the per-photo rotations that map the
+  // estimate's world into the reference's (R = R_ref^T R_est for each photo).
+  // The camera centres of a casual capture lie on a small cap (Sec. 4.1: a
+  // 0.3 m arm), which fixes this rotation far less well than the photos'
+  // orientations do; a rotation taken from the centres (Umeyama) would put
+  // its own error into every photo's rotation and centre error.
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  for (const auto& name : names) {
+    sum += reference.at(name).R().transpose() * estimated.at(name).R();
   }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
+  fix(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  c.alignment.R = svd.matrixU() * fix * svd.matrixV().transpose();
+  // Scale and translation: least squares on the centres given R.
+  Eigen::Vector3d mean_src = Eigen::Vector3d::Zero(), mean_dst = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < names.size(); ++i) {
+    mean_src += src[i] / names.size();
+    mean_dst += dst[i] / names.size();
+  }
+  double num = 0, den = 0;
+  for (size_t i = 0; i < names.size(); ++i) {
+    num += (c.alignment.R * (src[i] - mean_src)).dot(dst[i] - mean_dst);
+    den += (src[i] - mean_src).squaredNorm();
+  }
+  if (!(den > 1e-24) || !(num > 0)) {
+    throw std::runtime_error("pose comparison: camera centres are degenerate (all equal)");
+  }
+  c.alignment.scale = num / den;
+  c.alignment.t = mean_dst - c.alignment.scale * (c.alignment.R * mean_src);
   for (size_t i = 0; i < names.size(); ++i) {
     const geometry::Pose aligned = c.alignment.ApplyToPose(estimated.at(names[i]));
     const geometry::Pose& ref = reference.at(names[i]);

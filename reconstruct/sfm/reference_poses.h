@@ -60,10 +60,11 @@ struct PoseComparison {
   double reference_spread = 0;
 };
 
-// Aligns the estimated camera centres to the reference ones by a least-squares
-// similarity and reports rotation and centre errors of the aligned estimate.
-// Throws std::runtime_error if fewer than 3 photos are common or the centres
-// are degenerate (collinear).
+// Aligns the estimate to the reference by a similarity y = s R x + t: R is the
+// chordal mean of the photos' relative rotations (R_ref^T R_est), s and t the
+// least-squares fit of the camera centres given R. Then reports rotation and
+// centre errors of the aligned estimate. Throws std::runtime_error if fewer
+// than 3 photos are common or the centres all coincide.
 PoseComparison ComparePoses(const std::map<std::string, geometry::Pose>& estimated,
                             const std::map<std::string, geometry::Pose>& reference);
 

@@ -103,6 +103,12 @@ std::string LastLines(const std::string& text) {
   return pos == std::string::npos ? s : s.substr(pos + 1);
 }
 
+std::string NothingRegisteredMessage(int num_photos) {
+  return "COLMAP registered none of the " + std::to_string(num_photos) +
+         " photos (no initial pair found); take more photos with more overlap (each scene "
+         "point in 3 or more photos) of a textured scene, and move the camera between shots";
+}
+
 // The temporary output folder and its clean-up on failure.
 class StagingDir {
  public:
@@ -178,6 +184,10 @@ class ColmapSteps {
     };
     const ColmapResult r = RunColmap(colmap_, command, args, log_path_, on_line);
     if (InterruptRequested()) throw std::runtime_error("interrupted during COLMAP " + command);
+    if (r.signal == 0 && r.exit_code != 0 && command == "mapper" &&
+        r.last_lines.find("failed to create sparse model") != std::string::npos) {
+      throw std::runtime_error(NothingRegisteredMessage(num_images_));
+    }
     if (r.signal != 0 || r.exit_code != 0) {
       throw std::runtime_error("COLMAP " + command + " failed (" + DescribeExit(r) +
                                "): " + LastLines(r.last_lines) + " [full log kept next to the output]");
@@ -229,6 +239,7 @@ Json OptionsJson(const SparseStageOptions& o) {
           {"sequential_overlap", o.sequential_overlap},
           {"max_features", o.max_features},
           {"num_threads", o.num_threads},
+          {"init_min_tri_angle_deg", o.init_min_tri_angle_deg},
           {"min_registered_fraction", o.min_registered_fraction},
           {"depth_ranges",
            {{"near_percentile", o.depth_ranges.near_percentile},
@@ -266,6 +277,10 @@ Status SparseStageOptions::Check() const {
   }
   if (num_threads < 0 || num_threads > 1024) {
     return InvalidArgument("num_threads " + std::to_string(num_threads) + " is outside [0, 1024]");
+  }
+  if (!(init_min_tri_angle_deg >= 0.5 && init_min_tri_angle_deg <= 60)) {
+    return InvalidArgument("init_min_tri_angle_deg " + std::to_string(init_min_tri_angle_deg) +
+                           " is outside [0.5, 60]");
   }
   if (!(min_registered_fraction >= 0 && min_registered_fraction <= 1)) {
     return InvalidArgument("min_registered_fraction " + std::to_string(min_registered_fraction) +
@@ -406,19 +421,15 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
     fs::create_directories(mapped);
     steps.Run("mapper",
               {"--database_path", db, "--image_path", image_dir.string(), "--output_path",
-               mapped.string(), "--Mapper.num_threads", threads},
+               mapped.string(), "--Mapper.num_threads", threads, "--Mapper.init_min_tri_angle",
+               FormatNumber(options.init_min_tri_angle_deg)},
               "mapping");
     std::vector<fs::path> models;
     for (const auto& entry : fs::directory_iterator(mapped, ec)) {
       if (entry.is_directory() && HasModelFiles(entry.path())) models.push_back(entry.path());
     }
     std::sort(models.begin(), models.end());
-    if (models.empty()) {
-      throw std::runtime_error(
-          "COLMAP registered none of the " + std::to_string(n) +
-          " photos (no initial pair found); take more photos with more overlap (each scene "
-          "point in 3 or more photos) of a textured scene, and move the camera between shots");
-    }
+    if (models.empty()) throw std::runtime_error(NothingRegisteredMessage(n));
     auto [dir, model] = LargestModel(models);
     model_dir = dir;
     raw_model = std::move(model);

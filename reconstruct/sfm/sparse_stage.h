@@ -52,10 +52,16 @@ struct SparseStageOptions {
   MatcherType matcher = MatcherType::kAuto;
   int exhaustive_max_photos = 60;  // Range [3, 1e5]; kAuto's switch-over.
   int sequential_overlap = 10;     // Range [1, 1000]; neighbours matched by kSequential.
-  // SIFT features per photo. 4096 (half COLMAP's default) suits ~1.2 MP photos
-  // and quarters CPU matching time, which grows with its square.
-  int max_features = 4096;  // Range [500, 1e5].
+  // SIFT features per photo (COLMAP's default). COLMAP keeps the coarsest
+  // features when it caps them; 4096 lost the default synthetic capture's
+  // registration, at a quarter of the matching time (which grows with the square).
+  int max_features = 8192;  // Range [500, 1e5].
   int num_threads = 0;             // Range [0, 1024]; 0 = all cores.
+  // Smallest triangulation angle of the mapper's initial pair, degrees.
+  // COLMAP's 16 suits walk-around captures; a casual capture's photos sit on a
+  // ~0.3 m arm (Sec. 4.1) and see the scene from a few degrees apart, so the
+  // default pair search fails or starts from a poor pair.
+  double init_min_tri_angle_deg = 4.0;  // Range [0.5, 60].
   // Fewer registered photos than this fraction of the input is an error; any
   // unregistered photo is a warning.
   double min_registered_fraction = 0.5;  // Range [0, 1].

@@ -106,6 +106,15 @@ TEST_F(SparseStageTest, SkipUnreadableGoesOnWithoutTheBrokenPhoto) {
   ExpectFailure({"registered none of the 3 photos"});  // Only the 3 good ones went on.
 }
 
+TEST_F(SparseStageTest, PhotosOfDifferentCameras) {
+  WritePhotos(3);  // p0..p2 at 320x240.
+  cv::Mat other(480, 640, CV_8UC3, cv::Scalar(10, 200, 30));
+  cv::imwrite((root_ / "photos" / "z.jpg").string(), other);
+  ExpectFailure({"2 different cameras", "640x480", "z.jpg", "--mixed-cameras"});
+  options_.import.allow_mixed_devices = true;
+  ExpectFailure({"registered none of the 4 photos"});
+}
+
 TEST_F(SparseStageTest, ExistingOutputIsKept) {
   WritePhotos(3);
   fs::create_directories(out_);

@@ -84,6 +84,7 @@ Scene BuildDefaultScene(uint64_t seed) {
   std::vector<Primitive> p;
   // Ground: a 45 m disc, 1 m thick, top at y = 0.
   p.push_back(MakeCylinder({0, -1.0, 0}, {0, 0.0, 0}, 45.0, kGround));
+  p.back().is_ground = true;
 
   // --- Near objects in the forward view (0.6-2 m from the rig centre). ---
   // Stone pedestal with a ball on top (depth edges against the far scene).

@@ -33,7 +33,8 @@ GroundTruthPanorama RenderGroundTruthPanorama(const Scene& scene, const Panorama
       const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, width, height);
       const Eigen::Vector3d dir = (pano_to_world * Eigen::Vector3d(d.x, d.y, d.z)).normalized();
       Hit hits[2];
-      const int found = scene.TraceTwoSurfaces(centre, dir, &hits[0], &hits[1]);
+      bool into_ground = false;
+      const int found = scene.TraceTwoSurfaces(centre, dir, &hits[0], &hits[1], &into_ground);
       float* px = &out.pixels.at(x, y, 0);
       for (int layer = 0; layer < 2; ++layer) {
         float* v = px + layer * (kBackR - kFrontR);
@@ -45,7 +46,7 @@ GroundTruthPanorama RenderGroundTruthPanorama(const Scene& scene, const Panorama
             v[kFrontNX + k] = static_cast<float>(n[k]);
           }
           v[kFrontZ] = static_cast<float>(hits[layer].t);
-        } else if (layer == found) {
+        } else if (layer == found && !into_ground) {
           const Eigen::Vector3d c = scene.Sky(dir);
           for (int k = 0; k < 3; ++k) {
             v[kFrontR + k] = static_cast<float>(c[k]);

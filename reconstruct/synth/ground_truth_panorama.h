@@ -13,7 +13,8 @@
 //   back.R back.G back.B back.Z back.NX back.NY back.NZ  the same for the second
 //     surface: the sky (Z = +inf, normal 0) when the ray leaves the first solid
 //     into the open; Z = NaN and colour and normal 0 where there is no second
-//     surface (the first is the sky).
+//     surface (the first is the sky, or the ray ends in the ground, which is
+//     solid all the way down).
 // The moving object, if any, is where it is in the first photo.
 
 #include <array>

@@ -22,6 +22,9 @@ struct Primitive {
   Eigen::Vector3d half = Eigen::Vector3d::Ones();
   int material = 0;  // Index into the scene's materials.
   bool is_moving = false;  // The object that moves during the capture.
+  // The ground: solid matter continues below it, so a ray that enters it has
+  // no second surface (see Scene::TraceTwoSurfaces).
+  bool is_ground = false;
 };
 
 // A ray-solid intersection interval. `face` identifies the entry face (box:

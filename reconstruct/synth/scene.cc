@@ -162,13 +162,13 @@ bool Scene::TraceClosest(const Eigen::Vector3d& origin, const Eigen::Vector3d& d
 }
 
 int Scene::TraceTwoSurfaces(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Hit* first,
-                            Hit* second) const {
+                            Hit* second, bool* into_ground) const {
   struct Entry {
     Interval iv;
     int prim;
   };
-  std::vector<Entry> entries;
-  entries.reserve(16);
+  thread_local std::vector<Entry> entries;
+  entries.clear();
   Traverse(origin, dir, kInf, [&](int p) {
     Interval iv;
     if (IntersectPrimitive(primitives_[p], origin, dir, &iv) && iv.t_out > 0) {
@@ -179,27 +179,31 @@ int Scene::TraceTwoSurfaces(const Eigen::Vector3d& origin, const Eigen::Vector3d
     return a.iv.t_in < b.iv.t_in || (a.iv.t_in == b.iv.t_in && a.prim < b.prim);
   });
   // Merge overlapping (or touching) intervals into runs of solid matter.
+  *into_ground = false;
   int found = 0;
+  bool run_has_ground = false;
   double run_end = -kInf;
   for (const Entry& e : entries) {
     const double tolerance = 1e-6 * std::max(1.0, std::abs(run_end));
-    if (found > 0 && e.iv.t_in <= run_end + tolerance) {
+    const bool ground = primitives_[e.prim].is_ground;
+    if (e.iv.t_in <= run_end + tolerance || e.iv.t_in <= 0) {
+      // Continues the current run (or the origin is inside this solid, whose
+      // inside is not a visible surface).
       run_end = std::max(run_end, e.iv.t_out);
+      run_has_ground = run_has_ground || ground;
       continue;
     }
-    if (e.iv.t_in <= 0) {
-      // The origin is inside this solid: its inside is not a visible surface.
-      run_end = std::max(run_end, e.iv.t_out);
-      continue;
-    }
+    if (found > 0 && run_has_ground) break;  // Nothing is behind the ground.
     if (found == 2) break;
     Hit* h = found == 0 ? first : second;
     h->t = e.iv.t_in;
     h->primitive = e.prim;
     h->face = e.iv.face_in;
     run_end = e.iv.t_out;
+    run_has_ground = ground;
     ++found;
   }
+  if (found == 1 && run_has_ground) *into_ground = true;
   return found;
 }
 

@@ -5,7 +5,8 @@
 // queries, a sun and a sky at infinity. The solids form a union: the first
 // surface along a ray is where it first enters solid matter and the second
 // surface is where it next enters solid matter after leaving it (so the ground
-// under a box or the inside of a sphere never count as surfaces).
+// under a box or the inside of a sphere never count as surfaces). The ground
+// is solid all the way down: nothing is behind it.
 //
 // Units: metres. World frame: +Y up (the ground is the plane y = 0).
 
@@ -43,9 +44,11 @@ class Scene {
                     Hit* hit) const;
 
   // The first and second surfaces (see above) along a ray; returns how many
-  // exist (0: sky, 1: one surface then sky, 2: both).
+  // exist (0: sky, 1: one surface, 2: both). With 1, `*into_ground` tells
+  // whether the ray ends in the ground (nothing behind: the earth is solid)
+  // rather than leaving into the sky.
   int TraceTwoSurfaces(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Hit* first,
-                       Hit* second) const;
+                       Hit* second, bool* into_ground) const;
 
   // Outward unit normal at a hit.
   Eigen::Vector3d Normal(const Hit& hit, const Eigen::Vector3d& origin,

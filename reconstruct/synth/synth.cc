@@ -13,6 +13,7 @@
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/io/image_io.h"
+#include "reconstruct/io/jpeg_exif.h"
 #include "reconstruct/synth/default_scene.h"
 #include "reconstruct/synth/ground_truth_panorama.h"
 #include "reconstruct/synth/ground_truth_two_layer.h"
@@ -135,7 +136,15 @@ CaptureSummary GenerateCapture(const SynthOptions& options, const std::string& d
       exposures.push_back(develop.exposure);
       const Image8 photo = Develop(r.radiance, develop);
       names.push_back(PhotoName(i) + ".jpg");
-      io::WriteJpeg(dir + "/images/" + names.back(), photo.view(), {options.jpeg_quality});
+      // EXIF as a phone writes it (5.6 mm wide sensor), so that the sparse
+      // stage finds the focal length as it would for real photos.
+      io::ExifFields exif;
+      exif.make = "casual3d";
+      exif.model = std::string("synthetic ") + RigKindName(rig_options.kind);
+      exif.focal_plane_px_per_mm = rig.camera.width / 5.6;
+      exif.focal_mm = rig.camera.FocalX() / exif.focal_plane_px_per_mm;
+      io::WriteFileAtomic(dir + "/images/" + names.back(),
+                          io::InsertExif(io::EncodeJpeg(photo.view(), {options.jpeg_quality}), exif));
       io::WriteExr(dir + "/depth/" + PhotoName(i) + ".exr", r.depth_m.view(), {"Z"});
       UpdateRange(r.depth_m, 0, &depth_lo, &depth_hi);
       progress.Advance();

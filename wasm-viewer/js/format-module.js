@@ -120,7 +120,11 @@ export class Panorama {
     if (!this.format.m._c3d_panorama_validate(this.ptr)) throw this.format._error('panorama');
   }
 
-  /** The colour atlas: {width, height: 2 * panorama height, data: RGBA Uint8Array}. */
+  /**
+   * The colour atlas of format/colour_atlas.h (front colours above back colours, each half
+   * filled from the other layer where its node is absent; the mesh's uvs rely on that):
+   * {width, height: 2 * panorama height, data: RGBA Uint8Array}.
+   */
   atlas() {
     const m = this.format.m;
     const w = this.width, h = this.height;

@@ -5,8 +5,9 @@
 // so nearer scene geometry hides them correctly.
 //
 // Texturing: bilinear from the colour atlas (front colour panorama above the
-// back one), no mipmaps, no antialiasing: the same sampling as the project's
-// native software renderer, so screenshots can be compared with its renders.
+// back one; every triangle's uvs lie in one half, spec/mesh.md Sec. 4.4), no
+// mipmaps, no antialiasing: the same sampling as the project's native software
+// renderer, so screenshots can be compared with its renders.
 
 const SCENE_VS = `#version 300 es
 layout(location = 0) in vec3 aPosition;

@@ -45,6 +45,7 @@ export class Casual3dViewer extends EventTarget {
     this.stats = {};
     this._startTime = performance.now();
     this._loadId = 0;
+    this._levelShown = false;  // Whether the current load has shown a level.
     this._worker = null;
     this._dirty = true;
     this._frameWaiters = [];
@@ -280,7 +281,7 @@ export class Casual3dViewer extends EventTarget {
       view: lookAlong(eye, cam.forward()), projection: cam.projectionMatrix(aspect), eye,
       effects: this.effects, timeSec: this._effectsSeconds(),
     });
-    if (this.renderer.hasMesh && this.stats.timeToFirstFrameMs === undefined) {
+    if (this._levelShown && this.stats.timeToFirstFrameMs === undefined) {
       this.stats.timeToFirstFrameMs = now - this.stats.loadStart;
       this.stats.bytesBeforeFirstFrame = this._bytesFetched();
       this._emit('firstframe', {

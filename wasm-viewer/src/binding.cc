@@ -15,8 +15,10 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "format/colour_atlas.h"
 #include "format/image.h"
 #include "format/manifest.h"
 #include "format/mesh.h"
@@ -62,7 +64,8 @@ std::string JsonString(const std::string& s) {
       out += c;
     } else if (static_cast<unsigned char>(c) < 0x20) {
       char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      std::snprintf(buf, sizeof(buf), "\\u%04x",
+                    static_cast<unsigned>(static_cast<unsigned char>(c)));
       out += buf;
     } else {
       out += c;
@@ -74,9 +77,9 @@ std::string JsonString(const std::string& s) {
 }  // namespace
 }  // namespace casual3d::viewer
 
+using casual3d::viewer::MeshResult;
 using casual3d::viewer::Panorama;
 using casual3d::viewer::Reader;
-using casual3d::viewer::MeshResult;
 using casual3d::viewer::SetError;
 
 extern "C" {
@@ -109,21 +112,13 @@ EMSCRIPTEN_KEEPALIVE int c3d_panorama_validate(const Panorama* p) {
   return s.ok() ? 1 : 0;
 }
 
-// The colour atlas of format/mesh.h as RGBA (alpha 255): width x 2*height, the
-// front layer's colours above the back layer's. Owned by the panorama.
+// The colour atlas of format/colour_atlas.h as RGBA (alpha 255): width x
+// 2*height, the front layer's colours above the back layer's, each half filled
+// from the other layer where its node is absent (the mesh's uvs rely on it).
+// Owned by the panorama.
 EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_panorama_atlas_rgba(Panorama* p) {
-  const casual3d::TwoLayerPanorama& pano = p->pano;
-  const size_t n = static_cast<size_t>(pano.width()) * pano.height();
-  p->atlas.assign(n * 2 * 4, 255);
-  for (int l = 0; l < casual3d::kNumLayers; ++l) {
-    const std::vector<uint8_t>& rgb = pano.layer(l).rgb;
-    uint8_t* out = p->atlas.data() + l * n * 4;
-    for (size_t i = 0; i < n; ++i) {
-      out[4 * i + 0] = rgb[3 * i + 0];
-      out[4 * i + 1] = rgb[3 * i + 1];
-      out[4 * i + 2] = rgb[3 * i + 2];
-    }
-  }
+  casual3d::Image8 atlas = casual3d::BuildColourAtlas(p->pano, 4);
+  p->atlas = std::move(atlas.vector());
   return p->atlas.data();
 }
 
@@ -166,11 +161,19 @@ EMSCRIPTEN_KEEPALIVE uint32_t c3d_mesh_num_vertices(const MeshResult* m) {
 EMSCRIPTEN_KEEPALIVE uint32_t c3d_mesh_num_indices(const MeshResult* m) {
   return static_cast<uint32_t>(m->mesh.indices.size());
 }
-EMSCRIPTEN_KEEPALIVE const float* c3d_mesh_positions(const MeshResult* m) { return m->mesh.positions.data(); }
-EMSCRIPTEN_KEEPALIVE const float* c3d_mesh_normals(const MeshResult* m) { return m->mesh.normals.data(); }
+EMSCRIPTEN_KEEPALIVE const float* c3d_mesh_positions(const MeshResult* m) {
+  return m->mesh.positions.data();
+}
+EMSCRIPTEN_KEEPALIVE const float* c3d_mesh_normals(const MeshResult* m) {
+  return m->mesh.normals.data();
+}
 EMSCRIPTEN_KEEPALIVE const float* c3d_mesh_uvs(const MeshResult* m) { return m->mesh.uvs.data(); }
-EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_mesh_colors(const MeshResult* m) { return m->mesh.colors.data(); }
-EMSCRIPTEN_KEEPALIVE const uint32_t* c3d_mesh_indices(const MeshResult* m) { return m->mesh.indices.data(); }
+EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_mesh_colors(const MeshResult* m) {
+  return m->mesh.colors.data();
+}
+EMSCRIPTEN_KEEPALIVE const uint32_t* c3d_mesh_indices(const MeshResult* m) {
+  return m->mesh.indices.data();
+}
 EMSCRIPTEN_KEEPALIVE double c3d_mesh_max_error(const MeshResult* m) { return m->max_error; }
 
 // --- Packages ------------------------------------------------------------------
@@ -201,21 +204,23 @@ EMSCRIPTEN_KEEPALIVE const char* c3d_reader_level_json(Reader* r, int level) {
     return nullptr;
   }
   const casual3d::LevelEntry& L = m.levels[level];
-  std::string j = "{\"width\":" + std::to_string(L.width) + ",\"height\":" + std::to_string(L.height) +
-                  ",\"tiles\":[";
+  std::string j = "{\"width\":" + std::to_string(L.width) +
+                  ",\"height\":" + std::to_string(L.height) + ",\"tiles\":[";
   for (size_t t = 0; t < L.tiles.size(); ++t) {
     int x, y, w, h;
     m.TileRect(level, static_cast<int>(t), &x, &y, &w, &h);
-    j += (t ? ",{" : "{") + std::string("\"x\":") + std::to_string(x) + ",\"y\":" + std::to_string(y) +
-         ",\"w\":" + std::to_string(w) + ",\"h\":" + std::to_string(h) + ",\"files\":[";
+    j += (t ? ",{" : "{") + std::string("\"x\":") + std::to_string(x) +
+         ",\"y\":" + std::to_string(y) + ",\"w\":" + std::to_string(w) +
+         ",\"h\":" + std::to_string(h) + ",\"files\":[";
     for (int k = 0; k < casual3d::kNumTileImageKinds; ++k) {
       const auto kind = static_cast<casual3d::TileImageKind>(k);
       const std::string& path = L.tiles[t].files[k];
       const casual3d::FileEntry* f = m.FindFile(path);
       int iw, ih;
       casual3d::TileImageSize(kind, w, h, &iw, &ih);
-      j += (k ? ",{" : "{") + std::string("\"kind\":") + JsonString(casual3d::TileImageKindName(kind)) +
-           ",\"path\":" + JsonString(path) + ",\"bytes\":" + std::to_string(f ? f->bytes : 0) +
+      j += (k ? ",{" : "{") + std::string("\"kind\":") +
+           JsonString(casual3d::TileImageKindName(kind)) + ",\"path\":" + JsonString(path) +
+           ",\"bytes\":" + std::to_string(f ? f->bytes : 0) +
            ",\"sha256\":" + JsonString(f ? f->sha256 : "") + ",\"width\":" + std::to_string(iw) +
            ",\"height\":" + std::to_string(ih) + "}";
     }
@@ -228,8 +233,8 @@ EMSCRIPTEN_KEEPALIVE const char* c3d_reader_level_json(Reader* r, int level) {
 
 // Checks a fetched file against the manifest's size and SHA-256. 1 if it
 // matches, else 0 with an error naming the file.
-EMSCRIPTEN_KEEPALIVE int c3d_reader_check_file(const Reader* r, const char* path, const uint8_t* data,
-                                               size_t size) {
+EMSCRIPTEN_KEEPALIVE int c3d_reader_check_file(const Reader* r, const char* path,
+                                               const uint8_t* data, size_t size) {
   const casual3d::Status s = r->reader->VerifyFile(path, data, size);
   if (!s.ok()) SetError(s);
   return s.ok() ? 1 : 0;

@@ -132,6 +132,12 @@ test('loads a package and reports the first frame', async () => {
   const first = events.find((e) => e.type === 'firstframe');
   const levels = events.filter((e) => e.type === 'level').map((e) => e.detail.level);
   assert.deepEqual(levels, [2, 1, 0], 'levels arrive coarsest first');
+  const progress = events.filter((e) => e.type === 'progress').map((e) => e.detail);
+  assert.ok(progress.length >= 3, 'progress is reported');
+  for (let i = 1; i < progress.length; ++i) assert.ok(progress[i].loadedBytes >= progress[i - 1].loadedBytes);
+  const last = progress[progress.length - 1];
+  assert.equal(last.loadedBytes, last.totalBytes, 'progress ends at 100 %');
+  assert.equal(last.totalBytes, metrics.package.total_bytes, 'every file of the package was fetched once');
   const firstT = first.t;
   // Bytes the server sent before the first frame: package files and viewer code.
   const served = server.log.slice(start);

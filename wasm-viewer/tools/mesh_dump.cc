@@ -27,7 +27,8 @@ bool WriteFile(const std::string& path, const std::vector<uint8_t>& bytes) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
     if (!out) return false;
   }
   return std::rename(tmp.c_str(), path.c_str()) == 0;
@@ -42,7 +43,8 @@ int Fail(const std::string& message) {
 
 int main(int argc, char** argv) {
   if (argc != 5) {
-    return Fail("usage: viewer_mesh_dump <room|room-nosphere|sphere|test> <width> <height> <out_dir>");
+    return Fail(
+        "usage: viewer_mesh_dump <room|room-nosphere|sphere|test> <width> <height> <out_dir>");
   }
   const std::string kind = argv[1];
   const int width = std::atoi(argv[2]), height = std::atoi(argv[3]);
@@ -72,14 +74,16 @@ int main(int argc, char** argv) {
   simplify.max_triangles = static_cast<int64_t>(mesh->num_triangles() / 4);
   auto simplified = casual3d::BuildSimplifiedMesh(pano, simplify);
   if (!simplified.ok()) return Fail(kind + ": " + simplified.status().ToString());
-  const std::string base = out_dir + "/" + kind + "_" + std::to_string(width) + "x" + std::to_string(height);
+  const std::string base =
+      out_dir + "/" + kind + "_" + std::to_string(width) + "x" + std::to_string(height);
   if (!WriteFile(base + ".pano", casual3d::viewer::SerializePanorama(pano)) ||
       !WriteFile(base + ".mesh", casual3d::viewer::SerializeMesh(*mesh)) ||
       !WriteFile(base + ".smesh", casual3d::viewer::SerializeMesh(simplified->mesh))) {
     return Fail(out_dir + ": cannot write the blobs (does the folder exist?)");
   }
-  std::printf("{\"vertices\": %zu, \"triangles\": %zu, \"budget\": %lld, \"simplified_triangles\": %zu}\n",
-              mesh->num_vertices(), mesh->num_triangles(), static_cast<long long>(simplify.max_triangles),
-              simplified->mesh.num_triangles());
+  std::printf(
+      "{\"vertices\": %zu, \"triangles\": %zu, \"budget\": %lld, \"simplified_triangles\": %zu}\n",
+      mesh->num_vertices(), mesh->num_triangles(), static_cast<long long>(simplify.max_triangles),
+      simplified->mesh.num_triangles());
   return 0;
 }

@@ -16,16 +16,16 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "encoder/package_writer.h"
 #include "encoder/webp_codec.h"
+#include "format/colour_atlas.h"
 #include "format/file_source.h"
 #include "format/mesh_builder.h"
 #include "format/package_reader.h"
@@ -60,7 +60,9 @@ bool MakePanorama(const std::string& kind, int w, int h, casual3d::TwoLayerPanor
 }
 
 int Package(int argc, char** argv) {
-  if (argc < 6) return Fail("usage: viewer_test_tool package <kind> <width> <height> <out_dir> [tile_size] [levels]");
+  if (argc < 6)
+    return Fail(
+        "usage: viewer_test_tool package <kind> <width> <height> <out_dir> [tile_size] [levels]");
   casual3d::TwoLayerPanorama pano;
   if (!MakePanorama(argv[2], std::atoi(argv[3]), std::atoi(argv[4]), &pano)) {
     return Fail(std::string("unknown panorama kind '") + argv[2] + "'");
@@ -86,7 +88,8 @@ int Package(int argc, char** argv) {
 
 bool WriteFile(const std::string& path, const std::vector<uint8_t>& bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
   return static_cast<bool>(out);
 }
 
@@ -105,13 +108,16 @@ int DumpMesh(int argc, char** argv) {
       !WriteFile(base + ".mesh", casual3d::viewer::SerializeMesh(*mesh))) {
     return Fail(base + ": cannot write the blobs");
   }
-  std::printf("{\"vertices\": %zu, \"triangles\": %zu}\n", mesh->num_vertices(), mesh->num_triangles());
+  std::printf("{\"vertices\": %zu, \"triangles\": %zu}\n", mesh->num_vertices(),
+              mesh->num_triangles());
   return 0;
 }
 
 int Render(int argc, char** argv) {
   if (argc < 8) {
-    return Fail("usage: viewer_test_tool render <package_dir> <level> <width> <height> <out_prefix> <yaw,pitch,fov,x,y,z>...");
+    return Fail(
+        "usage: viewer_test_tool render <package_dir> <level> <width> <height> <out_prefix> "
+        "<yaw,pitch,fov,x,y,z>...");
   }
   casual3d::ReadOptions read;
   read.level = std::atoi(argv[3]);
@@ -123,13 +129,8 @@ int Render(int argc, char** argv) {
   if (!pano.ok()) return Fail(std::string(argv[2]) + ": " + pano.status().ToString());
   auto mesh = casual3d::BuildMesh(*pano);
   if (!mesh.ok()) return Fail(mesh.status().ToString());
-  // The colour atlas of format/mesh.h: front colours above back colours.
-  const int pw = pano->width(), ph = pano->height();
-  casual3d::Image8 atlas(pw, 2 * ph, 3);
-  for (int l = 0; l < casual3d::kNumLayers; ++l) {
-    const std::vector<uint8_t>& rgb = pano->layer(l).rgb;
-    std::copy(rgb.begin(), rgb.end(), atlas.data() + static_cast<size_t>(l) * pw * ph * 3);
-  }
+  // The colour atlas the viewer uploads (format/colour_atlas.h).
+  const casual3d::Image8 atlas = casual3d::BuildColourAtlas(*pano, 3);
   for (int i = 7; i < argc; ++i) {
     casual3d::render::GlCamera camera;
     char comma;
@@ -137,19 +138,23 @@ int Render(int argc, char** argv) {
     in >> camera.yaw_deg >> comma >> camera.pitch_deg >> comma >> camera.fov_y_deg >> comma >>
         camera.position[0] >> comma >> camera.position[1] >> comma >> camera.position[2];
     if (!in) return Fail(std::string("camera '") + argv[i] + "': expected yaw,pitch,fov,x,y,z");
-    const casual3d::render::PinholeView view = casual3d::render::ViewFromGlCamera(camera, width, height);
-    const casual3d::render::RenderResult result = casual3d::render::RenderMesh(*mesh, static_cast<const casual3d::Image8&>(atlas).view(), view);
+    const casual3d::render::PinholeView view =
+        casual3d::render::ViewFromGlCamera(camera, width, height);
+    const casual3d::render::RenderResult result = casual3d::render::RenderMesh(
+        *mesh, atlas.view(), view);
     const std::string base = prefix + "_" + std::to_string(i - 7);
     std::ofstream ppm(base + ".ppm", std::ios::binary);
     ppm << "P6\n" << width << " " << height << "\n255\n";
-    ppm.write(reinterpret_cast<const char*>(result.color.data()), static_cast<std::streamsize>(result.color.size()));
+    ppm.write(reinterpret_cast<const char*>(result.color.data()),
+              static_cast<std::streamsize>(result.color.size()));
     if (!ppm) return Fail(base + ".ppm: cannot write");
     cv::Mat rgb(height, width, CV_8UC3, const_cast<uint8_t*>(result.color.data()));
     cv::Mat bgr;
     cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
     if (!cv::imwrite(base + ".png", bgr)) return Fail(base + ".png: cannot write");
   }
-  std::printf("{\"vertices\": %zu, \"triangles\": %zu}\n", mesh->num_vertices(), mesh->num_triangles());
+  std::printf("{\"vertices\": %zu, \"triangles\": %zu}\n", mesh->num_vertices(),
+              mesh->num_triangles());
   return 0;
 }
 

@@ -1,0 +1,368 @@
+#include "reconstruct/eval/evaluate.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "encoder/gltf_export.h"
+#include "encoder/master_file.h"
+#include "encoder/webp_codec.h"
+#include "format/file_source.h"
+#include "format/mesh_builder.h"
+#include "format/package_reader.h"
+#include "reconstruct/geometry/colmap_model.h"
+#include "reconstruct/io/cv_bridge.h"
+#include "reconstruct/io/exr_io.h"
+#include "reconstruct/io/file_util.h"
+#include "reconstruct/io/image_io.h"
+#include "reconstruct/render/photo_renderer.h"
+#include "reconstruct/util/log.h"
+
+namespace casual3d::eval {
+
+namespace fs = std::filesystem;
+
+std::string EvaluateOptions::Check() const {
+  if (width != 0 && (width < 16 || width > 8192))
+    return "width: " + std::to_string(width) + " is outside [16, 8192] (or 0 for the photos' size)";
+  if (holdout_every < 0 || holdout_every > 1000)
+    return "holdout_every: " + std::to_string(holdout_every) + " is outside [0, 1000]";
+  if (!(depth_tolerance > 0 && depth_tolerance <= 1))
+    return "depth_tolerance: " + std::to_string(depth_tolerance) + " is outside (0, 1]";
+  if (num_threads < 0 || num_threads > 256)
+    return "num_threads: " + std::to_string(num_threads) + " is outside [0, 256]";
+  if (const std::string why = metrics.Check(); !why.empty()) return "metrics." + why;
+  return {};
+}
+
+std::vector<int> SelectPhotos(const std::vector<std::string>& names,
+                              const std::vector<std::string>& requested, int every,
+                              const std::vector<std::string>& holdout) {
+  std::vector<int> out;
+  auto index_of = [&](const std::string& name) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+  };
+  if (!requested.empty()) {
+    for (const std::string& r : requested) {
+      int index = index_of(r);
+      if (index < 0) {
+        // Not a name: a decimal index?
+        const bool numeric = !r.empty() && std::all_of(r.begin(), r.end(),
+                                                       [](char c) { return c >= '0' && c <= '9'; });
+        if (!numeric || r.size() > 9)
+          throw std::runtime_error(
+              "photo '" + r + "': not a registered photo of the 3D photo's model (" +
+              std::to_string(names.size()) + " photos; give a name or an index)");
+        index = std::stoi(r);
+        if (index >= static_cast<int>(names.size()))
+          throw std::runtime_error("photo index " + r + " is out of range: the model has " +
+                                   std::to_string(names.size()) + " photos (indices 0 to " +
+                                   std::to_string(int(names.size()) - 1) + ")");
+      }
+      out.push_back(index);
+    }
+  } else if (every > 0) {
+    for (int i = 0; i < static_cast<int>(names.size()); i += every) out.push_back(i);
+  } else {
+    for (const std::string& h : holdout)
+      if (const int i = index_of(h); i >= 0) out.push_back(i);
+    if (out.empty())
+      for (int i = 0; i < static_cast<int>(names.size()); ++i) out.push_back(i);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The 3D photo's panorama and where its other files are.
+struct LoadedPhoto3d {
+  TwoLayerPanorama pano;
+  fs::path root;  // Output folder (report.json, work/, photo.c3d), may not exist.
+  std::string source;
+  uint64_t package_bytes = 0;
+};
+
+TwoLayerPanorama ReadPackageOrThrow(const std::string& path, int num_threads) {
+  auto source = OpenPackage(path);
+  if (!source.ok()) throw std::runtime_error(source.status().message());
+  encoder::WebpImageDecoder decoder;
+  ReadOptions read;
+  read.num_threads = num_threads;
+  auto pano = ReadPackage(**source, decoder, read);
+  if (!pano.ok()) throw std::runtime_error(path + ": " + pano.status().message());
+  return std::move(*pano);
+}
+
+TwoLayerPanorama ReadMasterOrThrow(const fs::path& path) {
+  auto pano = encoder::ReadMasterFile(path.string());
+  if (!pano.ok()) throw std::runtime_error(path.string() + ": " + pano.status().message());
+  return std::move(*pano);
+}
+
+LoadedPhoto3d LoadPhoto3d(const std::string& path, int num_threads) {
+  LoadedPhoto3d out;
+  const fs::path p(path);
+  std::error_code ec;
+  if (!fs::exists(p, ec))
+    throw std::runtime_error(path +
+                             ": no such 3D photo (give the output folder of `casual3d "
+                             "reconstruct`, a master .exr, a package folder or a .c3d file)");
+  if (fs::is_directory(p) && fs::exists(p / "master.exr")) {
+    out.root = p;
+    out.source = (p / "master.exr").string();
+    out.pano = ReadMasterOrThrow(p / "master.exr");
+  } else if (fs::is_directory(p) && fs::exists(p / "manifest.json")) {
+    out.root = p.parent_path();
+    out.source = path;
+    out.pano = ReadPackageOrThrow(path, num_threads);
+  } else if (fs::is_regular_file(p) && p.extension() == ".exr") {
+    out.root = p.parent_path();
+    out.source = path;
+    out.pano = ReadMasterOrThrow(p);
+  } else if (fs::is_regular_file(p)) {
+    out.root = p.parent_path();
+    out.source = path;
+    out.pano = ReadPackageOrThrow(path, num_threads);
+    out.package_bytes = fs::file_size(p, ec);
+  } else {
+    throw std::runtime_error(path + ": not a 3D photo (no master.exr or manifest.json inside)");
+  }
+  if (out.package_bytes == 0 && fs::exists(out.root / "photo.c3d", ec))
+    out.package_bytes = fs::file_size(out.root / "photo.c3d", ec);
+  return out;
+}
+
+// Reads the held-out names and the timings per stage that the 3D photo's
+// output folder records (report.json of reconstruct, or panorama.json of the
+// panorama stage).
+void ReadReports(const fs::path& root, PhotoModelEvaluation* eval) {
+  const auto parse = [](const fs::path& file) -> nlohmann::json {
+    try {
+      return nlohmann::json::parse(io::ReadFile(file.string()));
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error(file.string() + ": not valid JSON (" + e.what() + ")");
+    }
+  };
+  std::error_code ec;
+  if (fs::exists(root / "report.json", ec)) {
+    const nlohmann::json j = parse(root / "report.json");
+    if (j.contains("holdout") && j["holdout"].is_array())
+      for (const auto& n : j["holdout"])
+        if (n.is_string()) eval->holdout.push_back(n.get<std::string>());
+    if (j.contains("stages") && j["stages"].is_array())
+      for (const auto& s : j["stages"])
+        if (s.contains("stage") && s.contains("seconds") && s["seconds"].is_number())
+          eval->stage_seconds.emplace_back(s["stage"].get<std::string>(),
+                                           s["seconds"].get<double>());
+  }
+  if (eval->stage_seconds.empty() && fs::exists(root / "panorama.json", ec)) {
+    const nlohmann::json j = parse(root / "panorama.json");
+    if (j.contains("seconds") && j["seconds"].is_object())
+      for (const auto& [k, v] : j["seconds"].items())
+        if (v.is_number()) eval->stage_seconds.emplace_back("panorama/" + k, v.get<double>());
+  }
+}
+
+// The workspace (folder with sparse/ and images/) giving the poses.
+fs::path FindSparseWorkspace(const fs::path& root, const fs::path& capture) {
+  std::error_code ec;
+  for (const fs::path& ws : {root / "work" / "sparse", capture}) {
+    for (const fs::path& model : {ws / "sparse", ws / "sparse" / "0"}) {
+      if (fs::exists(model / "cameras.bin", ec) || fs::exists(model / "cameras.txt", ec))
+        return model;
+    }
+  }
+  throw std::runtime_error(
+      "no camera poses: neither " + (root / "work" / "sparse" / "sparse").string() + " nor " +
+      (capture / "sparse").string() +
+      " holds a COLMAP model (evaluate the output folder of `casual3d reconstruct`, or a capture "
+      "folder with sparse/)");
+}
+
+fs::path FindReferencePhoto(const fs::path& model_dir, const fs::path& capture,
+                            const std::string& name) {
+  std::error_code ec;
+  for (const fs::path& p :
+       {model_dir.parent_path() / "images" / name, capture / "images" / name, capture / name})
+    if (fs::is_regular_file(p, ec)) return p;
+  throw std::runtime_error("photo " + name + ": not found in " +
+                           (model_dir.parent_path() / "images").string() + ", " +
+                           (capture / "images").string() + " or " + capture.string());
+}
+
+DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r, double tolerance) {
+  DepthComparison d;
+  const int w = r.depth.width(), h = r.depth.height();
+  std::vector<float> rel;
+  rel.reserve(static_cast<size_t>(w) * h);
+  int64_t within = 0;
+  for (int y = 0; y < h; ++y) {
+    const int ty = std::min(truth.height() - 1, int((y + 0.5) * truth.height() / h));
+    for (int x = 0; x < w; ++x) {
+      if (!r.mask.at(x, y)) continue;
+      const int tx = std::min(truth.width() - 1, int((x + 0.5) * truth.width() / w));
+      const float t = truth.at(tx, ty);
+      if (!std::isfinite(t) || t <= 0) continue;
+      const float e = std::abs(r.depth.at(x, y) - t) / t;
+      rel.push_back(e);
+      within += e <= tolerance;
+    }
+  }
+  d.available = true;
+  d.pixels = static_cast<int64_t>(rel.size());
+  if (rel.empty()) return d;
+  std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
+  d.median_relative_error = rel[rel.size() / 2];
+  d.within_tolerance = double(within) / rel.size();
+  return d;
+}
+
+}  // namespace
+
+PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
+                                     const std::string& photo3d_path,
+                                     const EvaluateOptions& options) {
+  if (const std::string why = options.Check(); !why.empty())
+    throw std::invalid_argument("evaluate: " + why);
+  const fs::path capture(capture_dir);
+  std::error_code ec;
+  if (!fs::is_directory(capture, ec))
+    throw std::runtime_error(capture_dir +
+                             ": not a folder (give the capture's photo or capture folder)");
+
+  PhotoModelEvaluation eval;
+  eval.label = photo3d_path;
+  const int threads = options.num_threads > 0 ? options.num_threads
+                                              : std::max(1u, std::thread::hardware_concurrency());
+  LoadedPhoto3d photo3d = LoadPhoto3d(photo3d_path, static_cast<int>(threads));
+  eval.source = photo3d.source;
+  eval.package_bytes = photo3d.package_bytes;
+  eval.pano_width = photo3d.pano.width();
+  eval.pano_height = photo3d.pano.height();
+  ReadReports(photo3d.root, &eval);
+
+  const fs::path model_dir = FindSparseWorkspace(photo3d.root, capture);
+  eval.poses_from = model_dir.string();
+  geometry::SparseModel model;
+  try {
+    model = geometry::ReadModel(model_dir.string());
+  } catch (const std::exception& e) {
+    throw std::runtime_error(model_dir.string() + ": " + e.what());
+  }
+  std::vector<std::string> names;
+  std::map<std::string, const geometry::ModelImage*> by_name;
+  for (const auto& [id, image] : model.images) {
+    names.push_back(image.name);
+    by_name[image.name] = &image;
+  }
+  std::sort(names.begin(), names.end());
+  if (names.empty())
+    throw std::runtime_error(model_dir.string() + ": the model has no registered photos");
+  const std::vector<int> selected =
+      SelectPhotos(names, options.photos, options.holdout_every, eval.holdout);
+
+  const auto mesh_start = std::chrono::steady_clock::now();
+  auto mesh = BuildMesh(photo3d.pano);
+  if (!mesh.ok()) throw std::runtime_error(photo3d.source + ": " + mesh.status().message());
+  const Image8 atlas = encoder::BuildColourAtlas(photo3d.pano);
+  eval.mesh_triangles = mesh->indices.size() / 3;
+  util::LogInfo("evaluate: " + photo3d_path + ": mesh of " + std::to_string(eval.mesh_triangles) +
+                " triangles in " + std::to_string(SecondsSince(mesh_start)) + " s; " +
+                std::to_string(selected.size()) + " photos");
+
+  render::RenderOptions render_options;
+  render_options.num_threads = options.num_threads;
+  util::Progress progress("rephotography", static_cast<int64_t>(selected.size()));
+  eval.error_histogram.assign(options.metrics.histogram_bins, 0);
+  for (const int index : selected) {
+    const std::string& name = names[index];
+    const geometry::ModelImage& image = *by_name.at(name);
+    const auto cam_it = model.cameras.find(image.camera_id);
+    if (cam_it == model.cameras.end())
+      throw std::runtime_error(model_dir.string() + ": photo " + name +
+                               " refers to a missing camera");
+    const geometry::Camera& full = cam_it->second;
+    const fs::path photo_path = FindReferencePhoto(model_dir, capture, name);
+    const Image8 photo_full = io::ReadImage(photo_path.string());
+    if (photo_full.width() != full.width || photo_full.height() != full.height)
+      throw std::runtime_error(photo_path.string() + ": " + std::to_string(photo_full.width()) +
+                               "x" + std::to_string(photo_full.height()) +
+                               " pixels but its camera is " + std::to_string(full.width) + "x" +
+                               std::to_string(full.height) +
+                               " (compare with the photos the 3D photo was reconstructed from)");
+    const double scale = options.width > 0 ? double(options.width) / full.width : 1.0;
+    const geometry::Camera camera = scale == 1.0 ? full : full.Scaled(scale);
+
+    PhotoEvaluation pe;
+    pe.name = name;
+    pe.index = index;
+    pe.held_out = std::find(eval.holdout.begin(), eval.holdout.end(), name) != eval.holdout.end();
+    Image8 photo(camera.width, camera.height, 3);
+    if (scale == 1.0) {
+      photo = photo_full;
+    } else {
+      cv::Mat dst = io::ToMat(photo);
+      cv::resize(io::ToMat(photo_full), dst, dst.size(), 0, 0,
+                 scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    }
+    const auto t = std::chrono::steady_clock::now();
+    render::RenderResult r = render::RenderPhotoView(*mesh, atlas.view(), photo3d.pano.frame(),
+                                                     camera, image.pose, render_options);
+    pe.seconds_render = SecondsSince(t);
+    ImageF error_map;
+    pe.metrics = ComputeRephotoMetrics(std::as_const(photo).view(), std::as_const(r.color).view(),
+                                       std::as_const(r.mask).view(), options.metrics,
+                                       options.keep_images ? &error_map : nullptr);
+    const fs::path truth = capture / "depth" / (fs::path(name).stem().string() + ".exr");
+    if (fs::is_regular_file(truth, ec))
+      pe.depth =
+          CompareDepth(io::ReadExrChannels(truth.string(), {"Z"}), r, options.depth_tolerance);
+    if (options.keep_images) {
+      pe.photo = std::move(photo);
+      pe.render = std::move(r.color);
+      pe.error_map = std::move(error_map);
+    }
+    for (size_t b = 0; b < eval.error_histogram.size(); ++b)
+      eval.error_histogram[b] += pe.metrics.error_histogram[b];
+    eval.total_pixels += int64_t{pe.metrics.width} * pe.metrics.height;
+    eval.photos.push_back(std::move(pe));
+    progress.Advance();
+  }
+  progress.Finish();
+
+  const double n = static_cast<double>(eval.photos.size());
+  int depth_n = 0;
+  for (const PhotoEvaluation& pe : eval.photos) {
+    eval.mean_error += pe.metrics.error / n;
+    eval.mean_completeness += pe.metrics.completeness / n;
+    eval.mean_psnr_db += pe.metrics.psnr_db / n;
+    eval.mean_ssim += pe.metrics.ssim / n;
+    if (pe.depth.available && pe.depth.pixels > 0) {
+      ++depth_n;
+      eval.mean_depth_median_rel += pe.depth.median_relative_error;
+      eval.mean_depth_within += pe.depth.within_tolerance;
+    }
+  }
+  if (depth_n > 0) {
+    eval.has_depth = true;
+    eval.mean_depth_median_rel /= depth_n;
+    eval.mean_depth_within /= depth_n;
+  }
+  return eval;
+}
+
+}  // namespace casual3d::eval

@@ -1,0 +1,117 @@
+#pragma once
+
+// Virtual rephotography of 3D photos (paper Sec. 6.3): every evaluated photo
+// of a capture is re-rendered from the 3D photo at the photo's exact pose
+// (reconstruct/render/photo_renderer.h), at about `width` pixels wide, and
+// compared with the photo (rephoto_metrics.h). On synthetic captures the
+// rendered depth is also compared with the ground-truth depth maps.
+//
+// Inputs:
+//   capture      a photo folder, a capture folder (DIR/images, DIR/sparse,
+//                DIR/depth for synthetic captures) or a COLMAP workspace.
+//   3D photo     the output folder of `casual3d reconstruct` (OUT/master.exr,
+//                OUT/report.json, OUT/work/sparse), a panorama-stage folder
+//                holding master.exr, a master .exr file, a package folder
+//                (manifest.json; OUT/web) or a single-file package (.c3d).
+// Poses: the 3D photo's own sparse model (ROOT/work/sparse/sparse, ROOT being
+// the 3D photo's output folder) when it exists, else the capture's
+// (CAPTURE/sparse, CAPTURE/sparse/0). Photos are matched by file name; the
+// reference image of a photo is the undistorted copy next to the model that
+// gave its pose (SPARSE/images/<name>), else CAPTURE/images/<name>, else
+// CAPTURE/<name>; it must have the camera's size.
+//
+// Held-out views: ROOT/report.json may list "holdout" (names of photos that
+// were registered but not used to build the 3D photo); by default exactly
+// those are evaluated. Without such a list every registered photo is.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "format/image.h"
+#include "reconstruct/eval/rephoto_metrics.h"
+
+namespace casual3d::eval {
+
+struct EvaluateOptions {
+  // Width of the rephotographs, pixels (height keeps the aspect ratio); the
+  // camera is scaled to it. Sec. 6.3: about 900. [16, 8192]; 0 = the photos' size.
+  int width = 900;
+  // Photos to evaluate, by file name or by zero-based index in the sorted list
+  // of the model's image names. Empty = the 3D photo's held-out photos if it
+  // lists any, else every registered photo.
+  std::vector<std::string> photos;
+  // When > 0 and `photos` is empty: evaluate the photos with index 0, n, 2n,
+  // ... (the LLFF held-out protocol uses 8). [0, 1000].
+  int holdout_every = 0;
+  RephotoMetricOptions metrics;
+  // Keep the per-photo images (render, error map) for the HTML report.
+  bool keep_images = true;
+  // Relative depth error threshold of "within" in the ground-truth comparison
+  // (0.03 = 3%); (0, 1].
+  double depth_tolerance = 0.03;
+  int num_threads = 0;  // Rendering threads; 0 = all cores.
+
+  std::string Check() const;  // Empty if valid, else "field: reason".
+};
+
+// Depth of the rephotograph against a synthetic capture's ground truth
+// (CAPTURE/depth/<stem>.exr, camera-frame z): over pixels that are covered
+// and have a finite ground-truth depth.
+struct DepthComparison {
+  bool available = false;
+  int64_t pixels = 0;
+  double median_relative_error = 0.0;  // median of |z - z_true| / z_true.
+  double within_tolerance = 0.0;       // Fraction with relative error <= depth_tolerance.
+};
+
+struct PhotoEvaluation {
+  std::string name;
+  int index = 0;          // Index in the sorted list of the model's image names.
+  bool held_out = false;  // Listed as held out by the 3D photo.
+  RephotoMetrics metrics;
+  DepthComparison depth;
+  double seconds_render = 0.0;
+  // When EvaluateOptions::keep_images: the photo as compared, the rendering
+  // and the per-pixel error (rephoto_metrics.h; -1 uncovered).
+  Image8 photo, render;
+  ImageF error_map;
+};
+
+struct PhotoModelEvaluation {
+  std::string label;       // The 3D photo's path as given.
+  std::string source;      // What was read: "master.exr" path or package path.
+  std::string poses_from;  // The sparse model folder used.
+  int pano_width = 0, pano_height = 0;
+  size_t mesh_triangles = 0;
+  uint64_t package_bytes = 0;  // Of the package next to it (OUT/photo.c3d) or the one read, if any.
+  std::vector<PhotoEvaluation> photos;
+  // Timings per stage read from ROOT/report.json or panorama.json (seconds).
+  std::vector<std::pair<std::string, double>> stage_seconds;
+  std::vector<std::string> holdout;  // Held-out names listed by the 3D photo.
+  // Means over the evaluated photos.
+  double mean_error = 0, mean_completeness = 0, mean_psnr_db = 0, mean_ssim = 0;
+  double mean_depth_median_rel = 0, mean_depth_within = 0;
+  bool has_depth = false;
+  std::vector<int64_t> error_histogram;  // Sum over photos.
+  int64_t total_pixels = 0;              // Sum of photo sizes.
+};
+
+// Evaluates one 3D photo on `capture_dir`. Throws std::invalid_argument for
+// bad options and std::runtime_error with one line naming the input for
+// unreadable or inconsistent inputs (no poses, an unknown photo name, a photo
+// whose size differs from its camera).
+PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
+                                     const std::string& photo3d_path,
+                                     const EvaluateOptions& options);
+
+// Resolves `requested` (names or decimal indices into `names`, sorted) and
+// the held-out rule into the list of indices to evaluate, in increasing order
+// without duplicates: `requested` if not empty, else indices 0, every, 2 every,
+// ... if every > 0, else the names in `holdout` that are in `names`, else all.
+// Throws std::runtime_error naming an unknown name or an index out of range.
+std::vector<int> SelectPhotos(const std::vector<std::string>& names,
+                              const std::vector<std::string>& requested, int every,
+                              const std::vector<std::string>& holdout);
+
+}  // namespace casual3d::eval

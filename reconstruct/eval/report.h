@@ -1,0 +1,52 @@
+#pragma once
+
+// Reports of `casual3d evaluate`: one self-contained HTML file (inline CSS,
+// inline SVG plots, PNG images as base64 data URIs; nothing is fetched from
+// the network) and a JSON document with the same numbers for machines.
+//
+// The HTML report holds, for each 3D photo evaluated: a summary, the table of
+// per-photo figures (error, plain error, completeness, PSNR, SSIM and, on
+// synthetic captures, depth error against the ground truth), the error
+// versus completeness plot (paper Fig. 13: one curve per 3D photo), per-photo
+// thumbnails of photo, rendering and error heatmap, and the timings per stage;
+// with several 3D photos, an ablation table comparing their means side by side.
+
+#include <string>
+#include <vector>
+
+#include "reconstruct/eval/evaluate.h"
+
+namespace casual3d::eval {
+
+struct ReportOptions {
+  // Width of the thumbnails embedded per photo, pixels; [32, 2048].
+  int thumbnail_width = 300;
+  // Error mapped to the hottest heatmap colour, [0, 1] units of the metric;
+  // (0, 1].
+  double heatmap_max_error = 0.25;
+  std::string title = "casual3d rephotography report";
+
+  std::string Check() const;  // Empty if valid, else "field: reason".
+};
+
+// The HTML document for `capture` and the evaluations of one or more 3D photos.
+// Throws std::invalid_argument for invalid options.
+std::string RenderHtmlReport(const std::string& capture,
+                             const std::vector<PhotoModelEvaluation>& evaluations,
+                             const ReportOptions& options = {});
+
+// The JSON document (pretty-printed): {"capture", "options", "photo3d": [{label,
+// source, means, stages, photos: [{name, index, held_out, error, error_plain,
+// completeness, psnr_db, ssim, covered_pixels, width, height, depth?}]}]}.
+std::string RenderJsonReport(const std::string& capture,
+                             const std::vector<PhotoModelEvaluation>& evaluations,
+                             const EvaluateOptions& options);
+
+// The colour of the error heatmap for `error` (dark blue = 0 to yellow-white at
+// `max_error`), RGB. Uncovered pixels (error < 0) are drawn mid grey.
+void HeatmapColor(float error, double max_error, uint8_t rgb[3]);
+
+// Base64 (RFC 4648, with padding) of `bytes`.
+std::string Base64(const std::string& bytes);
+
+}  // namespace casual3d::eval

@@ -1,0 +1,116 @@
+// `casual3d encode`, `info` and `validate` as a user runs them: exit codes, the
+// files they write, and one clear error line on bad input.
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "encoder/master_file.h"
+#include "format/package_test_scene.h"
+
+namespace casual3d {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code;
+  std::string output;  // stdout and stderr.
+};
+
+CommandResult Casual3d(const std::string& args) {
+  const char* bin = std::getenv("CASUAL3D_BINARY_DIR");
+  const std::string cmd = std::string(bin != nullptr ? bin : ".") + "/cli/casual3d " + args + " 2>&1";
+  CommandResult run{-1, ""};
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return run;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof(buf), pipe)) > 0) run.output.append(buf, n);
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+class PackageCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const char* bin = std::getenv("CASUAL3D_BINARY_DIR");
+    if (bin == nullptr || !fs::exists(fs::path(bin) / "cli/casual3d"))
+      GTEST_SKIP() << "the casual3d program is not built";
+    dir_ = fs::temp_directory_path() / ("casual3d_package_cli_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    master_ = (dir_ / "master.exr").string();
+    ASSERT_TRUE(encoder::WriteMasterFile(testing::MakePackageTestPanorama(256, 128), master_).ok());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  std::string master_;
+};
+
+TEST_F(PackageCliTest, EncodeInfoValidate) {
+  const std::string pkg = (dir_ / "pkg").string(), c3d = (dir_ / "pkg.c3d").string();
+  CommandResult encode = Casual3d("encode " + master_ + " -o " + pkg + " --tile-size 64 --levels 3 "
+                        "--no-viewer --single-file " + c3d);
+  ASSERT_EQ(encode.exit_code, 0) << encode.output;
+  EXPECT_TRUE(fs::exists(fs::path(pkg) / "manifest.json"));
+  EXPECT_TRUE(fs::exists(fs::path(pkg) / "l0/1-3.graph.webp"));
+  CommandResult info = Casual3d("info " + c3d);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("level 2      64x32, 1x1 tiles"), std::string::npos) << info.output;
+  for (const std::string& p : {pkg, c3d}) {
+    CommandResult validate = Casual3d("validate " + p);
+    EXPECT_EQ(validate.exit_code, 0) << validate.output;
+    EXPECT_NE(validate.output.find("valid casual3d 1.0 package"), std::string::npos);
+  }
+  // A corrupted tile: exit 1, one line naming the file.
+  {
+    std::fstream f(fs::path(pkg) / "l1/0-1.depth.webp", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(30);
+    f.put('\x7f');
+  }
+  CommandResult bad = Casual3d("validate " + pkg);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.output.find("casual3d: error: "), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("l1/0-1.depth.webp: SHA-256 does not match"), std::string::npos)
+      << bad.output;
+}
+
+TEST_F(PackageCliTest, BadInputsGiveOneClearLine) {
+  struct Case {
+    std::string args, message;
+  } cases[] = {
+      {"encode " + (dir_ / "missing.exr").string() + " -o " + (dir_ / "out").string(),
+       "missing.exr: no such master file"},
+      {"encode " + master_ + " -o " + (dir_ / "out").string() + " --tile-size 9",
+       "tile_size 9 is outside [16, 4096]"},
+      {"encode " + master_ + " -o " + (dir_ / "out").string() + " --levels 9",
+       "levels 9 is outside [0, 8]"},
+      {"encode " + master_ + " -o " + (dir_ / "out").string() + " --quality 101",
+       "color_quality 101.000000 is outside [0, 100]"},
+      {"encode " + master_ + " -o " + dir_.string(), "is not a casual3d package"},
+      {"info " + master_, "not a package folder (no manifest.json) nor a valid .c3d file"},
+      {"validate " + (dir_ / "nothing").string(), "not a package folder"},
+  };
+  for (const Case& c : cases) {
+    CommandResult run = Casual3d(c.args);
+    EXPECT_EQ(run.exit_code, 1) << c.args << "\n" << run.output;
+    EXPECT_NE(run.output.find("casual3d: error: "), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find(c.message), std::string::npos) << c.args << "\n" << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+  EXPECT_TRUE(fs::exists(master_));
+}
+
+}  // namespace
+}  // namespace casual3d

@@ -1,0 +1,18 @@
+// Compile-only check of js/casual3d-viewer.d.ts (ctest viewer_types_test runs
+// tsc --noEmit --strict on it): typical embedding code must type-check.
+import { Casual3dViewer, Casual3dViewerElement, CameraState } from '../js/casual3d-viewer.js';
+
+export async function embed(container: HTMLElement): Promise<number> {
+  const viewer = new Casual3dViewer(container, { maxLevelWidth: 2048, maxOffset: 0.2 });
+  viewer.addEventListener('progress', (e) => console.log(e.detail.loadedBytes / e.detail.totalBytes));
+  viewer.addEventListener('error', (e) => console.log(e.detail.fatal, e.detail.message));
+  await viewer.load('scene/manifest.json');
+  const camera: CameraState = viewer.getCamera();
+  viewer.setCamera({ yawDeg: camera.yawDeg + 10, position: [0.1, 0, 0] });
+  viewer.setEffects({ lighting: true, water: true, waterMinY: -1.5 });
+  await viewer.nextFrame();
+  const element: Casual3dViewerElement = document.querySelector('casual3d-viewer')!;
+  element.addEventListener('firstframe', (e) => console.log(e.detail.timeToFirstFrameMs));
+  element.setCamera({ fovDeg: 60 });
+  return viewer.stats.triangles ?? 0;
+}
