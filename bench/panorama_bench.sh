@@ -2,7 +2,7 @@
 # Benchmark of the panorama stages (warp + stitch + fuse + normals) on the
 # default synthetic captures with their ground-truth depth maps, so that the
 # numbers do not depend on the dense stage. Prints one table: wall time of each
-# step, whole-process wall time and peak memory.
+# step, whole-process wall and CPU (user + system) time and peak memory.
 #
 #   bash bench/panorama_bench.sh [BUILD_DIR] [PANO_WIDTH]
 set -euo pipefail
@@ -15,7 +15,7 @@ casual3d="$build/cli/casual3d"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
-printf "%-8s %6s %7s %7s %7s %7s %7s %7s %7s %8s %9s\n" rig photos load warp st.front st.back fuse normals write wall_s peak_MiB
+printf "%-8s %6s %7s %7s %7s %7s %7s %7s %7s %8s %8s %9s\n" rig photos load warp st.front st.back fuse normals write wall_s cpu_s peak_MiB
 for rig in partial sphere; do
   "$casual3d" synth --rig "$rig" -o "$work/$rig" --panorama-width 256 >/dev/null
   /usr/bin/time -v -o "$work/time.txt" "$casual3d" panorama "$work/$rig" -o "$work/$rig-out" \
@@ -27,8 +27,10 @@ t = open(sys.argv[2]).read()
 rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", t).group(1)) / 1024
 wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): ([\d:.]+)", t).group(1).split(":")
 secs = sum(float(x) * 60 ** i for i, x in enumerate(reversed(wall)))
-print("%-8s %6d %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %8.2f %9.0f" % (
+cpu = float(re.search(r"User time \(seconds\): ([\d.]+)", t).group(1)) + \
+      float(re.search(r"System time \(seconds\): ([\d.]+)", t).group(1))
+print("%-8s %6d %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %8.2f %8.2f %9.0f" % (
     sys.argv[3], p["photos"], s["load"], s["warp"], s["stitch_front"], s["stitch_back"],
-    s["fuse"], s["normals"], s["write"], secs, rss))
+    s["fuse"], s["normals"], s["write"], secs, cpu, rss))
 PY
 done

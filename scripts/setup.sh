@@ -13,7 +13,7 @@ build_dir="${CASUAL3D_BUILD_DIR:-$here/build}"
 # Every Debian package the project uses, by what needs it.
 packages=(
   # toolchain
-  build-essential cmake ninja-build pkg-config ccache dpkg-dev
+  build-essential cmake ninja-build pkg-config ccache dpkg-dev time
   # format/ and encoder/
   libwebp-dev libopenexr-dev libdraco-dev libtinygltf-dev libmeshoptimizer-dev nlohmann-json3-dev
   # reconstruct/

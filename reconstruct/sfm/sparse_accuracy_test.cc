@@ -1,4 +1,4 @@
-// Accuracy of the sparse stage with the real COLMAP (slow: about a minute
+// Accuracy of the sparse stage with the real COLMAP (slow: minutes
 // each on 2 cores): the default synthetic partial capture against its ground
 // truth, and the real captures fern (LLFF poses) and fountain-P11 (Strecha's
 // ground-truth cameras) from ../shared/datasets, skipped when absent.
