@@ -103,7 +103,7 @@ GroundTruthComparison CompareWithGroundTruth(const TwoLayerPanorama& pano, const
         }
       }
       const float back = back_depth.at(x, y);
-      if (near_edge[i] && !std::isnan(back) && back > 0) {
+      if (near_edge[i] && F.present[i] && !std::isnan(back) && back > 0) {
         ++c.back_edge_pixels;
         c.back_edge_present += B.present[i] != 0;
         if (B.present[i]) paint(x, y, 40, 200, 40); else paint(x, y, 230, 0, 230);

@@ -8,8 +8,8 @@
 //     a front node, the fraction within 3% relative depth;
 //   back near edges: of the pixels within 5 pixels of a ground-truth depth edge
 //     (a pixel whose first surface is at least 10% nearer than a pixel within
-//     5 pixels) that have a ground-truth second surface, the fraction with a
-//     back node;
+//     5 pixels) that have a ground-truth second surface and a front node (are
+//     inside the reconstructed field of view), the fraction with a back node;
 //   links across edges: of the 4-neighbour pairs whose ground-truth first
 //     surfaces differ by more than 10% in depth and are not one smooth surface
 //     (each pixel's depth is more than 10% off the plane through its

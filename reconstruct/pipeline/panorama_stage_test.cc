@@ -81,12 +81,12 @@ void CheckAgainstGroundTruth(synth::RigKind rig, int photos, double min_within_3
 }
 
 TEST(PanoramaStageTest, PartialCaptureWithGroundTruthDepthMatchesGroundTruthPanorama) {
-  CheckAgainstGroundTruth(synth::RigKind::kPartial, 16, 0.95, 0.05, 0.5);
+  CheckAgainstGroundTruth(synth::RigKind::kPartial, 16, 0.95, 0.05, 0.85);
 }
 
 TEST(PanoramaStageTest, SphereCaptureWithGroundTruthDepthMatchesGroundTruthPanorama) {
   // The sphere rig's two rings see latitudes up to about +-60 degrees: 70% of the sphere.
-  CheckAgainstGroundTruth(synth::RigKind::kSphere, 50, 0.95, 0.70, 0.7);
+  CheckAgainstGroundTruth(synth::RigKind::kSphere, 50, 0.95, 0.70, 0.78);
 }
 
 TEST(PanoramaStageTest, MissingDepthMapIsAClearError) {
