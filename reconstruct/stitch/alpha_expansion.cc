@@ -133,7 +133,6 @@ bool GridMrf::Expand(int alpha, const Pairwise& pairwise, std::vector<int>* labe
     cost0[np] += e00t;
     cost1[np] += e10;
     cost1[nq] -= e10;
-    cost0[nq] += 0.0;
     const double c = e01 + e10 - e00t;
     if (c > 0) graph->add_edge(np, nq, c, 0.0);
   };
