@@ -10,6 +10,8 @@
 #include <system_error>
 #include <vector>
 
+#include "reconstruct/util/html.h"
+
 namespace casual3d::cli {
 namespace fs = std::filesystem;
 
@@ -65,28 +67,6 @@ std::string ReadFile(const fs::path& path) {
   return ss.str();
 }
 
-std::string HtmlEscape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -109,8 +89,8 @@ fs::path FindViewerDir() {
 }
 
 std::string ViewerPageHtml(const std::string& title, const std::string& viewer_url_prefix) {
-  const std::string t = HtmlEscape(title);
-  const std::string p = HtmlEscape(viewer_url_prefix);
+  const std::string t = util::HtmlEscape(title);
+  const std::string p = util::HtmlEscape(viewer_url_prefix);
   return "<!DOCTYPE html>\n"
          "<html lang=\"en\">\n"
          "<head>\n"

@@ -9,7 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "reconstruct/io/colour_map.h"
 #include "reconstruct/io/cv_bridge.h"
+#include "reconstruct/util/html.h"
 
 namespace casual3d::eval {
 
@@ -51,40 +53,11 @@ void HeatmapColor(float error, double max_error, uint8_t rgb[3]) {
     rgb[0] = rgb[1] = rgb[2] = 128;
     return;
   }
-  // A dark-blue, purple, orange, pale-yellow ramp (monotonic in lightness).
-  static const double kStops[5][3] = {
-      {10, 10, 40}, {90, 30, 120}, {200, 60, 80}, {250, 160, 40}, {255, 250, 200}};
-  const double t = std::clamp(error / max_error, 0.0, 1.0) * 4.0;
-  const int k = std::min(3, static_cast<int>(t));
-  const double f = t - k;
-  for (int c = 0; c < 3; ++c)
-    rgb[c] = static_cast<uint8_t>(std::lround(kStops[k][c] * (1 - f) + kStops[k + 1][c] * f));
+  io::HeatColour(error / max_error, rgb);
 }
 
 namespace {
 
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 std::string Fmt(const char* format, double v) {
   char buf[64];
@@ -155,9 +128,9 @@ std::string ErrorCompletenessSvg(const std::vector<PhotoModelEvaluation>& evals)
     for (const auto& p : evals[k].photos)
       s << "<circle cx=\"" << Fmt("%.1f", px(p.metrics.completeness)) << "\" cy=\""
         << Fmt("%.1f", py(p.metrics.error)) << "\" r=\"3.5\" fill=\"" << color << "\"><title>"
-        << Escape(p.name) << "</title></circle>";
+        << util::HtmlEscape(p.name) << "</title></circle>";
     s << "<text x=\"" << left + 10 << "\" y=\"" << top + 16 + 16 * k << "\" fill=\"" << color
-      << "\">" << Escape(evals[k].label) << "</text>";
+      << "\">" << util::HtmlEscape(evals[k].label) << "</text>";
   }
   s << "</svg>";
   return s.str();
@@ -172,7 +145,7 @@ std::string RenderHtmlReport(const std::string& capture,
     throw std::invalid_argument("report: " + why);
   std::ostringstream s;
   s << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>"
-    << Escape(options.title)
+    << util::HtmlEscape(options.title)
     << "</title>\n<style>\n"
        "body{font-family:system-ui,sans-serif;margin:24px;color:#222;max-width:1400px}\n"
        "table{border-collapse:collapse;margin:8px 0 20px}\n"
@@ -182,7 +155,7 @@ std::string RenderHtmlReport(const std::string& capture,
        "svg text{font-size:12px;font-family:system-ui,sans-serif}\n"
        ".photo{border-top:1px solid #ddd;padding-top:6px}\n"
        "</style></head><body>\n";
-  s << "<h1>" << Escape(options.title) << "</h1>\n<p>Capture: <code>" << Escape(capture)
+  s << "<h1>" << util::HtmlEscape(options.title) << "</h1>\n<p>Capture: <code>" << util::HtmlEscape(capture)
     << "</code>. Virtual rephotography (Hedman et al. 2017, Sec. 6.3; Waechter et al. 2017): each "
        "photo is re-rendered from the 3D photo at its exact pose and compared with it. Error: per "
        "pixel, the minimum sum of absolute RGB differences within a shiftable window of &plusmn;2 "
@@ -196,7 +169,7 @@ std::string RenderHtmlReport(const std::string& capture,
          "err.</th>"
          "<th>depth within 3%</th><th>triangles</th></tr>\n";
     for (const auto& e : evals) {
-      s << "<tr><td class=\"l\">" << Escape(e.label) << "</td><td>" << e.photos.size()
+      s << "<tr><td class=\"l\">" << util::HtmlEscape(e.label) << "</td><td>" << e.photos.size()
         << "</td><td>" << Fmt("%.4f", e.mean_error) << "</td><td>"
         << Fmt("%.3f", e.mean_completeness) << "</td><td>" << Fmt("%.2f", e.mean_psnr_db)
         << "</td><td>" << Fmt("%.3f", e.mean_ssim) << "</td><td>"
@@ -213,8 +186,8 @@ std::string RenderHtmlReport(const std::string& capture,
     << ErrorCompletenessSvg(evals) << "\n";
 
   for (const auto& e : evals) {
-    s << "<h2>" << Escape(e.label) << "</h2>\n<p>Read from <code>" << Escape(e.source)
-      << "</code>; poses from <code>" << Escape(e.poses_from) << "</code>. Panorama "
+    s << "<h2>" << util::HtmlEscape(e.label) << "</h2>\n<p>Read from <code>" << util::HtmlEscape(e.source)
+      << "</code>; poses from <code>" << util::HtmlEscape(e.poses_from) << "</code>. Panorama "
       << e.pano_width << "&times;" << e.pano_height << ", mesh of " << e.mesh_triangles
       << " triangles";
     if (e.package_bytes) s << ", package " << Fmt("%.2f", e.package_bytes / 1048576.0) << " MiB";
@@ -228,7 +201,7 @@ std::string RenderHtmlReport(const std::string& capture,
     s << "<th>render (s)</th></tr>\n";
     for (const auto& p : e.photos) {
       const RephotoMetrics& m = p.metrics;
-      s << "<tr><td class=\"l\">" << Escape(p.name) << "</td><td>" << p.index << "</td><td>"
+      s << "<tr><td class=\"l\">" << util::HtmlEscape(p.name) << "</td><td>" << p.index << "</td><td>"
         << (p.held_out ? "yes" : "no") << "</td><td>" << m.width << "&times;" << m.height
         << "</td><td>" << Fmt("%.4f", m.error) << "</td><td>" << Fmt("%.4f", m.error_plain)
         << "</td><td>" << Fmt("%.3f", m.completeness) << "</td><td>" << Fmt("%.2f", m.psnr_db)
@@ -244,7 +217,7 @@ std::string RenderHtmlReport(const std::string& capture,
       s << "<h3>Timings per stage</h3>\n<table><tr><th "
            "class=\"l\">stage</th><th>seconds</th></tr>\n";
       for (const auto& [stage, sec] : e.stage_seconds)
-        s << "<tr><td class=\"l\">" << Escape(stage) << "</td><td>" << Fmt("%.2f", sec)
+        s << "<tr><td class=\"l\">" << util::HtmlEscape(stage) << "</td><td>" << Fmt("%.2f", sec)
           << "</td></tr>\n";
       s << "</table>\n";
     }
@@ -253,7 +226,7 @@ std::string RenderHtmlReport(const std::string& capture,
       << Fmt("%.2f", options.heatmap_max_error) << " or more, grey = not covered.</p>\n";
     for (const auto& p : e.photos) {
       if (p.photo.empty()) continue;
-      s << "<div class=\"photo\"><b>" << Escape(p.name) << "</b><br>";
+      s << "<div class=\"photo\"><b>" << util::HtmlEscape(p.name) << "</b><br>";
       s << "<figure><img alt=\"photo\" src=\"" << PngDataUri(p.photo, options.thumbnail_width)
         << "\"><figcaption>photo</figcaption></figure>";
       s << "<figure><img alt=\"rephotograph\" src=\""

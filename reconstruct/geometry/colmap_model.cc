@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 // garbage widths that would later size huge buffers.
 constexpr uint64_t kMaxImageSide = 1u << 20;
 
-std::string JoinPath(const std::string& dir, const char* name) {
+std::string JoinPath(const std::string& dir, const std::string& name) {
   return (fs::path(dir) / name).string();
 }
 
@@ -557,25 +557,27 @@ std::map<uint64_t, Point3D> ReadPoints3DBinary(const std::string& path) {
 // ---------------------------------------------------------------------------
 // Model-level readers.
 
-SparseModel ReadModelText(const std::string& dir) {
+namespace {
+
+// The three files of a model in one encoding, with the cross-file checks.
+SparseModel ReadModelFiles(const std::string& dir, bool binary) {
+  const std::string ext = binary ? ".bin" : ".txt";
+  const std::string images_path = JoinPath(dir, "images" + ext);
   SparseModel model;
-  model.cameras = ReadCamerasText(JoinPath(dir, "cameras.txt"));
-  const std::string images_path = JoinPath(dir, "images.txt");
-  model.images = ReadImagesText(images_path);
-  model.points = ReadPoints3DText(JoinPath(dir, "points3D.txt"));
+  model.cameras = binary ? ReadCamerasBinary(JoinPath(dir, "cameras" + ext))
+                         : ReadCamerasText(JoinPath(dir, "cameras" + ext));
+  model.images = binary ? ReadImagesBinary(images_path) : ReadImagesText(images_path);
+  model.points = binary ? ReadPoints3DBinary(JoinPath(dir, "points3D" + ext))
+                        : ReadPoints3DText(JoinPath(dir, "points3D" + ext));
   CheckCameraReferences(model, images_path);
   return model;
 }
 
-SparseModel ReadModelBinary(const std::string& dir) {
-  SparseModel model;
-  model.cameras = ReadCamerasBinary(JoinPath(dir, "cameras.bin"));
-  const std::string images_path = JoinPath(dir, "images.bin");
-  model.images = ReadImagesBinary(images_path);
-  model.points = ReadPoints3DBinary(JoinPath(dir, "points3D.bin"));
-  CheckCameraReferences(model, images_path);
-  return model;
-}
+}  // namespace
+
+SparseModel ReadModelText(const std::string& dir) { return ReadModelFiles(dir, false); }
+
+SparseModel ReadModelBinary(const std::string& dir) { return ReadModelFiles(dir, true); }
 
 SparseModel ReadModel(const std::string& dir) {
   auto all_exist = [&](const char* ext) {
