@@ -85,6 +85,40 @@ void QuadTriangles(const TwoLayerPanorama& p, int x, int y, bool use_back, unsig
   const bool wrap = x + 1 == p.width();  // B and D are column 0, seen as column width.
   const int xb = wrap ? 0 : x + 1;
   const size_t idx[4] = {p.index(x, y), p.index(xb, y), p.index(x, y + 1), p.index(xb, y + 1)};
+  auto ref = [&](int c, int l) {
+    return static_cast<NodeRef>(idx[c] * 2 + l) | (wrap && (c == B || c == D) ? kSeamBit : 0u);
+  };
+  // The common cases first: four front nodes linked to each other around the
+  // quad, and at its corners either no back node or four back nodes linked
+  // to each other around it. The rules below then give exactly the corner-B
+  // and corner-C triangles of each such layer, corner B's first, front before
+  // back (corners A and D are closed by them).
+  {
+    const LayerData& f = p.layer(kFront);
+    const LayerData& b = p.layer(kBack);
+    // Links around the quad, two bits per direction: right and down at A,
+    // down and left at B, right and up at C, left and up at D, all to `link`.
+    auto linked_around = [&](const LayerData& d, unsigned link) {
+      return d.present[idx[A]] == 1 && d.present[idx[B]] == 1 && d.present[idx[C]] == 1 &&
+             d.present[idx[D]] == 1 && (d.links[idx[A]] & 0x0Fu) == link * 0x05u &&
+             (d.links[idx[B]] & 0x3Cu) == link * 0x14u &&
+             (d.links[idx[C]] & 0xC3u) == link * 0x41u && (d.links[idx[D]] & 0xF0u) == link * 0x50u;
+    };
+    if (linked_around(f, 1)) {
+      const bool no_back = !use_back || !(b.present[idx[A]] | b.present[idx[B]] |
+                                          b.present[idx[C]] | b.present[idx[D]]);
+      if (no_back || linked_around(b, 2)) {
+        const int layers = no_back ? 1 : 2;
+        for (int l = 0; l < layers; ++l) {
+          if (!(skip_layers & (1u << l))) out->AddTriangle(ref(B, l), ref(A, l), ref(D, l));
+        }
+        for (int l = 0; l < layers; ++l) {
+          if (!(skip_layers & (1u << l))) out->AddTriangle(ref(C, l), ref(D, l), ref(A, l));
+        }
+        return;
+      }
+    }
+  }
   // Local copies: bit l of present[c] is set if corner c has a usable node of
   // layer l; links[c][l] are its links (0 otherwise).
   unsigned present[4] = {0, 0, 0, 0};
@@ -107,9 +141,6 @@ void QuadTriangles(const TwoLayerPanorama& p, int x, int y, bool use_back, unsig
     if (link == 0 || link == 3) return -1;
     const int t = static_cast<int>(link) - 1;
     return (present[oc] >> t) & 1u ? t : -1;
-  };
-  auto ref = [&](int c, int l) {
-    return static_cast<NodeRef>(idx[c] * 2 + l) | (wrap && (c == B || c == D) ? kSeamBit : 0u);
   };
   auto usable = [&](int c, int l) { return ((present[c] & ~skip_layers) >> l) & 1u; };
   // Corner A: links right and down; only where neither B nor C closes the
@@ -265,14 +296,14 @@ Mesh MeshAssembler::Finish() {
     mesh.uvs.push_back(u_of[seam ? w : x]);
     mesh.uvs.push_back(v_of[2 * y + half]);
   };
-  size_t key = 0;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      for (int l = 0; l < kNumLayers; ++l) {
-        for (int other = 0; other < 2; ++other, ++key) {
-          if ((used[key >> 6] >> (key & 63)) & 1) emit(x, y, l, l ^ other, false);
-        }
-      }
+  // Used keys in increasing order, i.e. (row, column, layer, half) order.
+  for (size_t word = 0; word < words; ++word) {
+    for (uint64_t bits = used[word]; bits != 0; bits &= bits - 1) {
+      const size_t key = word * 64 + static_cast<size_t>(__builtin_ctzll(bits));
+      const size_t pixel = key >> 2;
+      const int l = static_cast<int>((key >> 1) & 1);
+      const int other = static_cast<int>(key & 1);
+      emit(static_cast<int>(pixel % w), static_cast<int>(pixel / w), l, l ^ other, false);
     }
   }
   for (int y = 0; y < h; ++y) {

@@ -33,15 +33,22 @@ struct Directions {
 // only blocks wholly inside the quad grid (width columns with wrap, height - 1
 // rows) exist. error[k][by * nx[k] + bx] is the block's relative error, or
 // infinity if it cannot be merged.
+//
+// Errors above `max_error` are stored as infinity: no threshold the
+// simplifier tries exceeds it, so such a block behaves exactly like one that
+// cannot be merged, and its parent need not look at its nodes.
+//
+// Cost: every node of a mergeable block enters one dot product per level, so
+// the quad grid is walked in tiles of the largest block's size, all levels of
+// one tile at a time, with the tile's node positions computed once and kept
+// in a cache small enough for the processor's caches (400 KB for 128 quads).
 class LayerPyramid {
  public:
-  LayerPyramid(const TwoLayerPanorama& p, const Directions& dirs, int layer, int levels)
-      : p_(p), dirs_(dirs), layer_(layer) {
+  LayerPyramid(const TwoLayerPanorama& p, const Directions& dirs, int layer, int levels,
+               double max_error)
+      : p_(p), dirs_(dirs), layer_(layer), max_error_(max_error) {
     const int qw = p.width(), qh = p.height() - 1;
-    full_.assign(static_cast<size_t>(qw) * qh, 0);
-    for (int y = 0; y < qh; ++y) {
-      for (int x = 0; x < qw; ++x) full_[static_cast<size_t>(y) * qw + x] = FullQuad(x, y);
-    }
+    FullQuads();
     nx_.push_back(qw);
     ny_.push_back(qh);
     error_.emplace_back();  // Level 0 uses full_.
@@ -50,10 +57,27 @@ class LayerPyramid {
       nx_.push_back(qw / s);
       ny_.push_back(qh / s);
       error_.emplace_back(static_cast<size_t>(nx_[k]) * ny_[k], kInf);
-      for (int by = 0; by < ny_[k]; ++by) {
-        for (int bx = 0; bx < nx_[k]; ++bx) error_[k][Index(k, bx, by)] = BlockError(k, bx, by);
+    }
+    // Blocks nest inside tiles, so a block's children are evaluated before it.
+    const int tile = 1 << levels;
+    for (int y0 = 0; y0 < qh; y0 += tile) {
+      for (int x0 = 0; x0 < qw; x0 += tile) {
+        tile_x0_ = x0;
+        tile_y0_ = y0;
+        tile_ready_ = false;
+        for (int k = 1; k <= levels; ++k) {
+          const int s = 1 << k;
+          const int by_end = std::min(ny_[k], (y0 + tile) / s);
+          const int bx_end = std::min(nx_[k], (x0 + tile) / s);
+          for (int by = y0 / s; by < by_end; ++by) {
+            for (int bx = x0 / s; bx < bx_end; ++bx) {
+              error_[k][Index(k, bx, by)] = BlockError(k, bx, by);
+            }
+          }
+        }
       }
     }
+    std::vector<double>().swap(positions_);
   }
 
   int levels() const { return static_cast<int>(error_.size()) - 1; }
@@ -61,6 +85,8 @@ class LayerPyramid {
   int ny(int k) const { return ny_[k]; }
   size_t Index(int k, int bx, int by) const { return static_cast<size_t>(by) * nx_[k] + bx; }
   double Error(int k, int bx, int by) const { return error_[k][Index(k, bx, by)]; }
+  // Whether pixel quad (x, y) has four nodes of this layer linked around it.
+  bool FullQuad(int x, int y) const { return full_[static_cast<size_t>(y) * nx_[0] + x] != 0; }
   // The parent's error, or infinity if the parent block does not exist.
   double ParentError(int k, int bx, int by) const {
     if (k == levels()) return kInf;
@@ -70,37 +96,79 @@ class LayerPyramid {
   }
 
  private:
-  int Column(int x) const { return x == p_.width() ? 0 : x; }
-  int LinkLayer(int x, int y, Direction d) const {
-    const Link l = GetLink(p_.layer(layer_).links[p_.index(Column(x), y)], d);
-    return l == Link::kFront ? kFront : l == Link::kBack ? kBack : -1;
-  }
-  bool Present(int x, int y) const { return p_.layer(layer_).present[p_.index(Column(x), y)]; }
-
-  // All four corners are nodes of this layer, linked around the quad.
-  uint8_t FullQuad(int x, int y) const {
-    if (!Present(x, y) || !Present(x + 1, y) || !Present(x, y + 1) || !Present(x + 1, y + 1)) {
-      return 0;
+  // full_: whether all four corners of a quad are nodes of this layer, linked
+  // to each other around the quad. Per node, bit 0: present; bits 1 + d: the
+  // link in direction d leads to this layer.
+  void FullQuads() {
+    const int w = p_.width(), qh = p_.height() - 1;
+    const LayerData& d = p_.layer(layer_);
+    const unsigned same = static_cast<unsigned>(layer_ == kFront ? Link::kFront : Link::kBack);
+    uint8_t link_bits[256];  // Bits 1 + d of a packed links byte.
+    for (unsigned links = 0; links < 256; ++links) {
+      unsigned bits = 0;
+      for (int dir = 0; dir < kNumDirections; ++dir) {
+        bits |= (((links >> (2 * dir)) & 3u) == same ? 1u : 0u) << (1 + dir);
+      }
+      link_bits[links] = static_cast<uint8_t>(bits);
     }
-    return LinkLayer(x, y, kRight) == layer_ && LinkLayer(x, y, kDown) == layer_ &&
-           LinkLayer(x + 1, y, kDown) == layer_ && LinkLayer(x, y + 1, kRight) == layer_ &&
-           LinkLayer(x + 1, y, kLeft) == layer_ && LinkLayer(x, y + 1, kUp) == layer_ &&
-           LinkLayer(x + 1, y + 1, kUp) == layer_ && LinkLayer(x + 1, y + 1, kLeft) == layer_;
+    std::vector<uint8_t> upper(w), lower(w);
+    auto row_bits = [&](int y, std::vector<uint8_t>* out) {
+      const size_t i0 = p_.index(0, y);
+      for (int x = 0; x < w; ++x) {
+        (*out)[x] = link_bits[d.links[i0 + x]] | (d.present[i0 + x] ? 1u : 0u);
+      }
+    };
+    constexpr unsigned kP = 1, kR = 1 << (1 + kRight), kD = 1 << (1 + kDown), kL = 1 << (1 + kLeft),
+                       kU = 1 << (1 + kUp);
+    full_.assign(static_cast<size_t>(w) * qh, 0);
+    if (qh > 0) row_bits(0, &upper);
+    for (int y = 0; y < qh; ++y) {
+      row_bits(y + 1, &lower);
+      uint8_t* full = &full_[static_cast<size_t>(y) * w];
+      for (int x = 0; x < w; ++x) {
+        const int xb = x + 1 == w ? 0 : x + 1;
+        full[x] = (upper[x] & (kP | kR | kD)) == (kP | kR | kD) &&
+                  (upper[xb] & (kP | kD | kL)) == (kP | kD | kL) &&
+                  (lower[x] & (kP | kR | kU)) == (kP | kR | kU) &&
+                  (lower[xb] & (kP | kU | kL)) == (kP | kU | kL);
+      }
+      upper.swap(lower);
+    }
   }
 
-  void Position(int x, int y, double out[3]) const {
-    const int c = Column(x);
-    const double depth = p_.layer(layer_).depth_m[p_.index(c, y)];
-    const double horizontal = dirs_.cos_lat[y] * depth;
-    out[0] = horizontal * dirs_.sin_lon[c];
-    out[1] = dirs_.sin_lat[y] * depth;
-    out[2] = -(horizontal * dirs_.cos_lon[c]);
+  // Positions (x, y, z) of the nodes of the current tile: rows tile_y0_ ..
+  // tile_y0_ + tile size and columns tile_x0_ .. tile_x0_ + tile size, clipped
+  // to the grid (column `width` repeats column 0), computed on first use.
+  void PrepareTile() {
+    if (tile_ready_) return;
+    tile_ready_ = true;
+    const int w = p_.width(), last_row = p_.height() - 1;
+    const int tile = 1 << levels();
+    const int rows = std::min(tile, last_row - tile_y0_) + 1;
+    const int cols = std::min(tile, w - tile_x0_) + 1;
+    const size_t stride = static_cast<size_t>(tile) + 1;
+    positions_.resize(3 * stride * stride);
+    const LayerData& d = p_.layer(layer_);
+    for (int r = 0; r < rows; ++r) {
+      const int y = tile_y0_ + r;
+      const float* depth_row = &d.depth_m[p_.index(0, y)];
+      const double cos_lat = dirs_.cos_lat[y], sin_lat = dirs_.sin_lat[y];
+      double* out = &positions_[3 * r * stride];
+      for (int i = 0; i < cols; ++i, out += 3) {
+        const int c = tile_x0_ + i == w ? 0 : tile_x0_ + i;
+        const double depth = depth_row[c];
+        const double horizontal = cos_lat * depth;
+        out[0] = horizontal * dirs_.sin_lon[c];
+        out[1] = sin_lat * depth;
+        out[2] = -(horizontal * dirs_.cos_lon[c]);
+      }
+    }
   }
 
   // Spec/mesh.md Sec. 5.2: the children must be mergeable; the plane normal is
   // the cross product of the block's diagonals; the slab is the range of n.p
   // over the block's (s+1)^2 nodes.
-  double BlockError(int k, int bx, int by) const {
+  double BlockError(int k, int bx, int by) {
     const int s = 1 << k;
     const int x0 = bx * s, y0 = by * s;
     double children = 0.0;
@@ -113,41 +181,124 @@ class LayerPyramid {
         }
       }
     }
-    if (children == kInf) return kInf;
+    if (!(children <= max_error_)) return kInf;
+    PrepareTile();
+    // Node (x0 + i, y0 + j) is cached at index top + j * stride + i.
+    const size_t stride = (size_t{1} << levels()) + 1;
+    const size_t top = static_cast<size_t>(y0 - tile_y0_) * stride + (x0 - tile_x0_);
+    const size_t bottom = top + static_cast<size_t>(s) * stride;
+    auto position = [&](size_t node, double out[3]) {
+      for (int i = 0; i < 3; ++i) out[i] = positions_[3 * node + i];
+    };
     double a[3], b[3], c[3], d[3];
-    Position(x0, y0, a);
-    Position(x0 + s, y0, b);
-    Position(x0, y0 + s, c);
-    Position(x0 + s, y0 + s, d);
+    position(top, a);
+    position(top + s, b);
+    position(bottom, c);
+    position(bottom + s, d);
     const double u[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
     const double v[3] = {c[0] - b[0], c[1] - b[1], c[2] - b[2]};
     double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 0.0)) return kInf;
     for (double& e : n) e /= len;
-    double lo = kInf, hi = -kInf;
-    for (int y = y0; y <= y0 + s; ++y) {
-      for (int x = x0; x <= x0 + s; ++x) {
-        double q[3];
-        Position(x, y, q);
-        const double t = n[0] * q[0] + n[1] * q[1] + n[2] * q[2];
-        lo = std::min(lo, t);
-        hi = std::max(hi, t);
+    // Separate running minima and maxima for even and odd columns shorten the
+    // dependency chains; the range does not depend on the order of the nodes.
+    double lo0 = kInf, hi0 = -kInf, lo1 = kInf, hi1 = -kInf;
+    for (size_t row = top; row <= bottom; row += stride) {
+      const double* q = &positions_[3 * row];
+      int x = 0;
+      for (; x < s; x += 2, q += 6) {
+        const double t0 = n[0] * q[0] + n[1] * q[1] + n[2] * q[2];
+        const double t1 = n[0] * q[3] + n[1] * q[4] + n[2] * q[5];
+        lo0 = std::min(lo0, t0);
+        hi0 = std::max(hi0, t0);
+        lo1 = std::min(lo1, t1);
+        hi1 = std::max(hi1, t1);
       }
+      const double t = n[0] * q[0] + n[1] * q[1] + n[2] * q[2];  // x == s (s is even).
+      lo0 = std::min(lo0, t);
+      hi0 = std::max(hi0, t);
     }
+    const double lo = std::min(lo0, lo1), hi = std::max(hi0, hi1);
     const double delta = 0.5 * (hi - lo);
     const double offset = std::fabs(0.5 * (hi + lo));
     if (!(offset > delta)) return kInf;  // The slab contains the centre.
-    return std::max(children, 2.0 * delta / (offset - delta));
+    const double error = std::max(children, 2.0 * delta / (offset - delta));
+    return error <= max_error_ ? error : kInf;
   }
 
   const TwoLayerPanorama& p_;
   const Directions& dirs_;
   int layer_;
+  double max_error_;
   std::vector<uint8_t> full_;
   std::vector<int> nx_, ny_;
   std::vector<std::vector<double>> error_;
+  // The tile being evaluated (its top-left quad) and its node positions.
+  int tile_x0_ = 0, tile_y0_ = 0;
+  bool tile_ready_ = false;
+  std::vector<double> positions_;
 };
+
+// The triangles of BuildMesh(). A quad whose four front nodes are linked
+// around it has two (AddQuadTriangles' corner-B and corner-C triangles) if it
+// has no back node, four if its back nodes are linked around it as well;
+// other quads are counted rule by rule. `back` is null without the back layer.
+int64_t CountFullTriangles(const TwoLayerPanorama& p, const LayerPyramid& front,
+                           const LayerPyramid* back) {
+  const bool use_back = back != nullptr;
+  const int w = p.width(), qh = p.height() - 1;
+  const std::vector<uint8_t>& back_present = p.layer(kBack).present;
+  std::vector<uint8_t> back_in_column(w, 0);  // A back node at (x, y) or (x, y + 1).
+  int64_t triangles = 0;
+  for (int y = 0; y < qh; ++y) {
+    if (use_back) {
+      const size_t i0 = p.index(0, y);
+      for (int x = 0; x < w; ++x) {
+        back_in_column[x] = back_present[i0 + x] | back_present[i0 + w + x];
+      }
+    }
+    for (int x = 0; x < w; ++x) {
+      const int xb = x + 1 == w ? 0 : x + 1;
+      if (front.FullQuad(x, y) && !(back_in_column[x] | back_in_column[xb])) {
+        triangles += 2;
+      } else if (front.FullQuad(x, y) && use_back && back->FullQuad(x, y)) {
+        triangles += 4;
+      } else {
+        triangles += CountQuadTriangles(p, x, y, use_back, 0);
+      }
+    }
+  }
+  return triangles;
+}
+
+// Adds to the difference array `saving` (over threshold steps) the triangles
+// each block of `py` saves at the steps where it is a leaf: a leaf of 2^k x
+// 2^k quads replaces 2 * 4^k triangles by 2, and a block is a leaf for the
+// steps i with error <= steps[i] < its parent's error. step_of(e) is the
+// finest step i with e <= steps[i], or -1.
+template <typename StepOf>
+void AddSavings(const LayerPyramid& py, const StepOf& step_of, std::vector<int64_t>* saving) {
+  // Each block's step, level by level from the top, so that a block finds its
+  // parent's step in the level above.
+  std::vector<int8_t> parent_steps, block_steps;
+  for (int k = py.levels(); k >= 1; --k) {
+    const int64_t s = (int64_t{2} << (2 * k)) - 2;
+    block_steps.assign(static_cast<size_t>(py.nx(k)) * py.ny(k), -1);
+    for (int by = 0; by < py.ny(k); ++by) {
+      for (int bx = 0; bx < py.nx(k); ++bx) {
+        const int last = step_of(py.Error(k, bx, by));
+        if (last < 0) continue;
+        block_steps[py.Index(k, bx, by)] = static_cast<int8_t>(last);
+        const bool has_parent = k < py.levels() && bx / 2 < py.nx(k + 1) && by / 2 < py.ny(k + 1);
+        const int parent = has_parent ? parent_steps[py.Index(k + 1, bx / 2, by / 2)] : -1;
+        (*saving)[parent + 1] += s;  // i in (parent, last].
+        (*saving)[last + 1] -= s;
+      }
+    }
+    parent_steps.swap(block_steps);
+  }
+}
 
 struct Leaf {
   int layer, level, x0, y0;
@@ -189,9 +340,24 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
   }
   MeshAssembler out(p);
   out.Reserve(2 * static_cast<size_t>(w) * qh / 4 + 1024);
+  // A quad covered by leaves of every layer that has a node at its corners
+  // has no triangle left (each triangle starts at a corner node of an
+  // uncovered layer).
+  const std::vector<uint8_t>& back_present = p.layer(kBack).present;
+  std::vector<uint8_t> back_in_column(w, 0);  // A back node at (x, y) or (x, y + 1).
   for (int y = 0; y < qh; ++y) {
+    const uint8_t* row_covered = &covered[static_cast<size_t>(y) * w];
+    if (use_back) {
+      const size_t i0 = p.index(0, y);
+      for (int x = 0; x < w; ++x) {
+        back_in_column[x] = back_present[i0 + x] | back_present[i0 + w + x];
+      }
+    }
     for (int x = 0; x < w; ++x) {
-      AddQuadTriangles(p, x, y, use_back, covered[static_cast<size_t>(y) * w + x], &out);
+      const int xb = x + 1 == w ? 0 : x + 1;
+      const unsigned back_needed = (back_in_column[x] | back_in_column[xb]) ? 2u : 0u;
+      if ((row_covered[x] & 1u) && !(back_needed & ~row_covered[x])) continue;
+      AddQuadTriangles(p, x, y, use_back, row_covered[x], &out);
     }
   }
   // Nodes that geometry outside a leaf uses: every vertex of the remaining
@@ -288,60 +454,46 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
                                              const MeshSimplifyOptions& options) {
   CASUAL3D_RETURN_IF_ERROR(options.Check());
   CASUAL3D_RETURN_IF_ERROR(CheckMeshInput(pano, options.max_pixels, options.validate_input));
-  const int w = pano.width(), qh = pano.height() - 1;
+  const int w = pano.width();
   const bool use_back = options.include_back_layer;
-
-  SimplifiedMesh result;
-  for (int y = 0; y < qh; ++y) {
-    for (int x = 0; x < w; ++x)
-      result.full_triangles += CountQuadTriangles(pano, x, y, use_back, 0);
-  }
 
   int levels = 0;
   while ((2 << levels) <= options.max_block_size) ++levels;
   const Directions dirs(w, pano.height());
   std::vector<LayerPyramid> pyramids;
   for (int l = 0; l < (use_back ? kNumLayers : 1); ++l) {
-    pyramids.emplace_back(pano, dirs, l, levels);
+    pyramids.emplace_back(pano, dirs, l, levels, options.max_relative_error);
   }
+
+  SimplifiedMesh result;
+  result.full_triangles =
+      CountFullTriangles(pano, pyramids[kFront], use_back ? &pyramids[kBack] : nullptr);
 
   // Candidate thresholds, coarsest first, and the triangle count each would
   // give before border vertices are added to the patches: a leaf of 2^k x 2^k
   // quads replaces 2 * 4^k triangles by 2. A block is a leaf for thresholds in
   // [its error, its parent's error).
-  double steps[kNumSteps + 1];
+  // steps[] is padded with -infinity up to kStepsPadded entries so that the
+  // search below needs no bounds check.
+  constexpr int kStepsPadded = 128;
+  static_assert(kNumSteps < kStepsPadded, "the padded step table must hold every step");
+  double steps[kStepsPadded];
   steps[0] = options.max_relative_error;
   for (int i = 1; i < kNumSteps; ++i) steps[i] = steps[i - 1] * kQuarterOctave;
   steps[kNumSteps] = 0.0;
+  for (int i = kNumSteps + 1; i < kStepsPadded; ++i) steps[i] = -kInf;
   auto step_of = [&](double e) {  // The last (finest) step i with e <= steps[i], or -1.
     if (!(e <= steps[0])) return -1;
-    int lo = 0, hi = kNumSteps;  // steps[lo] >= e; find the largest such index.
-    while (lo < hi) {
-      const int mid = (lo + hi + 1) / 2;
-      if (e <= steps[mid]) {
-        lo = mid;
-      } else {
-        hi = mid - 1;
-      }
+    // e <= steps[i] holds for a prefix of i (steps decrease): find its end
+    // without data-dependent branches.
+    int last = 0;
+    for (int half = kStepsPadded / 2; half >= 1; half /= 2) {
+      last = e <= steps[last + half] ? last + half : last;
     }
-    return lo;
+    return last;
   };
   std::vector<int64_t> saving(kNumSteps + 2, 0);  // Difference array over step indices.
-  for (const LayerPyramid& py : pyramids) {
-    for (int k = 1; k <= py.levels(); ++k) {
-      const int64_t s = (int64_t{2} << (2 * k)) - 2;
-      for (int by = 0; by < py.ny(k); ++by) {
-        for (int bx = 0; bx < py.nx(k); ++bx) {
-          const int last = step_of(py.Error(k, bx, by));
-          if (last < 0) continue;
-          const int parent = step_of(py.ParentError(k, bx, by));
-          // A leaf at steps i with e <= steps[i] < parent error: i in (parent, last].
-          saving[parent + 1] += s;
-          saving[last + 1] -= s;
-        }
-      }
-    }
-  }
+  for (const LayerPyramid& py : pyramids) AddSavings(py, step_of, &saving);
   std::vector<int64_t> estimate(kNumSteps + 1);
   int64_t running = 0;
   for (int i = 0; i <= kNumSteps; ++i) {

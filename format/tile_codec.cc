@@ -206,10 +206,119 @@ Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int 
   return image;
 }
 
-TileDecoder::TileDecoder(const TileQuantization& q) : q_(q), table_(q.depth.MaxCode() + 1) {
+TileDecoder::TileDecoder(const TileQuantization& q)
+    : q_(q), table_(q.depth.MaxCode() + 1) {
   for (int code = 0; code <= q.depth.MaxCode(); ++code)
     table_[code] = static_cast<float>(DequantizeDepth(static_cast<uint16_t>(code), q.depth));
+  // Every 8-bit code pair through DecodeOctahedral once, so that decoding a
+  // tile is a table look-up per pixel with exactly the same floats.
+  normal_table_.resize(3 * 65536);
+  normal_valid_.resize(65536);
+  for (int c0 = 0; c0 < 256; ++c0) {
+    for (int c1 = 0; c1 < 256; ++c1) {
+      const uint8_t code[2] = {static_cast<uint8_t>(c0), static_cast<uint8_t>(c1)};
+      const size_t k = static_cast<size_t>(c0) << 8 | c1;
+      normal_valid_[k] = DecodeOctahedral(code, q.normal, &normal_table_[3 * k]) ? 1 : 0;
+    }
+  }
 }
+
+namespace {
+
+// The first invalid pixel of a depth or normal image (the same scan order as
+// the decoding loops: rows, columns, then layers), for the error message.
+Status DecodeError(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
+                   int h, const TileDecoder& decoder) {
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int l = 0; l < kNumLayers; ++l) {
+        const uint8_t* px = &image.at(x, l * h + y);
+        if (kind == TileImageKind::kDepth) {
+          const uint16_t code = static_cast<uint16_t>((px[0] << 8) | px[1]);
+          if (decoder.Depth(code) < 0)
+            return InvalidData("depth image: code " + std::to_string(code) + " above the maximum " +
+                               std::to_string(decoder.quantization().depth.MaxCode()) +
+                               " at pixel " + PixelName(x0 + x, y0 + y));
+        } else if (!decoder.NormalValid(px)) {
+          return InvalidData("normal image: invalid octahedral code (" + std::to_string(px[0]) +
+                             ", " + std::to_string(px[1]) + ") at pixel " +
+                             PixelName(x0 + x, y0 + y) + (l == kFront ? " (front)" : " (back)"));
+        }
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+// The per-kind loops of DecodeTileImage for images of `kChannels` channels.
+// Each returns false if some pixel was invalid (the caller then finds the
+// first one for the message); they never read or write out of bounds.
+template <int kChannels>
+bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int h,
+                     TwoLayerPanorama* pano, int* bad_x, int* bad_y) {
+  LayerData& F = pano->layer(kFront);
+  LayerData& B = pano->layer(kBack);
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* px = image.row(y);
+    const size_t i0 = pano->index(x0, y0 + y);
+    for (int x = 0; x < w; ++x, px += kChannels) {
+      const uint8_t flags = px[2];
+      if (flags & kFlagReserved) {
+        *bad_x = x0 + x;
+        *bad_y = y0 + y;
+        return false;
+      }
+      const size_t i = i0 + x;
+      F.present[i] = flags & kFlagFrontPresent;
+      B.present[i] = (flags & kFlagBackPresent) >> 1;
+      F.label[i] = (flags & kFlagFrontLabel) >> 2;
+      B.label[i] = (flags & kFlagBackLabel) >> 3;
+      F.links[i] = px[0];
+      B.links[i] = px[1];
+    }
+  }
+  return true;
+}
+
+template <int kChannels>
+bool DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
+                     int h, const TileDecoder& decoder, TwoLayerPanorama* pano) {
+  bool ok = true;
+  for (int l = 0; l < kNumLayers; ++l) {
+    LayerData& L = pano->layer(l);
+    for (int y = 0; y < h; ++y) {
+      const uint8_t* px = image.row(l * h + y);
+      const size_t i0 = pano->index(x0, y0 + y);
+      if (kind == TileImageKind::kColor) {
+        uint8_t* rgb = &L.rgb[3 * i0];
+        for (int x = 0; x < w; ++x, px += kChannels, rgb += 3) {
+          rgb[0] = px[0];
+          rgb[1] = px[1];
+          rgb[2] = px[2];
+        }
+      } else if (kind == TileImageKind::kDepth) {
+        float* depth = &L.depth_m[i0];
+        for (int x = 0; x < w; ++x, px += kChannels) {
+          const float d = decoder.Depth(static_cast<uint16_t>((px[0] << 8) | px[1]));
+          ok &= d >= 0;
+          depth[x] = d;
+        }
+      } else {
+        float* normal = &L.normal[3 * i0];
+        for (int x = 0; x < w; ++x, px += kChannels, normal += 3) {
+          ok &= decoder.NormalValid(px);
+          const float* n = decoder.Normal(px);
+          normal[0] = n[0];
+          normal[1] = n[1];
+          normal[2] = n[2];
+        }
+      }
+    }
+  }
+  return ok;
+}
+
+}  // namespace
 
 Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
                        int h, const TileDecoder& decoder, TwoLayerPanorama* pano) {
@@ -225,46 +334,18 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
   if (image.channels() != 3 && image.channels() != 4)
     return InvalidData(std::string(TileImageKindName(kind)) + " image has " +
                        std::to_string(image.channels()) + " channels, expected 3 or 4");
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const size_t i = pano->index(x0 + x, y0 + y);
-      if (kind == TileImageKind::kGraph) {
-        const uint8_t* px = &image.at(x, y);
-        if (px[2] & kFlagReserved)
-          return InvalidData("graph image: reserved flag bits set at pixel " +
-                             PixelName(x0 + x, y0 + y));
-        LayerData& F = pano->layer(kFront);
-        LayerData& B = pano->layer(kBack);
-        F.present[i] = (px[2] & kFlagFrontPresent) ? 1 : 0;
-        B.present[i] = (px[2] & kFlagBackPresent) ? 1 : 0;
-        F.label[i] = (px[2] & kFlagFrontLabel) ? 1 : 0;
-        B.label[i] = (px[2] & kFlagBackLabel) ? 1 : 0;
-        F.links[i] = px[0];
-        B.links[i] = px[1];
-        continue;
-      }
-      for (int l = 0; l < kNumLayers; ++l) {
-        LayerData& L = pano->layer(l);
-        const uint8_t* px = &image.at(x, l * h + y);
-        if (kind == TileImageKind::kColor) {
-          for (int c = 0; c < 3; ++c) L.rgb[3 * i + c] = px[c];
-        } else if (kind == TileImageKind::kDepth) {
-          const uint16_t code = static_cast<uint16_t>((px[0] << 8) | px[1]);
-          const float d = decoder.Depth(code);
-          if (d < 0)
-            return InvalidData("depth image: code " + std::to_string(code) + " above the maximum " +
-                               std::to_string(decoder.quantization().depth.MaxCode()) +
-                               " at pixel " + PixelName(x0 + x, y0 + y));
-          L.depth_m[i] = d;
-        } else if (!DecodeOctahedral(px, decoder.quantization().normal, &L.normal[3 * i])) {
-          return InvalidData("normal image: invalid octahedral code (" + std::to_string(px[0]) +
-                             ", " + std::to_string(px[1]) + ") at pixel " +
-                             PixelName(x0 + x, y0 + y) + (l == kFront ? " (front)" : " (back)"));
-        }
-      }
-    }
+  const bool rgba = image.channels() == 4;
+  if (kind == TileImageKind::kGraph) {
+    int bad_x = 0, bad_y = 0;
+    const bool ok = rgba ? DecodeGraphRows<4>(image, x0, y0, w, h, pano, &bad_x, &bad_y)
+                         : DecodeGraphRows<3>(image, x0, y0, w, h, pano, &bad_x, &bad_y);
+    if (!ok)
+      return InvalidData("graph image: reserved flag bits set at pixel " + PixelName(bad_x, bad_y));
+    return Status::Ok();
   }
-  return Status::Ok();
+  const bool ok = rgba ? DecodeLayerRows<4>(image, kind, x0, y0, w, h, decoder, pano)
+                       : DecodeLayerRows<3>(image, kind, x0, y0, w, h, decoder, pano);
+  return ok ? Status::Ok() : DecodeError(image, kind, x0, y0, w, h, decoder);
 }
 
 Status FinishDecodedPanorama(TwoLayerPanorama* pano) {

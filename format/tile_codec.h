@@ -99,18 +99,29 @@ struct TileQuantization {
 Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int h,
                        TileImageKind kind, const TileQuantization& q);
 
-// Precomputed DequantizeDepth for all valid codes (up to 256 KB), for fast
-// decoding, plus the normal encoding. Precondition: q.Check() is ok.
+// Precomputed DequantizeDepth for all valid codes (up to 256 KB) and
+// DecodeOctahedral for all 65536 code pairs (832 KB), for fast decoding with
+// exactly the values of those functions. Precondition: q.Check() is ok.
 class TileDecoder {
  public:
   explicit TileDecoder(const TileQuantization& q);
   const TileQuantization& quantization() const { return q_; }
   // Depth of `code`, or -1 for a code above the maximum.
   float Depth(uint16_t code) const { return code < table_.size() ? table_[code] : -1.0f; }
+  // DecodeOctahedral(code): the normal (zero for an invalid code) and whether
+  // the code is valid.
+  const float* Normal(const uint8_t code[2]) const {
+    return &normal_table_[3 * (static_cast<size_t>(code[0]) << 8 | code[1])];
+  }
+  bool NormalValid(const uint8_t code[2]) const {
+    return normal_valid_[static_cast<size_t>(code[0]) << 8 | code[1]] != 0;
+  }
 
  private:
   TileQuantization q_;
   std::vector<float> table_;
+  std::vector<float> normal_table_;  // 3 floats per code pair (code[0] << 8 | code[1]).
+  std::vector<uint8_t> normal_valid_;
 };
 
 // Writes the content of a decoded image of `kind` into the tile [x0, x0+w) x

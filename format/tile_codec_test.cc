@@ -149,5 +149,74 @@ TEST(TileCodecTest, HostileImagesAreRefused) {
   EXPECT_EQ(FinishDecodedPanorama(&p).code(), StatusCode::kInvalidData);
 }
 
+// The decoder's look-up tables must give exactly DecodeOctahedral and
+// DequantizeDepth, for RGB and RGBA images alike.
+TEST(TileCodecTest, TableDecodingMatchesTheReferenceFunctions) {
+  for (int normal_bits : {8, 6}) {
+    TileQuantization q;
+    q.depth.near_m = 0.5;
+    q.depth.far_m = 300.0;
+    q.depth.bits = 16;
+    q.normal.bits = normal_bits;
+    const TileDecoder decoder(q);
+    const int m = q.normal.MaxCode();
+    for (int channels : {3, 4}) {
+      // Front: every valid code pair (c0, c1) = (x + 1, y + 1); back: depth
+      // codes spread over the whole range, normals (0, 0).
+      TwoLayerPanorama out(m, m);
+      Image8 normal(m, 2 * m, channels, 0), depth(m, 2 * m, channels, 0);
+      for (int y = 0; y < m; ++y) {
+        for (int x = 0; x < m; ++x) {
+          normal.at(x, y, 0) = static_cast<uint8_t>(x + 1);
+          normal.at(x, y, 1) = static_cast<uint8_t>(y + 1);
+          const int code = (y * m + x) * 65535 / (m * m - 1);
+          depth.at(x, m + y, 0) = static_cast<uint8_t>(code >> 8);
+          depth.at(x, m + y, 1) = static_cast<uint8_t>(code & 255);
+        }
+      }
+      ASSERT_TRUE(
+          DecodeTileImage(V(normal), TileImageKind::kNormal, 0, 0, m, m, decoder, &out).ok());
+      ASSERT_TRUE(DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, m, m, decoder, &out).ok());
+      for (int y = 0; y < m; ++y) {
+        for (int x = 0; x < m; ++x) {
+          const size_t i = out.index(x, y);
+          const uint8_t code[2] = {static_cast<uint8_t>(x + 1), static_cast<uint8_t>(y + 1)};
+          float expected[3];
+          ASSERT_TRUE(DecodeOctahedral(code, q.normal, expected));
+          for (int c = 0; c < 3; ++c) ASSERT_EQ(out.layer(kFront).normal[3 * i + c], expected[c]);
+          for (int c = 0; c < 3; ++c) ASSERT_EQ(out.layer(kBack).normal[3 * i + c], 0.0f);
+          const uint16_t depth_code = static_cast<uint16_t>((y * m + x) * 65535 / (m * m - 1));
+          ASSERT_EQ(out.layer(kBack).depth_m[i],
+                    static_cast<float>(DequantizeDepth(depth_code, q.depth)));
+        }
+      }
+    }
+  }
+}
+
+// Errors name the first invalid pixel in row, column, layer order, whichever
+// layer it is in.
+TEST(TileCodecTest, ErrorsNameTheFirstInvalidPixel) {
+  TileQuantization q;
+  q.depth.bits = 10;
+  q.normal.bits = 6;
+  const TileDecoder decoder(q);
+  TwoLayerPanorama out(16, 8);
+  Image8 normal(16, 16, 4, 0);
+  normal.at(5, 3, 0) = 7;       // Front (5, 3): one zero coordinate.
+  normal.at(2, 8 + 3, 1) = 70;  // Back (2, 3): 70 > 63, invalid; comes first.
+  normal.at(1, 8 + 6, 0) = 9;   // Back (1, 6): later row.
+  Status s = DecodeTileImage(V(normal), TileImageKind::kNormal, 0, 0, 16, 8, decoder, &out);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidData);
+  EXPECT_NE(s.message().find("(2, 3) (back)"), std::string::npos) << s.message();
+  Image8 depth(16, 16, 3, 0);
+  depth.at(9, 2, 0) = 0x05;      // Front (9, 2): code 1280 > 1023.
+  depth.at(4, 8 + 2, 0) = 0x04;  // Back (4, 2): code 1024, the first.
+  s = DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 16, 8, decoder, &out);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidData);
+  EXPECT_NE(s.message().find("code 1024"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("(4, 2)"), std::string::npos) << s.message();
+}
+
 }  // namespace
 }  // namespace casual3d

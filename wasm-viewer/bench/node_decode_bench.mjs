@@ -1,11 +1,14 @@
-// Benchmark: decode a 4096x2048 package and build its mesh with the wasm format
-// library in Node (the viewer's worker path; WebP through the wasm libwebp of
-// @jsquash/webp instead of the browser's decoder). Prints one JSON line.
+// Benchmark: read one level of a package and build its meshes with the wasm
+// format library in Node, step by step as the viewer's worker does (WebP
+// through the wasm libwebp of @jsquash/webp standing in for the browser's
+// decoder). Prints a table of wall and CPU milliseconds per step (the best of
+// `repeats` runs; CPU = this process's user + system time, which stays
+// meaningful when other jobs share the cores; every step runs on one thread),
+// then the same numbers as one JSON line.
 //
-//   CASUAL3D_BINARY_DIR=build node wasm-viewer/bench/node_decode_bench.mjs [package_dir] [repeats]
-// Wall times (ms) and CPU times (cpuMs: this process's user + system time,
-// which stays meaningful when other jobs share the cores; the wasm work is
-// single-threaded). Without package_dir it writes the procedural test panorama's package
+//   CASUAL3D_BINARY_DIR=build node wasm-viewer/bench/node_decode_bench.mjs [package_dir] [repeats] [level]
+//
+// Without package_dir it writes the procedural test panorama's package
 // (viewer_test_tool package test 4096 2048) to a temporary folder.
 
 import fs from 'node:fs';
@@ -16,6 +19,8 @@ import { loadFormatModule, runTool } from '../test/node-support.mjs';
 import { readPackageLevel } from '../test/node-package.mjs';
 
 const repeats = Number(process.argv[3] ?? 3);
+const level = Number(process.argv[4] ?? 0);
+const MAX_TRIANGLES = 2000000;  // The viewer's default budget (js/viewer-core.js).
 let pkg = process.argv[2];
 let tmp = null;
 if (!pkg) {
@@ -23,45 +28,68 @@ if (!pkg) {
   pkg = path.join(tmp, 'pkg');
   runTool('viewer_test_tool', ['package', 'test', '4096', '2048', pkg]);
 }
+
+const cpuNow = () => {
+  const u = process.cpuUsage();
+  return (u.user + u.system) / 1000;
+};
+// Runs fn, returning [result, wall ms, CPU ms].
+function measure(fn) {
+  const t = performance.now(), c = cpuNow();
+  const result = fn();
+  return [result, performance.now() - t, cpuNow() - c];
+}
+
 try {
   const format = await loadFormatModule();
   const manifest = JSON.parse(fs.readFileSync(path.join(pkg, 'manifest.json'), 'utf8'));
-  const best = {};
-  const keep = (k, v) => { best[k] = Math.min(best[k] ?? Infinity, v); };
+  const best = {};  // step -> {wall, cpu}, each the minimum over repeats.
+  const keep = (step, wall, cpu) => {
+    const b = (best[step] ??= { wall: Infinity, cpu: Infinity });
+    b.wall = Math.min(b.wall, wall);
+    b.cpu = Math.min(b.cpu, cpu);
+  };
   let full = 0, simplified = 0, bound = 0;
-  const cpu = () => { const u = process.cpuUsage(); return (u.user + u.system) / 1000; };
   for (let r = 0; r < repeats; ++r) {
-    let c = cpu();
-    const { pano, timing } = await readPackageLevel(format, pkg, 0);
-    keep('readAllCpuMs', cpu() - c);
-    for (const [k, v] of Object.entries(timing)) keep(k, v);
-    let t = performance.now();
-    c = cpu();
-    const mesh = format.buildMesh(pano);
-    keep('meshFullMs', performance.now() - t);
-    keep('meshFullCpuMs', cpu() - c);
+    const { pano, timing, cpu } = await readPackageLevel(format, pkg, level);
+    for (const k of Object.keys(timing)) keep(k, timing[k], cpu[k]);
+    let mesh, wall, c;
+    [mesh, wall, c] = measure(() => format.buildMesh(pano, { maxTriangles: MAX_TRIANGLES }));
+    keep('meshSimplifiedMs', wall, c);
+    simplified = mesh.indices.length / 3;
+    bound = mesh.maxRelativeError;
+    mesh = null;
+    [, wall, c] = measure(() => pano.atlas());
+    keep('atlasMs', wall, c);
+    [mesh, wall, c] = measure(() => format.buildMesh(pano));
+    keep('meshFullMs', wall, c);
     full = mesh.indices.length / 3;
-    t = performance.now();
-    c = cpu();
-    const simple = format.buildMesh(pano, { maxTriangles: 2000000 });
-    keep('meshSimplifiedMs', performance.now() - t);
-    keep('meshSimplifiedCpuMs', cpu() - c);
-    simplified = simple.indices.length / 3;
-    bound = simple.maxRelativeError;
-    t = performance.now();
-    pano.atlas();
-    keep('atlasMs', performance.now() - t);
+    mesh = null;
     pano.free();
   }
-  const decodeOnly = best.readMs + best.checkMs + best.decodeMs;
-  const wasmDecode = best.addMs + best.finishMs;
   const levelBytes = manifest.levels.map((_, l) => manifest.files.filter((f) => f.path.startsWith(`l${l}/`)).reduce((s, f) => s + f.bytes, 0));
+  const L = manifest.levels[level];
+  const rows = [
+    ['read files (fs)', ['readMs']],
+    ['SHA-256 check (wasm)', ['checkMs']],
+    ['WebP decode (@jsquash/webp)', ['decodeMs']],
+    ['tile unpacking: copy in + DecodeTileImage (wasm)', ['addMs']],
+    ['assemble: FinishDecodedPanorama + Validate (wasm)', ['finishMs']],
+    [`simplified mesh, ${MAX_TRIANGLES / 1e6} M budget, copied out (${simplified} triangles)`, ['meshSimplifiedMs']],
+    ['colour atlas, copied out', ['atlasMs']],
+    [`full mesh, copied out (${full} triangles)`, ['meshFullMs']],
+    ['viewer path: check + decode + unpack + assemble + simplified mesh + atlas', ['checkMs', 'decodeMs', 'addMs', 'finishMs', 'meshSimplifiedMs', 'atlasMs']],
+    ['wasm format library only: check + unpack + assemble + simplified mesh', ['checkMs', 'addMs', 'finishMs', 'meshSimplifiedMs']],
+    ['wasm format library only, full mesh: check + unpack + assemble + full mesh', ['checkMs', 'addMs', 'finishMs', 'meshFullMs']],
+  ];
+  const sum = (keys, f) => keys.reduce((s, k) => s + best[k][f], 0);
+  console.log(`level ${level} of ${pkg}: ${L.width}x${L.height}, ${levelBytes[level]} bytes; best of ${repeats}`);
+  console.log('| step | wall ms | CPU ms |\n|---|---|---|');
+  for (const [name, keys] of rows) console.log(`| ${name} | ${Math.round(sum(keys, 'wall'))} | ${Math.round(sum(keys, 'cpu'))} |`);
   console.log(JSON.stringify({
     package: { width: manifest.width, height: manifest.height, levels: manifest.levels.length, levelBytes },
-    ms: Object.fromEntries(Object.entries(best).map(([k, v]) => [k, Math.round(v)])),
-    wasmTileDecodePlusMeshFullMs: Math.round(wasmDecode + best.meshFullMs),
-    wasmTileDecodePlusMeshSimplifiedMs: Math.round(wasmDecode + best.meshSimplifiedMs),
-    webpDecodeAndChecksumMs: Math.round(decodeOnly),
+    level,
+    ms: Object.fromEntries(Object.entries(best).map(([k, v]) => [k, { wall: Math.round(v.wall), cpu: Math.round(v.cpu) }])),
     triangles: { full, simplified, relativeErrorBound: bound },
     repeats,
   }));

@@ -21,6 +21,10 @@ function copyOut(module, Type, ptr, count) {
 export class FormatModule {
   constructor(module) {
     this.m = module;
+    // A heap buffer reused for the bytes and pixels handed in (tile after tile
+    // of the same size), instead of an allocation per call.
+    this._scratchPtr = 0;
+    this._scratchSize = 0;
   }
 
   /** Instantiates the wasm module; `options` go to the Emscripten factory. */
@@ -40,6 +44,25 @@ export class FormatModule {
     if (!ptr) throw new Error(`out of memory for ${bytes.length} bytes`);
     this.m.HEAPU8.set(bytes, ptr);
     return ptr;
+  }
+
+  /**
+   * Copies bytes into the scratch buffer and returns its pointer, valid until
+   * the next call (for library calls that do not keep the pointer).
+   */
+  _copyToScratch(bytes) {
+    if (bytes.length > this._scratchSize) {
+      if (this._scratchPtr) this.m._free(this._scratchPtr);
+      this._scratchPtr = 0;
+      this._scratchSize = 0;
+      const size = Math.max(bytes.length, 1 << 20);
+      const ptr = this.m._malloc(size);
+      if (!ptr) throw new Error(`out of memory for ${bytes.length} bytes`);
+      this._scratchPtr = ptr;
+      this._scratchSize = size;
+    }
+    this.m.HEAPU8.set(bytes, this._scratchPtr);
+    return this._scratchPtr;
   }
 
   _string(s) {
@@ -161,25 +184,23 @@ export class PackageReader {
   checkFile(path, bytes) {
     const f = this.format;
     const sp = f._string(path);
-    const bp = f._copyIn(bytes);
     try {
+      const bp = f._copyToScratch(bytes);
       if (!f.m._c3d_reader_check_file(this.ptr, sp, bp, bytes.length)) throw f._error();
     } finally {
       f.m._free(sp);
-      f.m._free(bp);
     }
   }
 
   /** Adds the decoded pixels (RGB or RGBA rows) of image `kind` (0..3) of a tile. */
   addImage(level, tile, kind, pixels, width, height, channels) {
     const f = this.format;
-    const ptr = f._copyIn(pixels);
-    try {
-      if (!f.m._c3d_reader_add_image(this.ptr, level, tile, kind, ptr, width, height, channels)) {
-        throw f._error();
-      }
-    } finally {
-      f.m._free(ptr);
+    if (pixels.length !== width * height * channels) {
+      throw new Error(`addImage: ${pixels.length} bytes for ${width}x${height} pixels of ${channels} channels`);
+    }
+    const ptr = f._copyToScratch(pixels);
+    if (!f.m._c3d_reader_add_image(this.ptr, level, tile, kind, ptr, width, height, channels)) {
+      throw f._error();
     }
   }
 

@@ -9,6 +9,8 @@
 // mipmaps, no antialiasing: the same sampling as the project's native software
 // renderer, so screenshots can be compared with its renders.
 
+import { multiply } from './camera.js';
+
 const SCENE_VS = `#version 300 es
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
@@ -264,7 +266,7 @@ export class Renderer {
       gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     }
     if (!this.mesh) return;
-    const viewProjection = multiply4(projection, view);
+    const viewProjection = multiply(projection, view);
     gl.enable(gl.DEPTH_TEST);
     gl.depthFunc(gl.LEQUAL);
     gl.disable(gl.CULL_FACE);  // The two-layer mesh is seen from both sides.
@@ -339,15 +341,3 @@ export class Renderer {
 }
 
 const IDENTITY = new Float32Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
-
-function multiply4(a, b) {
-  const m = new Float32Array(16);
-  for (let c = 0; c < 4; ++c) {
-    for (let r = 0; r < 4; ++r) {
-      let s = 0;
-      for (let k = 0; k < 4; ++k) s += a[k * 4 + r] * b[c * 4 + k];
-      m[c * 4 + r] = s;
-    }
-  }
-  return m;
-}

@@ -48,6 +48,9 @@ struct Reader {
 
 struct Panorama {
   TwoLayerPanorama pano;
+  // Whether pano passed Validate() (the reader's FinishLevel validates): the
+  // mesh builders then skip their own O(pixels) validation.
+  bool validated = false;
   std::vector<uint8_t> atlas;  // RGBA, width x 2*height, built on demand.
 };
 
@@ -106,9 +109,10 @@ EMSCRIPTEN_KEEPALIVE int c3d_panorama_width(const Panorama* p) { return p->pano.
 EMSCRIPTEN_KEEPALIVE int c3d_panorama_height(const Panorama* p) { return p->pano.height(); }
 
 // 1 if the panorama passes TwoLayerPanorama::Validate(), else 0 (error set).
-EMSCRIPTEN_KEEPALIVE int c3d_panorama_validate(const Panorama* p) {
+EMSCRIPTEN_KEEPALIVE int c3d_panorama_validate(Panorama* p) {
   const casual3d::Status s = p->pano.Validate();
   if (!s.ok()) SetError(s);
+  p->validated = s.ok();
   return s.ok() ? 1 : 0;
 }
 
@@ -130,8 +134,10 @@ EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_panorama_atlas_rgba(Panorama* p) {
 EMSCRIPTEN_KEEPALIVE MeshResult* c3d_build_mesh(const Panorama* p, double max_triangles,
                                                 double max_error_rel) {
   casual3d::MeshBuildOptions options;
+  options.validate_input = !p->validated;
   if (max_triangles > 0) {
     casual3d::MeshSimplifyOptions simplify;
+    simplify.validate_input = !p->validated;
     simplify.max_triangles = static_cast<int64_t>(max_triangles);
     if (max_error_rel > 0) simplify.max_relative_error = max_error_rel;
     auto simplified = casual3d::BuildSimplifiedMesh(p->pano, simplify);
@@ -287,6 +293,7 @@ EMSCRIPTEN_KEEPALIVE Panorama* c3d_reader_assemble(Reader* r, int level) {
   }
   auto* p = new Panorama();
   p->pano = std::move(pano).value();
+  p->validated = true;  // FinishLevel validated it.
   return p;
 }
 

@@ -64,6 +64,22 @@ class Reader {
   size_t at_ = 0;
 };
 
+// The arrays of a layer in blob order, each with its elements per pixel. The
+// blob writer and reader both go through these lists, so the two cannot drift.
+template <typename Layer, typename Visit>
+bool VisitLayerArrays(Layer& L, Visit&& visit) {
+  return visit(L.present, 1) && visit(L.rgb, 3) && visit(L.depth_m, 1) && visit(L.normal, 3) &&
+         visit(L.label, 1) && visit(L.links, 1);
+}
+
+// The vertex arrays of a mesh in blob order, each with its elements per vertex
+// (the index array follows them).
+template <typename MeshT, typename Visit>
+bool VisitVertexArrays(MeshT& mesh, Visit&& visit) {
+  return visit(mesh.positions, 3) && visit(mesh.normals, 3) && visit(mesh.uvs, 2) &&
+         visit(mesh.colors, 3);
+}
+
 }  // namespace
 
 std::vector<uint8_t> SerializePanorama(const TwoLayerPanorama& pano) {
@@ -74,13 +90,10 @@ std::vector<uint8_t> SerializePanorama(const TwoLayerPanorama& pano) {
   for (double c : pano.frame().centre) w.Put(c);
   for (double r : pano.frame().rotation) w.Put(r);
   for (int l = 0; l < kNumLayers; ++l) {
-    const LayerData& L = pano.layer(l);
-    w.PutArray(L.present);
-    w.PutArray(L.rgb);
-    w.PutArray(L.depth_m);
-    w.PutArray(L.normal);
-    w.PutArray(L.label);
-    w.PutArray(L.links);
+    VisitLayerArrays(pano.layer(l), [&w](const auto& v, size_t) {
+      w.PutArray(v);
+      return true;
+    });
   }
   return w.Take();
 }
@@ -104,11 +117,10 @@ StatusOr<TwoLayerPanorama> ParsePanorama(const uint8_t* data, size_t size) {
   }
   const size_t n = size_t{width} * height;
   for (int l = 0; l < kNumLayers; ++l) {
-    LayerData& L = pano.layer(l);
-    if (!r.GetArray(n, &L.present) || !r.GetArray(3 * n, &L.rgb) || !r.GetArray(n, &L.depth_m) ||
-        !r.GetArray(3 * n, &L.normal) || !r.GetArray(n, &L.label) || !r.GetArray(n, &L.links)) {
-      return InvalidData("panorama blob: truncated layer " + std::to_string(l));
-    }
+    const bool read = VisitLayerArrays(pano.layer(l), [&r, n](auto& v, size_t per_pixel) {
+      return r.GetArray(per_pixel * n, &v);
+    });
+    if (!read) return InvalidData("panorama blob: truncated layer " + std::to_string(l));
   }
   if (!r.AtEnd()) return InvalidData("panorama blob: trailing bytes");
   return pano;
@@ -119,10 +131,10 @@ std::vector<uint8_t> SerializeMesh(const Mesh& mesh) {
   w.PutBytes(kMeshMagic, 8);
   w.Put(static_cast<uint32_t>(mesh.num_vertices()));
   w.Put(static_cast<uint32_t>(mesh.indices.size()));
-  w.PutArray(mesh.positions);
-  w.PutArray(mesh.normals);
-  w.PutArray(mesh.uvs);
-  w.PutArray(mesh.colors);
+  VisitVertexArrays(mesh, [&w](const auto& v, size_t) {
+    w.PutArray(v);
+    return true;
+  });
   w.PutArray(mesh.indices);
   return w.Take();
 }
@@ -133,9 +145,9 @@ StatusOr<Mesh> ParseMesh(const uint8_t* data, size_t size) {
   uint32_t nv = 0, ni = 0;
   if (!r.Get(&nv) || !r.Get(&ni)) return InvalidData("mesh blob: truncated header");
   Mesh mesh;
-  if (!r.GetArray(size_t{nv} * 3, &mesh.positions) || !r.GetArray(size_t{nv} * 3, &mesh.normals) ||
-      !r.GetArray(size_t{nv} * 2, &mesh.uvs) || !r.GetArray(size_t{nv} * 3, &mesh.colors) ||
-      !r.GetArray(ni, &mesh.indices) || !r.AtEnd()) {
+  const bool read = VisitVertexArrays(
+      mesh, [&r, nv](auto& v, size_t per_vertex) { return r.GetArray(per_vertex * nv, &v); });
+  if (!read || !r.GetArray(ni, &mesh.indices) || !r.AtEnd()) {
     return InvalidData("mesh blob: truncated or trailing bytes");
   }
   for (uint32_t i : mesh.indices) {
