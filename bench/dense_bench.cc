@@ -2,14 +2,19 @@
 // (220 hypotheses, 4 neighbours), the WTA, the near-envelope filters and
 // solver, TRW-S and the upsampling, on a ray-cast toy scene at the working
 // resolution of a 1152x864 photo (576x432 at the default working scale 0.5).
-// Counters: seconds per megapixel of the photo (4x the working pixels).
+// Counters: seconds per megapixel of the photo (4x the working pixels); for
+// the sweep and TRW-S, CPU time of the whole process (all threads) per unit
+// of work: per pixel x label x neighbour (sweep) and per pixel x label x pass
+// (TRW-S), and TRW-S's message memory.
 //
+//   build/bench/dense_bench --benchmark_filter='Sweep|Trws'
 //   build/bench/dense_bench --benchmark_filter=Sweep/576
 
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
 #include <cmath>
 #include <map>
-
-#include <benchmark/benchmark.h>
 
 #include "reconstruct/depth/gc_filter.h"
 #include "reconstruct/depth/median_prune.h"
@@ -35,11 +40,12 @@ const Rig& GetRig(int width) {
   const int height = width * 3 / 4;
   const double f = 0.785 * width;  // 65 degrees horizontal field of view.
   const testing::ToyScene scene = testing::ToyScene::Default();
-  const Eigen::Vector3d centres[5] = {{0, 0, 0}, {0.15, 0, 0}, {-0.15, 0, 0}, {0, 0.15, 0}, {0, -0.15, 0}};
+  const Eigen::Vector3d centres[5] = {
+      {0, 0, 0}, {0.15, 0, 0}, {-0.15, 0, 0}, {0, 0.15, 0}, {0, -0.15, 0}};
   for (const auto& c : centres) {
     ImageF d;
-    rig.views.push_back(testing::MakeView(scene, testing::ToyCamera(c, width, height, f), {0.5, 50.0}, 1.0,
-                                          0.0, &d));
+    rig.views.push_back(testing::MakeView(scene, testing::ToyCamera(c, width, height, f),
+                                          {0.5, 50.0}, 1.0, 0.0, &d));
     rig.depth.push_back(std::move(d));
   }
   return rigs.emplace(width, std::move(rig)).first->second;
@@ -47,11 +53,19 @@ const Rig& GetRig(int width) {
 
 void SetPerMegapixel(benchmark::State& state, int width) {
   const double photo_mp = 4.0 * width * (width * 3 / 4) / 1e6;  // Working scale 0.5.
-  state.counters["s_per_photo_MP"] =
-      benchmark::Counter(1.0 / photo_mp, benchmark::Counter::kIsIterationInvariantRate |
-                                             benchmark::Counter::kInvert);
+  state.counters["s_per_photo_MP"] = benchmark::Counter(
+      1.0 / photo_mp, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
+// The sweep's and TRW-S's counters are CPU rates: these benchmarks measure
+// the process's CPU time (all threads), so the rates are CPU seconds per unit.
+void SetCpuPerUnit(benchmark::State& state, const char* name, double units_per_iteration) {
+  state.counters[name] =
+      benchmark::Counter(units_per_iteration, benchmark::Counter::kIsIterationInvariantRate |
+                                                  benchmark::Counter::kInvert);
+}
+
+// Args: working width, threads.
 void BM_Sweep(benchmark::State& state) {
   const int width = static_cast<int>(state.range(0));
   const Rig& rig = GetRig(width);
@@ -62,35 +76,82 @@ void BM_Sweep(benchmark::State& state) {
     CostVolume vol = ComputeCostVolume(rig.views[0], nbs, opt);
     benchmark::DoNotOptimize(vol.cost.data());
   }
-  SetPerMegapixel(state, width);
+  const double pixels = static_cast<double>(width) * (width * 3 / 4);
+  SetCpuPerUnit(state, "cpu_s_per_px_label_nb", pixels * opt.num_depths * nbs.size());
+  SetCpuPerUnit(state, "cpu_s_per_photo_MP", 4.0 * pixels / 1e6);
 }
-BENCHMARK(BM_Sweep)->Args({288, 2})->Args({576, 1})->Args({576, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Sweep)
+    ->Args({288, 2})
+    ->Args({576, 1})
+    ->Args({576, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime();
 
-void BM_Trws(benchmark::State& state) {
-  const int width = static_cast<int>(state.range(0));
+// The MRF of the dense stage on the toy scene: unaries from the sweep, edge
+// weights lambda_smooth / T * max(floor, w_color) as in dense_stage.cc.
+const GridMrf& GetMrf(int width) {
+  static std::map<int, GridMrf> mrfs;
+  auto it = mrfs.find(width);
+  if (it != mrfs.end()) return it->second;
   const Rig& rig = GetRig(width);
-  static std::map<int, CostVolume> vols;
-  if (!vols.count(width)) {
-    SweepOptions opt;
-    vols[width] = ComputeCostVolume(rig.views[0], {&rig.views[1], &rig.views[2], &rig.views[3], &rig.views[4]}, opt);
-  }
-  const CostVolume& vol = vols[width];
+  SweepOptions opt;
+  const CostVolume vol = ComputeCostVolume(
+      rig.views[0], {&rig.views[1], &rig.views[2], &rig.views[3], &rig.views[4]}, opt);
   GridMrf m;
   m.width = vol.width;
   m.height = vol.height;
   m.num_labels = vol.num_labels;
   m.truncation = 8;
   m.unary = vol.cost;
-  m.weight_right.assign(static_cast<size_t>(vol.width) * vol.height, 0.25f / 8);
-  m.weight_down = m.weight_right;
-  for (auto _ : state) {
-    TrwsResult r = SolveTrws(m);
-    benchmark::DoNotOptimize(r.energy);
-    state.counters["iterations"] = r.iterations;
-  }
-  SetPerMegapixel(state, width);
+  const size_t n = static_cast<size_t>(vol.width) * vol.height;
+  m.weight_right.assign(n, 0.0f);
+  m.weight_down.assign(n, 0.0f);
+  const ImageF& c = rig.views[0].color;
+  auto weight = [&](int x0, int y0, int x1, int y1) {
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) d2 += std::pow(c.at(x0, y0, k) - c.at(x1, y1, k), 2);
+    return static_cast<float>(0.25 / 8 * std::max(0.02, std::exp(-d2 / (2 * 0.04 * 0.04))));
+  };
+  for (int y = 0; y < m.height; ++y)
+    for (int x = 0; x < m.width; ++x) {
+      const size_t p = static_cast<size_t>(y) * m.width + x;
+      if (x + 1 < m.width) m.weight_right[p] = weight(x, y, x + 1, y);
+      if (y + 1 < m.height) m.weight_down[p] = weight(x, y, x, y + 1);
+    }
+  return mrfs.emplace(width, std::move(m)).first->second;
 }
-BENCHMARK(BM_Trws)->Arg(288)->Arg(576)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Args: working width, passes (0: the default stopping rule).
+void BM_Trws(benchmark::State& state) {
+  const int width = static_cast<int>(state.range(0));
+  const GridMrf& m = GetMrf(width);
+  TrwsOptions opt;
+  if (state.range(1) > 0) {
+    opt.max_iterations = static_cast<int>(state.range(1));
+    opt.relative_tolerance = 0.0;
+    opt.patience = opt.max_iterations;  // Exactly max_iterations passes.
+  }
+  TrwsResult r;
+  for (auto _ : state) {
+    r = SolveTrws(m, opt);
+    benchmark::DoNotOptimize(r.energy);
+  }
+  state.counters["passes"] = r.iterations;
+  state.counters["energy"] = r.energy;
+  state.counters["best_pass"] =
+      static_cast<double>(std::min_element(r.pass_energies.begin(), r.pass_energies.end()) -
+                          r.pass_energies.begin() + 1);
+  state.counters["message_MB"] = TrwsMessageBytes(m.width, m.height, m.num_labels) / 1e6;
+  const double pixels = static_cast<double>(m.width) * m.height;
+  SetCpuPerUnit(state, "cpu_s_per_px_label_pass", pixels * m.num_labels * r.iterations);
+  SetCpuPerUnit(state, "cpu_s_per_photo_MP", 4.0 * pixels / 1e6);
+}
+BENCHMARK(BM_Trws)
+    ->Args({288, 8})
+    ->Args({576, 8})
+    ->Args({576, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime();
 
 void BM_EnvelopeFilters(benchmark::State& state) {
   const int width = static_cast<int>(state.range(0));
@@ -109,7 +170,8 @@ void BM_EnvelopeFilters(benchmark::State& state) {
   EnvelopeOptions env;
   env.variance_radius = std::max(1, static_cast<int>(std::lround(9 * ratio)));
   for (auto _ : state) {
-    const ImageF gc = GeometricConsistencyFilter(0, vp, dp, {1, 2, 3, 4}, grid.InvStep(), GcFilterOptions(), 1);
+    const ImageF gc =
+        GeometricConsistencyFilter(0, vp, dp, {1, 2, 3, 4}, grid.InvStep(), GcFilterOptions(), 1);
     const ImageF med = MedianPrune(gc, grid, prune, 1);
     const ImageF bil = BilateralMedianPrune(med, rig.views[0].color, grid, prune, 1);
     const ImageF prop = PropagateAnchors(bil, rig.views[0].color, env);
@@ -126,7 +188,8 @@ void BM_Upsample(benchmark::State& state) {
   UpsampleOptions opt;
   opt.num_threads = 1;
   for (auto _ : state) {
-    ImageF up = JointBilateralMedianUpsample(low.depth[0], low.views[0].color, high.views[0].color, opt);
+    ImageF up =
+        JointBilateralMedianUpsample(low.depth[0], low.views[0].color, high.views[0].color, opt);
     benchmark::DoNotOptimize(up.data());
   }
   SetPerMegapixel(state, width);

@@ -29,6 +29,8 @@ void RunDense(const DenseCommandOptions& o) {
   const depth::DenseReport report = depth::RunDenseStage(o.workspace, o.out, opt);
   std::printf("dense: %zu depth maps in %s (%.1f s, peak memory %.0f MB)\n", report.photos.size(),
               o.out.c_str(), report.seconds_total, report.peak_rss_bytes / 1048576.0);
+  std::printf("dense: cross-view consistency (depth within 2%% of >= 2 other views): %.1f%%\n",
+              100 * report.cross_view_consistency);
   if (report.evaluated) {
     std::printf(
         "dense: against ground truth: median relative error %.2f%%, within 3%%: %.1f%%, near "

@@ -17,6 +17,7 @@
 #include "reconstruct/depth/mrf_trws.h"
 #include "reconstruct/depth/parallel.h"
 #include "reconstruct/depth/workspace.h"
+#include "reconstruct/io/colour_map.h"
 #include "reconstruct/io/cv_bridge.h"
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
@@ -44,30 +45,36 @@ int ScaledRadius(int radius_at_reference, double ratio) {
   return std::max(1, static_cast<int>(std::lround(radius_at_reference * ratio)));
 }
 
-// Inverse depth mapped to [0, 255] over the photo's range (near = 255) and
-// coloured with the turbo map; invalid pixels are black.
+// Inverse depth over the photo's range (near = warm); invalid pixels black.
 Image8 Colorize(const ImageF& depth, const DepthRange& range) {
+  return io::ColouriseDepth(depth, range.near_m, range.far_m);
+}
+
+// Per-pixel verdict against ground truth: red = near floater (d < 0.85 g),
+// yellow = nearer than 3%, green = within 3%, blue = farther than 3%,
+// grey = sky (non-finite ground truth) estimated nearer than the far half of
+// the range, black = sky otherwise.
+Image8 ErrorMap(const ImageF& depth, const ImageF& gt) {
   const int w = depth.width(), h = depth.height();
-  cv::Mat gray(h, w, CV_8UC1), mask(h, w, CV_8UC1);
-  const double inv_near = 1.0 / range.near_m, inv_far = 1.0 / range.far_m;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const float d = depth.at(x, y);
-      const bool ok = d > 0 && std::isfinite(d);
-      const double t = ok ? (1.0 / d - inv_far) / (inv_near - inv_far) : 0.0;
-      gray.at<uint8_t>(y, x) = static_cast<uint8_t>(std::lround(255.0 * std::min(1.0, std::max(0.0, t))));
-      mask.at<uint8_t>(y, x) = ok ? 255 : 0;
-    }
-  cv::Mat bgr;
-  cv::applyColorMap(gray, bgr, cv::COLORMAP_TURBO);
   Image8 rgb(w, h, 3, 0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (!mask.at<uint8_t>(y, x)) continue;
-      const cv::Vec3b c = bgr.at<cv::Vec3b>(y, x);
-      rgb.at(x, y, 0) = c[2];
-      rgb.at(x, y, 1) = c[1];
-      rgb.at(x, y, 2) = c[0];
+      const int gx = std::min(gt.width() - 1, static_cast<int>((x + 0.5) * gt.width() / w));
+      const int gy = std::min(gt.height() - 1, static_cast<int>((y + 0.5) * gt.height() / h));
+      const float g = gt.at(gx, gy), d = depth.at(x, y);
+      uint8_t c[3] = {0, 0, 0};
+      if (!(std::isfinite(g) && g > 0)) {
+        if (std::isfinite(d)) c[0] = c[1] = c[2] = 96;
+      } else if (!(d >= 0.85f * g)) {
+        c[0] = 255;
+      } else if (d < 0.97f * g) {
+        c[0] = 255, c[1] = 200;
+      } else if (d <= 1.03f * g) {
+        c[1] = 200;
+      } else {
+        c[2] = 255;
+      }
+      for (int k = 0; k < 3; ++k) rgb.at(x, y, k) = c[k];
     }
   return rgb;
 }
@@ -148,7 +155,7 @@ Status DenseOptions::Check() const {
   if (!(reference_diagonal > 0)) return InvalidArgument("reference_diagonal must be > 0");
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   for (const Status& s : {neighbors.Check(), sweep.Check(), gc.Check(), prune.Check(), envelope.Check(),
-                          mrf.Check(), upsample.Check()})
+                          mrf.Check(), edge_median.Check(), sublabel.Check(), upsample.Check()})
     if (!s.ok()) return s;
   return Status::Ok();
 }
@@ -228,6 +235,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   // one thread each (TRW-S is sequential).
   std::vector<const DenseView*> view_ptrs;
   std::vector<const ImageF*> wta_ptrs;
+  std::vector<ImageF> final_low(n);  // Final depth at working resolution, for cross-view checks.
   for (int i = 0; i < n; ++i) {
     view_ptrs.push_back(&ws.views[i]);
     wta_ptrs.push_back(&wta[i]);
@@ -323,21 +331,19 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       pr.mrf_energy = res.energy;
       pr.mrf_iterations = res.iterations;
 
-      // Labels to depth, with sub-label refinement on E_photo, and confidence.
+      // Edge-aware median (window fattening), sub-label refinement, depth and confidence.
+      const std::vector<int> labels = EdgeAwareMedian(std::vector<int>(res.labels.begin(), res.labels.end()),
+                                                      L, v.color, options.edge_median, inner);
+      const std::vector<float> fl = RefineSubLabel(vol, labels, v.color, options.sublabel, inner);
       ImageF low_depth(w, h, 1), low_conf(w, h, 1);
       for (size_t p = 0; p < np; ++p) {
-        const int k = res.labels[p];
         const float* c = vol.cost.data() + p * L;
-        double kf = k;
-        if (options.mrf.refine_sublabel && k > 0 && k + 1 < L && c[k] <= c[k - 1] && c[k] <= c[k + 1]) {
-          const double denom = c[k - 1] - 2.0 * c[k] + c[k + 1];
-          if (denom > 1e-6) kf += std::min(0.5, std::max(-0.5, 0.5 * (c[k - 1] - c[k + 1]) / denom));
-        }
-        low_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(kf));
-        low_conf.data()[p] = vol.photo_weight.data()[p] * std::max(0.0f, 1.0f - c[k]);
+        low_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(fl[p]));
+        low_conf.data()[p] = vol.photo_weight.data()[p] * std::max(0.0f, 1.0f - c[labels[p]]);
       }
       vol.cost.clear();
       vol.cost.shrink_to_fit();
+      final_low[i] = low_depth;
       pr.t_mrf = Since(t0);
 
       // Full resolution (Sec. 4.3.1: joint bilateral weighted median).
@@ -377,6 +383,12 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
         const ImageF gt = ReadGroundTruth(options.ground_truth_dir, stem);
         if (!gt.empty()) {
           pr.evaluated = true;
+          if (options.debug) {
+            const std::string base = (fs::path(debug_dir) / stem).string();
+            const Image8 gt_rgb = Colorize(gt, v.range), err_rgb = ErrorMap(depth, gt);
+            io::WritePng(base + "_gt.png", gt_rgb.view());
+            io::WritePng(base + "_error.png", err_rgb.view());
+          }
           const DepthAccuracy acc = EvaluateDepth(depth, gt, 0.5 * v.range.far_m);
           pr.median_rel_error = acc.median_rel_error;
           pr.within_3pct = acc.within_3pct;
@@ -404,6 +416,17 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   });
   progress.Finish();
   if (!first_error.empty()) throw std::runtime_error(first_error);
+
+  // Cross-view consistency of the final depth maps (issue 5).
+  {
+    std::vector<const ImageF*> final_ptrs;
+    for (const ImageF& d : final_low) final_ptrs.push_back(&d);
+    ParallelFor(0, n, threads, [&](int64_t i) {
+      report.photos[i].cross_view_consistency =
+          CrossViewConsistency(static_cast<int>(i), view_ptrs, final_ptrs, ws.ranked_neighbors[i]);
+    });
+    for (const PhotoReport& pr : report.photos) report.cross_view_consistency += pr.cross_view_consistency / n;
+  }
 
   // Summary.
   long long weight = 0;
@@ -434,6 +457,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   j["use_gc_filter"] = options.use_gc_filter;
   j["num_depths"] = options.sweep.num_depths;
   j["working_scale"] = options.working_scale;
+  j["cross_view_consistency"] = report.cross_view_consistency;
   if (report.evaluated) {
     j["accuracy"] = {{"median_rel_error", report.median_rel_error},
                      {"within_3pct", report.within_3pct},
@@ -452,6 +476,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     p["cg_iterations"] = pr.cg_iterations;
     p["mrf_energy"] = pr.mrf_energy;
     p["mrf_iterations"] = pr.mrf_iterations;
+    p["cross_view_consistency"] = pr.cross_view_consistency;
     p["seconds"] = {{"sweep", pr.t_sweep}, {"envelope", pr.t_envelope}, {"mrf", pr.t_mrf},
                     {"upsample_write", pr.t_upsample}};
     if (pr.evaluated) {

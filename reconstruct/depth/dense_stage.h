@@ -9,25 +9,29 @@
 //   depth/<stem>.exr       float "Z": depth in metres along the optical axis, full resolution
 //   confidence/<stem>.exr  float "Y" in [0, 1]: w_photo * (1 - E_photo) of the chosen depth
 //   envelope/<stem>.exr    float "Z": the near envelope (metres), full resolution
-//   dense.json             per photo: neighbours, depth range, anchor counts, timings
-//                          (and accuracy when ground truth is given)
+//   dense.json             per photo: neighbours, depth range, anchor counts, timings,
+//                          cross-view consistency (and accuracy when ground truth is given)
 //   debug/<stem>_{wta,gc,median,bilateral,propagated,envelope,mrf,depth}.png  with debug
+//   debug/<stem>_{gt,error}.png  with debug and ground truth
 //
 // Per photo: neighbour selection; plane sweep with ZNCC (plane_sweep.h);
 // WTA; near envelope: GC filter (gc_filter.h), median and bilateral median
 // pruning (median_prune.h), Poisson propagation, scaling and min filter
 // (near_envelope.h); MRF of Eq. 1-4 solved by TRW-S (mrf_trws.h); sub-label
-// refinement; joint bilateral weighted-median upsampling (upsample.h).
+// edge-aware median against window fattening (edge_median.h); sub-label
+// refinement (sublabel_refine.h); joint bilateral weighted-median upsampling (upsample.h).
 
 #include <string>
 #include <vector>
 
 #include "format/status.h"
+#include "reconstruct/depth/edge_median.h"
 #include "reconstruct/depth/gc_filter.h"
 #include "reconstruct/depth/median_prune.h"
 #include "reconstruct/depth/near_envelope.h"
 #include "reconstruct/depth/neighbor_selection.h"
 #include "reconstruct/depth/plane_sweep.h"
+#include "reconstruct/depth/sublabel_refine.h"
 #include "reconstruct/depth/upsample.h"
 
 namespace casual3d::depth {
@@ -45,7 +49,6 @@ struct MrfTermOptions {
   double far_bias = 0.02;
   int truncation_labels = 8;    // w_depth = min(|k_i - k_j|, T) / T, labels (inverse depth). [1, 4096].
   int max_iterations = 8;       // TRW-S passes. [1, 1000].
-  bool refine_sublabel = true;  // Parabola fit of E_photo around the chosen label.
 
   Status Check() const;
 };
@@ -62,6 +65,8 @@ struct DenseOptions {
   MedianPruneOptions prune;
   EnvelopeOptions envelope;
   MrfTermOptions mrf;
+  EdgeMedianOptions edge_median;  // In working pixels, like the sweep's window (fattening scale).
+  SubLabelOptions sublabel;
   UpsampleOptions upsample;
   bool use_near_envelope = true;  // false: the "MRF without near envelope" baseline (Fig. 5).
   bool use_gc_filter = true;      // false: skip the GC filter when building anchors.
@@ -89,6 +94,9 @@ struct PhotoReport {
   std::vector<int> anchors;               // Surviving pixels after wta, gc, median, bilateral.
   int cg_iterations = 0;
   double mrf_energy = 0.0;
+  // Fraction of pixels whose depth agrees within 2% with >= 2 other views'
+  // final depth maps (working resolution; needs no ground truth).
+  double cross_view_consistency = 0.0;
   int mrf_iterations = 0;
   // Seconds per step.
   double t_sweep = 0, t_envelope = 0, t_mrf = 0, t_upsample = 0;
@@ -107,6 +115,7 @@ struct DenseReport {
   // Means over evaluated photos (pixel-weighted for accuracy).
   bool evaluated = false;
   double median_rel_error = 0, within_3pct = 0, near_floaters = 0;
+  double cross_view_consistency = 0.0;  // Mean over photos.
 };
 
 // Runs the stage. Throws std::invalid_argument for bad options and

@@ -87,4 +87,47 @@ EnvelopeQuality EvaluateEnvelope(const ImageF& envelope, const ImageF& gt) {
   return q;
 }
 
+double CrossViewConsistency(int ref, const std::vector<const DenseView*>& views,
+                            const std::vector<const ImageF*>& depths, const std::vector<int>& others,
+                            double rel_tolerance, int min_views, int max_views) {
+  const ImageF& src = *depths[ref];
+  const PinholeCamera& cr = views[ref]->camera;
+  struct Other {
+    Eigen::Matrix3d r;
+    Eigen::Vector3d t;
+    const PinholeCamera* cam;
+    const ImageF* depth;
+  };
+  std::vector<Other> list;
+  for (int j : others) {
+    if (j == ref || static_cast<int>(list.size()) >= max_views) continue;
+    Other o;
+    o.cam = &views[j]->camera;
+    o.r = o.cam->R * cr.R.transpose();
+    o.t = o.cam->t - o.r * cr.t;
+    o.depth = depths[j];
+    list.push_back(o);
+  }
+  long long valid = 0, consistent = 0;
+  for (int y = 0; y < src.height(); ++y)
+    for (int x = 0; x < src.width(); ++x) {
+      const double d = src.at(x, y);
+      if (!(d > 0 && std::isfinite(d))) continue;
+      ++valid;
+      const Eigen::Vector3d p(((x + 0.5) - cr.cx) / cr.fx * d, ((y + 0.5) - cr.cy) / cr.fy * d, d);
+      int agree = 0;
+      for (const Other& o : list) {
+        const Eigen::Vector3d q = o.r * p + o.t;
+        if (q.z() <= 0) continue;
+        const int u = static_cast<int>(std::floor(o.cam->fx * q.x() / q.z() + o.cam->cx));
+        const int v = static_cast<int>(std::floor(o.cam->fy * q.y() / q.z() + o.cam->cy));
+        if (u < 0 || v < 0 || u >= o.depth->width() || v >= o.depth->height()) continue;
+        const double dj = o.depth->at(u, v);
+        if (dj > 0 && std::isfinite(dj) && std::abs(q.z() - dj) <= rel_tolerance * dj) ++agree;
+      }
+      if (agree >= min_views) ++consistent;
+    }
+  return valid > 0 ? static_cast<double>(consistent) / valid : 0.0;
+}
+
 }  // namespace casual3d::depth

@@ -5,7 +5,10 @@
 // (spec/stage-dense.md, "Evaluation"). Maps may differ in size: the ground
 // truth is sampled at each estimate pixel's centre (nearest pixel).
 
+#include <vector>
+
 #include "format/image.h"
+#include "reconstruct/depth/view.h"
 
 namespace casual3d::depth {
 
@@ -37,5 +40,17 @@ struct EnvelopeQuality {
   double tightness = 0.0;  // Mean of 1/n - 1/g over pixels with finite ground truth, 1/m.
 };
 EnvelopeQuality EvaluateEnvelope(const ImageF& envelope, const ImageF& ground_truth);
+
+// Cross-view consistency, which needs no ground truth (issue 5): the
+// fraction of view `ref`'s pixels with a valid depth whose 3D point, projected
+// into the other views listed in `others` (indices into `views`, at most
+// `max_views` used), agrees within `rel_tolerance` (|z_j - d_j| / d_j, z_j the
+// point's depth in view j, d_j view j's depth at the projection) with at least
+// `min_views` of them. `depths[i]` is view i's depth map (metres, <= 0 or
+// non-finite = none) at the size of views[i]->camera. Returns 0 when view
+// `ref` has no valid depth.
+double CrossViewConsistency(int ref, const std::vector<const DenseView*>& views,
+                            const std::vector<const ImageF*>& depths, const std::vector<int>& others,
+                            double rel_tolerance = 0.02, int min_views = 2, int max_views = 8);
 
 }  // namespace casual3d::depth

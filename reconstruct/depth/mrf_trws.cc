@@ -4,25 +4,147 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
 
 namespace casual3d::depth {
 namespace {
 
-// out(l') = min_l h(l) + w * min(|l - l'|, T), normalised to min 0.
-void DistanceTransform(const float* h, float* out, int num_labels, float w, int truncation) {
-  float hmin = h[0];
-  out[0] = h[0];
-  for (int l = 1; l < num_labels; ++l) {
-    out[l] = std::min(h[l], out[l - 1] + w);
-    hmin = std::min(hmin, h[l]);
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Labels rounded up to whole blocks of 8: every per-label array below has
+// this stride; the distance transform treats labels past num_labels as +inf.
+int PaddedLabels(int num_labels) { return (num_labels + 7) & ~7; }
+
+// Messages from one node along kCount edges at once (kCount independent
+// dependency chains keep the pipeline busy). For edge e, with
+// h(l) = gamma * belief(l) - edge_e(l) for l < num_labels (the edge holding
+// the message towards the node) and +inf above, the edge is overwritten with
+//   m(l') = min_l h(l) + w_e * min(|l - l'|, T) - min_l h(l)
+// by the lower-envelope distance transform of Felzenszwalb and Huttenlocher
+// (2006): a forward and a backward min-plus recursion, then the truncation
+// as a cap. Requires w_e >= 0.
+template <int kCount>
+void SendMessages(const float* belief, float gamma, int num_labels, int padded, float* const* edges,
+                  const float* weights, int truncation) {
+#if defined(__SSE2__)
+  // The recursions run on blocks of 8 labels: within a 4-label vector two
+  // shift-and-min steps (offsets 1 and 2) give the recursion restricted to
+  // the vector (lanes that would shift in from outside shift in themselves:
+  // min(v, v + k w) = v for w >= 0); the second vector takes the first's
+  // end; the carry from the previous block, plus w times the distance,
+  // completes both. Only the carry is a loop-carried dependency.
+  const __m128 g = _mm_set1_ps(gamma);
+  const __m128 inf = _mm_set1_ps(kInf);
+  // Per edge: w, 4w and the ramps (1..4) w and (4..1) w; other multiples are
+  // derived where needed (fewer live registers).
+  __m128 w1[kCount], w4[kCount], up[kCount], down[kCount], carry[kCount], hmin[kCount];
+  for (int e = 0; e < kCount; ++e) {
+    const float w = weights[e];
+    w1[e] = _mm_set1_ps(w);
+    w4[e] = _mm_set1_ps(4.0f * w);
+    up[e] = _mm_set_ps(4.0f * w, 3.0f * w, 2.0f * w, w);
+    down[e] = _mm_set_ps(w, 2.0f * w, 3.0f * w, 4.0f * w);
+    carry[e] = inf;
+    hmin[e] = inf;
   }
-  for (int l = num_labels - 2; l >= 0; --l) out[l] = std::min(out[l], out[l + 1] + w);
-  const float cap = hmin + w * static_cast<float>(truncation);
-  for (int l = 0; l < num_labels; ++l) out[l] = std::min(out[l], cap) - hmin;
+  // h for labels [b, b + 4): +inf past num_labels.
+  auto load_h = [&](int e, int b) {
+    const __m128 v =
+        _mm_sub_ps(_mm_mul_ps(g, _mm_loadu_ps(belief + b)), _mm_loadu_ps(edges[e] + b));
+    if (b + 4 <= num_labels) return v;
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, v);
+    for (int l = std::max(0, num_labels - b); l < 4; ++l) lanes[l] = kInf;
+    return _mm_load_ps(lanes);
+  };
+  for (int b = 0; b < padded; b += 8) {
+    for (int e = 0; e < kCount; ++e) {
+      __m128 a = load_h(e, b), c = load_h(e, b + 4);
+      hmin[e] = _mm_min_ps(hmin[e], _mm_min_ps(a, c));
+      a = _mm_min_ps(a, _mm_add_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 1, 0, 0)), w1[e]));
+      c = _mm_min_ps(c, _mm_add_ps(_mm_shuffle_ps(c, c, _MM_SHUFFLE(2, 1, 0, 0)), w1[e]));
+      const __m128 w2 = _mm_add_ps(w1[e], w1[e]);
+      a = _mm_min_ps(a, _mm_add_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(1, 0, 1, 0)), w2));
+      c = _mm_min_ps(c, _mm_add_ps(_mm_shuffle_ps(c, c, _MM_SHUFFLE(1, 0, 1, 0)), w2));
+      c = _mm_min_ps(c, _mm_add_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 3, 3, 3)), up[e]));
+      const __m128 base = _mm_add_ps(carry[e], up[e]);
+      _mm_storeu_ps(edges[e] + b, _mm_min_ps(a, base));
+      _mm_storeu_ps(edges[e] + b + 4, _mm_min_ps(c, _mm_add_ps(base, w4[e])));
+      carry[e] = _mm_min_ps(_mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 3, 3)),
+                            _mm_add_ps(carry[e], _mm_add_ps(w4[e], w4[e])));
+    }
+  }
+  __m128 cap[kCount];
+  for (int e = 0; e < kCount; ++e) {
+    __m128 m = hmin[e];
+    m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+    hmin[e] = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+    cap[e] = _mm_add_ps(hmin[e], _mm_set1_ps(weights[e] * static_cast<float>(truncation)));
+    carry[e] = inf;
+  }
+  for (int b = padded - 8; b >= 0; b -= 8) {
+    for (int e = 0; e < kCount; ++e) {
+      __m128 a = _mm_loadu_ps(edges[e] + b), c = _mm_loadu_ps(edges[e] + b + 4);
+      a = _mm_min_ps(a, _mm_add_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 3, 2, 1)), w1[e]));
+      c = _mm_min_ps(c, _mm_add_ps(_mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 2, 1)), w1[e]));
+      const __m128 w2 = _mm_add_ps(w1[e], w1[e]);
+      a = _mm_min_ps(a, _mm_add_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 2, 3, 2)), w2));
+      c = _mm_min_ps(c, _mm_add_ps(_mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 2, 3, 2)), w2));
+      a = _mm_min_ps(a, _mm_add_ps(_mm_shuffle_ps(c, c, _MM_SHUFFLE(0, 0, 0, 0)), down[e]));
+      const __m128 base = _mm_add_ps(carry[e], down[e]);
+      const __m128 a_out = _mm_min_ps(a, _mm_add_ps(base, w4[e]));
+      const __m128 c_out = _mm_min_ps(c, base);
+      carry[e] = _mm_min_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(0, 0, 0, 0)),
+                            _mm_add_ps(carry[e], _mm_add_ps(w4[e], w4[e])));
+      _mm_storeu_ps(edges[e] + b, _mm_sub_ps(_mm_min_ps(a_out, cap[e]), hmin[e]));
+      _mm_storeu_ps(edges[e] + b + 4, _mm_sub_ps(_mm_min_ps(c_out, cap[e]), hmin[e]));
+    }
+  }
+#else
+  std::vector<float> h(padded);
+  for (int e = 0; e < kCount; ++e) {
+    float* out = edges[e];
+    const float w = weights[e];
+    for (int l = 0; l < padded; ++l) h[l] = l < num_labels ? gamma * belief[l] - out[l] : kInf;
+    float hmin = h[0];
+    out[0] = h[0];
+    for (int l = 1; l < padded; ++l) {
+      out[l] = std::min(h[l], out[l - 1] + w);
+      hmin = std::min(hmin, h[l]);
+    }
+    for (int l = padded - 2; l >= 0; --l) out[l] = std::min(out[l], out[l + 1] + w);
+    const float cap = hmin + w * static_cast<float>(truncation);
+    for (int l = 0; l < padded; ++l) out[l] = std::min(out[l], cap) - hmin;
+  }
+#endif
 }
 
 inline float Pairwise(float w, int a, int b, int truncation) {
   return w * static_cast<float>(std::min(std::abs(a - b), truncation));
+}
+
+// Index of the first minimum of c[0, n) (n a multiple of 4).
+int ArgMin(const float* c, int n) {
+#if defined(__SSE2__)
+  __m128 m = _mm_loadu_ps(c);
+  for (int l = 4; l < n; l += 4) m = _mm_min_ps(m, _mm_loadu_ps(c + l));
+  m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+  for (int l = 0; l < n; l += 4) {
+    const int mask = _mm_movemask_ps(_mm_cmpeq_ps(_mm_loadu_ps(c + l), m));
+    if (mask != 0) return l + __builtin_ctz(static_cast<unsigned>(mask));
+  }
+  return 0;
+#else
+  int best = 0;
+  for (int l = 1; l < n; ++l)
+    if (c[l] < c[best]) best = l;
+  return best;
+#endif
 }
 
 }  // namespace
@@ -40,6 +162,10 @@ double MrfEnergy(const GridMrf& mrf, const std::vector<uint16_t>& labels) {
   return e;
 }
 
+size_t TrwsMessageBytes(int width, int height, int num_labels) {
+  return 2 * static_cast<size_t>(width) * height * PaddedLabels(num_labels) * sizeof(float);
+}
+
 TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options) {
   const int w = mrf.width, h = mrf.height, L = mrf.num_labels;
   const size_t n = static_cast<size_t>(w) * h;
@@ -47,17 +173,51 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options) {
       mrf.weight_right.size() != n || mrf.weight_down.size() != n || mrf.truncation < 1)
     throw std::invalid_argument("TRW-S: inconsistent MRF sizes");
   if (options.max_iterations < 1) throw std::invalid_argument("TRW-S: max_iterations < 1");
+  for (size_t p = 0; p < n; ++p)
+    if (!(mrf.weight_right[p] >= 0.0f && mrf.weight_down[p] >= 0.0f))
+      throw std::invalid_argument("TRW-S: edge weight of pixel " + std::to_string(p) +
+                                  " is negative or NaN");
 
-  // Incoming messages of every node, by the side they come from.
-  std::vector<float> from_left(n * L, 0.0f), from_right(n * L, 0.0f), from_up(n * L, 0.0f),
-      from_down(n * L, 0.0f);
-  std::vector<float> belief(L), tmp(L);
+  // One message per edge (as in Kolmogorov 2006): at any time the edge
+  // holds the message towards the endpoint that the current pass reaches
+  // last, which is the only direction still needed. horizontal[p] is the edge
+  // (x, y)-(x+1, y), vertical[p] the edge (x, y)-(x, y+1). Half the memory of
+  // storing both directions, and the same results.
+  const int S = PaddedLabels(L);
+  std::vector<float> horizontal(n * S, 0.0f), vertical(n * S, 0.0f);
+  const std::vector<float> zeros(S, 0.0f);
+  std::vector<float> belief(S, 0.0f), cost(S, kInf);
+  std::vector<float> label_f(S);
+  for (int l = 0; l < S; ++l) label_f[l] = static_cast<float>(l);
   std::vector<uint16_t> labels(n, 0);
   TrwsResult result;
   result.energy = std::numeric_limits<double>::infinity();
   const int T = mrf.truncation;
+  const float t_f = static_cast<float>(T);
   double prev_best = result.energy;
   int stale = 0;
+
+  // Belief of node p: its unary plus the four incoming messages (missing
+  // neighbours contribute `zeros`).
+  auto compute_belief = [&](size_t p, const float* ml, const float* mr, const float* mu,
+                            const float* md) {
+    const float* __restrict u = &mrf.unary[p * L];
+    float* __restrict b = belief.data();
+    for (int l = 0; l < L; ++l) b[l] = u[l] + ml[l] + mr[l] + mu[l] + md[l];
+  };
+  // Messages from the node whose belief is in `belief` along one or two
+  // edges (each holding the message towards the node; overwritten).
+  auto send = [&](float gamma, float* e0, float w0, float* e1, float w1) {
+    if (e0 && e1) {
+      float* const edges[2] = {e0, e1};
+      const float weights[2] = {w0, w1};
+      SendMessages<2>(belief.data(), gamma, L, S, edges, weights, T);
+    } else if (e0 || e1) {
+      float* const edges[1] = {e0 ? e0 : e1};
+      const float weights[1] = {e0 ? w0 : w1};
+      SendMessages<1>(belief.data(), gamma, L, S, edges, weights, T);
+    }
+  };
 
   for (int iter = 0; iter < options.max_iterations; ++iter) {
     // Forward pass (raster order): messages to the right and down neighbours,
@@ -65,41 +225,34 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options) {
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
         const size_t p = static_cast<size_t>(y) * w + x;
-        const float* u = &mrf.unary[p * L];
-        const float* ml = &from_left[p * L];
-        const float* mr = &from_right[p * L];
-        const float* mu = &from_up[p * L];
-        const float* md = &from_down[p * L];
-        for (int l = 0; l < L; ++l) belief[l] = u[l] + ml[l] + mr[l] + mu[l] + md[l];
-        // Labelling (Kolmogorov 2006, Sec. 5).
+        float* mr = &horizontal[p * S];
+        float* md = &vertical[p * S];
+        const float* ml = x > 0 ? &horizontal[(p - 1) * S] : zeros.data();
+        const float* mu = y > 0 ? &vertical[(p - w) * S] : zeros.data();
+        // Belief, and the labelling cost (Kolmogorov 2006, Sec. 5): unary,
+        // messages from the nodes not yet labelled in this pass, and the
+        // pairwise terms to the labelled left and up neighbours.
         {
-          int best = 0;
-          float best_cost = std::numeric_limits<float>::infinity();
-          const int ll = x > 0 ? labels[p - 1] : -1;
-          const int lu = y > 0 ? labels[p - w] : -1;
+          const float* __restrict u = &mrf.unary[p * L];
+          const float* __restrict lf = label_f.data();
+          float* __restrict b = belief.data();
+          float* __restrict c = cost.data();
+          const float ll = x > 0 ? static_cast<float>(labels[p - 1]) : 0.0f;
+          const float lu = y > 0 ? static_cast<float>(labels[p - w]) : 0.0f;
           const float wl = x > 0 ? mrf.weight_right[p - 1] : 0.0f;
           const float wu = y > 0 ? mrf.weight_down[p - w] : 0.0f;
           for (int l = 0; l < L; ++l) {
-            float c = u[l] + mr[l] + md[l];
-            if (ll >= 0) c += Pairwise(wl, l, ll, T);
-            if (lu >= 0) c += Pairwise(wu, l, lu, T);
-            if (c < best_cost) {
-              best_cost = c;
-              best = l;
-            }
+            b[l] = u[l] + ml[l] + mr[l] + mu[l] + md[l];
+            const float pl = wl * std::min(std::abs(lf[l] - ll), t_f);
+            const float pu = wu * std::min(std::abs(lf[l] - lu), t_f);
+            c[l] = u[l] + mr[l] + md[l] + pl + pu;
           }
-          labels[p] = static_cast<uint16_t>(best);
+          labels[p] = static_cast<uint16_t>(ArgMin(cost.data(), S));
         }
         const int before = (x > 0) + (y > 0), after = (x + 1 < w) + (y + 1 < h);
         const float gamma = 1.0f / static_cast<float>(std::max(1, std::max(before, after)));
-        if (x + 1 < w) {
-          for (int l = 0; l < L; ++l) tmp[l] = gamma * belief[l] - mr[l];
-          DistanceTransform(tmp.data(), &from_left[(p + 1) * L], L, mrf.weight_right[p], T);
-        }
-        if (y + 1 < h) {
-          for (int l = 0; l < L; ++l) tmp[l] = gamma * belief[l] - md[l];
-          DistanceTransform(tmp.data(), &from_up[(p + w) * L], L, mrf.weight_down[p], T);
-        }
+        send(gamma, x + 1 < w ? mr : nullptr, mrf.weight_right[p], y + 1 < h ? md : nullptr,
+             mrf.weight_down[p]);
       }
     }
     const double e = MrfEnergy(mrf, labels);
@@ -107,27 +260,21 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options) {
       result.energy = e;
       result.labels = labels;
     }
+    result.pass_energies.push_back(e);
     result.iterations = iter + 1;
     // Backward pass (reverse raster order): messages to the left and up neighbours.
     for (int y = h - 1; y >= 0; --y) {
       for (int x = w - 1; x >= 0; --x) {
         const size_t p = static_cast<size_t>(y) * w + x;
-        const float* u = &mrf.unary[p * L];
-        const float* ml = &from_left[p * L];
-        const float* mr = &from_right[p * L];
-        const float* mu = &from_up[p * L];
-        const float* md = &from_down[p * L];
-        for (int l = 0; l < L; ++l) belief[l] = u[l] + ml[l] + mr[l] + mu[l] + md[l];
+        float* ml = x > 0 ? &horizontal[(p - 1) * S] : nullptr;
+        float* mu = y > 0 ? &vertical[(p - w) * S] : nullptr;
+        const float* mr = x + 1 < w ? &horizontal[p * S] : zeros.data();
+        const float* md = y + 1 < h ? &vertical[p * S] : zeros.data();
+        compute_belief(p, ml ? ml : zeros.data(), mr, mu ? mu : zeros.data(), md);
         const int before = (x > 0) + (y > 0), after = (x + 1 < w) + (y + 1 < h);
         const float gamma = 1.0f / static_cast<float>(std::max(1, std::max(before, after)));
-        if (x > 0) {
-          for (int l = 0; l < L; ++l) tmp[l] = gamma * belief[l] - ml[l];
-          DistanceTransform(tmp.data(), &from_right[(p - 1) * L], L, mrf.weight_right[p - 1], T);
-        }
-        if (y > 0) {
-          for (int l = 0; l < L; ++l) tmp[l] = gamma * belief[l] - mu[l];
-          DistanceTransform(tmp.data(), &from_down[(p - w) * L], L, mrf.weight_down[p - w], T);
-        }
+        send(gamma, ml, x > 0 ? mrf.weight_right[p - 1] : 0.0f, mu,
+             y > 0 ? mrf.weight_down[p - w] : 0.0f);
       }
     }
     // Stop after `patience` passes without a significant improvement.

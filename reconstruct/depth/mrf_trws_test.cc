@@ -1,10 +1,11 @@
 #include "reconstruct/depth/mrf_trws.h"
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
-
-#include <gtest/gtest.h>
 
 namespace casual3d::depth {
 namespace {
@@ -45,7 +46,8 @@ double Icm(const GridMrf& m) {
   const int w = m.width, h = m.height, L = m.num_labels;
   std::vector<uint16_t> lab(static_cast<size_t>(w) * h);
   for (size_t p = 0; p < lab.size(); ++p)
-    lab[p] = static_cast<uint16_t>(std::min_element(&m.unary[p * L], &m.unary[p * L] + L) - &m.unary[p * L]);
+    lab[p] = static_cast<uint16_t>(std::min_element(&m.unary[p * L], &m.unary[p * L] + L) -
+                                   &m.unary[p * L]);
   for (int it = 0; it < 20; ++it)
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
@@ -114,7 +116,8 @@ TEST(Trws, DenoisesAPiecewiseConstantLabelImage) {
     for (int x = 0; x < w; ++x) {
       const size_t p = static_cast<size_t>(y) * w + x;
       truth[p] = x < w / 2 ? 5 : 20;
-      for (int l = 0; l < L; ++l) m.unary[p * L + l] = 0.6f * noise(rng) + (l == truth[p] ? 0.0f : 0.35f);
+      for (int l = 0; l < L; ++l)
+        m.unary[p * L + l] = 0.6f * noise(rng) + (l == truth[p] ? 0.0f : 0.35f);
     }
   m.weight_right.assign(static_cast<size_t>(w) * h, 0.15f);
   m.weight_down.assign(static_cast<size_t>(w) * h, 0.15f);
@@ -122,6 +125,70 @@ TEST(Trws, DenoisesAPiecewiseConstantLabelImage) {
   int correct = 0;
   for (size_t p = 0; p < truth.size(); ++p) correct += r.labels[p] == truth[p];
   EXPECT_GE(correct, static_cast<int>(0.98 * truth.size()));
+}
+
+// Exact minimum of a chain MRF (a 1 x n or n x 1 grid) by dynamic programming.
+double ChainMinimum(const GridMrf& m) {
+  const int n = m.width * m.height, L = m.num_labels;
+  const std::vector<float>& wt = m.height == 1 ? m.weight_right : m.weight_down;
+  std::vector<double> cost(m.unary.begin(), m.unary.begin() + L), next(L);
+  for (int i = 1; i < n; ++i) {
+    for (int l = 0; l < L; ++l) {
+      double best = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < L; ++k)
+        best = std::min(best, cost[k] + static_cast<double>(wt[i - 1]) *
+                                            std::min(std::abs(l - k), m.truncation));
+      next[l] = m.unary[static_cast<size_t>(i) * L + l] + best;
+    }
+    cost.swap(next);
+  }
+  return *std::min_element(cost.begin(), cost.end());
+}
+
+TEST(Trws, ExactOnChains) {
+  // Chains are trees, on which TRW-S is exact. Label counts around the SIMD
+  // block sizes (multiples of 4 and 8 and not) exercise the padded labels;
+  // truncations from 1 to beyond the label range exercise the cap.
+  int cases = 0;
+  for (int labels : {1, 2, 3, 7, 8, 9, 21, 64}) {
+    for (int truncation : {1, 3, 100}) {
+      for (int vertical = 0; vertical < 2; ++vertical) {
+        const int len = 17;
+        GridMrf m = RandomMrf(vertical ? 1 : len, vertical ? len : 1, labels, truncation,
+                              1000 + labels * 7 + truncation + vertical, 0.4f);
+        const TrwsResult r = SolveTrws(m);
+        const double exact = ChainMinimum(m);
+        EXPECT_NEAR(r.energy, exact, 1e-5 * std::max(1.0, exact))
+            << labels << " labels, truncation " << truncation
+            << (vertical ? ", vertical" : ", horizontal");
+        EXPECT_NEAR(r.energy, MrfEnergy(m, r.labels), 1e-5);
+        ++cases;
+      }
+    }
+  }
+  EXPECT_EQ(cases, 48);
+}
+
+TEST(Trws, ReportsTheEnergyOfEveryPass) {
+  const GridMrf m = RandomMrf(20, 15, 30, 5, 11, 0.5f);
+  TrwsOptions opt;
+  opt.max_iterations = 6;
+  opt.relative_tolerance = 0.0;
+  opt.patience = 1000;  // Run every pass.
+  const TrwsResult r = SolveTrws(m, opt);
+  ASSERT_EQ(r.iterations, 6);
+  ASSERT_EQ(r.pass_energies.size(), 6u);
+  EXPECT_DOUBLE_EQ(r.energy, *std::min_element(r.pass_energies.begin(), r.pass_energies.end()));
+  // Stopping early: with a tolerance no pass can meet, patience 1 stops after two passes.
+  opt.relative_tolerance = 1.0;
+  opt.patience = 1;
+  EXPECT_EQ(SolveTrws(m, opt).iterations, 2);
+}
+
+TEST(Trws, RejectsNegativeWeights) {
+  GridMrf m = RandomMrf(4, 4, 3, 1, 1, 0.1f);
+  m.weight_down[5] = -0.1f;
+  EXPECT_THROW(SolveTrws(m), std::invalid_argument);
 }
 
 TEST(Trws, RejectsInconsistentSizes) {

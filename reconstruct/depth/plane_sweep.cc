@@ -8,11 +8,10 @@
 #include <thread>
 
 #include "reconstruct/depth/parallel.h"
+#include "reconstruct/depth/sweep_kernels.h"
 
 namespace casual3d::depth {
 namespace {
-
-constexpr float kInvalidCost = 2.0f;  // Marks "this neighbour does not see the pixel".
 
 // Mean over a (2r+1)^2 window clipped to the image, for one plane. `tmp` has
 // width*height elements; `acc` has `width` elements.
@@ -58,24 +57,37 @@ struct NeighborWarp {
   const DenseView* view = nullptr;
   float a[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   float b[3] = {0, 0, 0};
+
+  // Row y of the homography of the plane with inverse depth inv_d, with the
+  // pixel-centre offsets (x + 0.5, y + 0.5) folded in.
+  sweep::HomographyRow Row(int y, float inv_d) const {
+    sweep::HomographyRow row;
+    const float v = y + 0.5f;
+    for (int c = 0; c < 3; ++c) {
+      row.p0[c] = a[c][1] * v + a[c][2] + b[c] * inv_d + a[c][0] * 0.5f;
+      row.step[c] = a[c][0];
+    }
+    return row;
+  }
 };
 
-// Bilinear sample with clamping to the border (window pixels that fall just
-// outside the neighbour keep a sensible value; the centre's own validity is
-// checked separately).
-inline float Bilinear(const float* img, int w, int h, float x, float y) {
-  x = std::min(std::max(x, 0.0f), static_cast<float>(w - 1));
-  y = std::min(std::max(y, 0.0f), static_cast<float>(h - 1));
-  const int x0 = std::min(static_cast<int>(x), w - 2 < 0 ? 0 : w - 2);
-  const int y0 = std::min(static_cast<int>(y), h - 2 < 0 ? 0 : h - 2);
-  const float fx = x - x0, fy = y - y0;
-  const float* p = img + static_cast<size_t>(y0) * w + x0;
-  const int dx = w > 1 ? 1 : 0;
-  const size_t dy = h > 1 ? static_cast<size_t>(w) : 0;
-  const float top = p[0] + fx * (p[dx] - p[0]);
-  const float bot = p[dy] + fx * (p[dy + dx] - p[dy]);
-  return top + fy * (bot - top);
-}
+// The rolling state of one neighbour while a plane is swept top to bottom:
+// the horizontal window sums of J, J^2 and I*J for the last 2r+2 rows (a
+// ring), their vertical running sums, and the centre validity per row.
+struct NeighborRows {
+  NeighborRows(int width, int radius)
+      : ring_rows(2 * radius + 2),
+        ring_j(static_cast<size_t>(ring_rows) * width),
+        ring_jj(ring_j.size()),
+        ring_ij(ring_j.size()),
+        ring_invalid(ring_j.size()),
+        acc_j(width),
+        acc_jj(width),
+        acc_ij(width) {}
+  int ring_rows;
+  std::vector<float> ring_j, ring_jj, ring_ij, ring_invalid;
+  std::vector<float> acc_j, acc_jj, acc_ij;
+};
 
 }  // namespace
 
@@ -98,7 +110,8 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
                              const SweepOptions& options) {
   const Status st = options.Check();
   if (!st.ok()) throw std::invalid_argument("plane sweep: " + st.message());
-  if (neighbors.empty()) throw std::invalid_argument("plane sweep: " + ref.name + ": no neighbours");
+  if (neighbors.empty())
+    throw std::invalid_argument("plane sweep: " + ref.name + ": no neighbours");
   if (!(ref.range.near_m > 0.0 && ref.range.far_m > ref.range.near_m))
     throw std::invalid_argument("plane sweep: " + ref.name + ": invalid depth range");
   const int w = ref.gray.width(), h = ref.gray.height();
@@ -153,148 +166,93 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
     }
   }
 
-  // Plane-major scratch volume: each plane is written by one thread.
-  std::vector<float> planes(n * num_labels);
+  // Planes are handed out in groups of kGroup. A thread sweeps each plane of
+  // its group row by row (all working rows stay in cache), keeps the group
+  // plane-major in a small buffer, then writes it into the pixel-major volume
+  // (kGroup consecutive floats per pixel).
+  constexpr int kGroup = 16;
   const int num_nb = static_cast<int>(neighbors.size());
   const int best_k = std::min(options.best_k, num_nb);
-  std::atomic<int> next_plane(0);
+  const int num_groups = (num_labels + kGroup - 1) / kGroup;
+  vol.cost.resize(n * num_labels);
+  std::atomic<int> next_group(0);
   auto worker = [&]() {
-    // Horizontal window sums of J, J^2 and I*J (one image each), one warped row,
-    // the vertical accumulators, and the per-neighbour costs of one plane.
-    std::vector<float> hj(n), hjj(n), hij(n), jrow(w), acc_j(w), acc_jj(w), acc_ij(w);
-    std::vector<float> nb_cost(n * num_nb);
+    std::vector<NeighborRows> rows(num_nb, NeighborRows(w, r));
+    // Rows padded with r zeros on both sides: J, J^2 and I*J.
+    std::vector<float> pad_j(w + 2 * r, 0.0f), pad_jj(pad_j.size(), 0.0f),
+        pad_ij(pad_j.size(), 0.0f);
+    std::vector<float> cost_row(w), slots(static_cast<size_t>(best_k) * w);
+    std::vector<float> group(static_cast<size_t>(kGroup) * n);
     for (;;) {
-      const int k = next_plane.fetch_add(1);
-      if (k >= num_labels) break;
-      const float inv_d = static_cast<float>(vol.InvDepthOfLabel(k));
-      for (int j = 0; j < num_nb; ++j) {
-        const NeighborWarp& wp = warps[j];
-        const int nw = wp.view->gray.width(), nh = wp.view->gray.height();
-        const float* src = wp.view->gray.data();
-        float* cost = nb_cost.data() + static_cast<size_t>(j) * n;
-        // Warp row by row (x_n ~ A (u, v, 1) + b / d is affine in u along a
-        // row) and take horizontal window sums right away.
-        for (int y = 0; y < h; ++y) {
-          const float v = y + 0.5f;
-          const float* gi_row = gi + static_cast<size_t>(y) * w;
-          float* cost_row = cost + static_cast<size_t>(y) * w;
-          const float px0 = wp.a[0][1] * v + wp.a[0][2] + wp.b[0] * inv_d + wp.a[0][0] * 0.5f;
-          const float py0 = wp.a[1][1] * v + wp.a[1][2] + wp.b[1] * inv_d + wp.a[1][0] * 0.5f;
-          const float pz0 = wp.a[2][1] * v + wp.a[2][2] + wp.b[2] * inv_d + wp.a[2][0] * 0.5f;
-          for (int x = 0; x < w; ++x) {
-            // One rounding per coordinate (no accumulated drift along the row).
-            const float px = px0 + wp.a[0][0] * x;
-            const float py = py0 + wp.a[1][0] * x;
-            const float pz = pz0 + wp.a[2][0] * x;
-            float val = 0.0f;
-            bool inside = false;
-            if (pz > 1e-9f) {
-              const float iz = 1.0f / pz;
-              const float u = px * iz - 0.5f, vv = py * iz - 0.5f;
-              inside = u >= -0.5f && vv >= -0.5f && u <= nw - 0.5f && vv <= nh - 0.5f;
-              if (inside) val = Bilinear(src, nw, nh, u, vv);
-            }
-            cost_row[x] = inside ? 0.0f : kInvalidCost;
-            jrow[x] = val;
-          }
-          float* dj = hj.data() + static_cast<size_t>(y) * w;
-          float* djj = hjj.data() + static_cast<size_t>(y) * w;
-          float* dij = hij.data() + static_cast<size_t>(y) * w;
-          float sj = 0.0f, sjj = 0.0f, sij = 0.0f;
-          for (int x = 0; x < std::min(r, w); ++x) {
-            sj += jrow[x];
-            sjj += jrow[x] * jrow[x];
-            sij += jrow[x] * gi_row[x];
-          }
-          for (int x = 0; x < w; ++x) {
-            if (x + r < w) {
-              const float a = jrow[x + r];
-              sj += a;
-              sjj += a * a;
-              sij += a * gi_row[x + r];
-            }
-            if (x - r - 1 >= 0) {
-              const float a = jrow[x - r - 1];
-              sj -= a;
-              sjj -= a * a;
-              sij -= a * gi_row[x - r - 1];
-            }
-            dj[x] = sj;
-            djj[x] = sjj;
-            dij[x] = sij;
-          }
+      const int group_index = next_group.fetch_add(1);
+      if (group_index >= num_groups) break;
+      const int k0 = group_index * kGroup, k1 = std::min(num_labels, k0 + kGroup);
+      for (int k = k0; k < k1; ++k) {
+        const float inv_d = static_cast<float>(vol.InvDepthOfLabel(k));
+        float* plane = group.data() + static_cast<size_t>(k - k0) * n;
+        for (NeighborRows& nr : rows) {
+          std::fill(nr.acc_j.begin(), nr.acc_j.end(), 0.0f);
+          std::fill(nr.acc_jj.begin(), nr.acc_jj.end(), 0.0f);
+          std::fill(nr.acc_ij.begin(), nr.acc_ij.end(), 0.0f);
         }
-        // Vertical window sums over whole rows (contiguous, vectorisable),
-        // fused with the ZNCC.
-        std::fill(acc_j.begin(), acc_j.end(), 0.0f);
-        std::fill(acc_jj.begin(), acc_jj.end(), 0.0f);
-        std::fill(acc_ij.begin(), acc_ij.end(), 0.0f);
-        auto add_row = [&](int yy, float sign) {
-          const size_t o = static_cast<size_t>(yy) * w;
-          for (int x = 0; x < w; ++x) {
-            acc_j[x] += sign * hj[o + x];
-            acc_jj[x] += sign * hjj[o + x];
-            acc_ij[x] += sign * hij[o + x];
+        // Row yi enters the window sums; row yo = yi - r leaves complete.
+        for (int yi = 0; yi < h + r; ++yi) {
+          const int yo = yi - r;
+          if (yo >= 0) std::fill(slots.begin(), slots.end(), sweep::kInvalidCost);
+          for (int j = 0; j < num_nb; ++j) {
+            NeighborRows& nr = rows[j];
+            if (yi < h) {
+              const NeighborWarp& wp = warps[j];
+              const size_t slot = static_cast<size_t>(yi % nr.ring_rows) * w;
+              sweep::WarpRow(wp.view->gray.data(), wp.view->gray.width(), wp.view->gray.height(),
+                             wp.Row(yi, inv_d), w, pad_j.data() + r, nr.ring_invalid.data() + slot);
+              const float* gi_row = gi + static_cast<size_t>(yi) * w;
+              for (int x = 0; x < w; ++x) {
+                const float jv = pad_j[r + x];
+                pad_jj[r + x] = jv * jv;
+                pad_ij[r + x] = jv * gi_row[x];
+              }
+              float* hj = nr.ring_j.data() + slot;
+              float* hjj = nr.ring_jj.data() + slot;
+              float* hij = nr.ring_ij.data() + slot;
+              sweep::WindowSumAccumulate(pad_j.data(), w, r, hj, nr.acc_j.data());
+              sweep::WindowSumAccumulate(pad_jj.data(), w, r, hjj, nr.acc_jj.data());
+              sweep::WindowSumAccumulate(pad_ij.data(), w, r, hij, nr.acc_ij.data());
+            }
+            if (yo < 0) continue;
+            if (yo - r - 1 >= 0) {
+              const size_t old = static_cast<size_t>((yo - r - 1) % nr.ring_rows) * w;
+              sweep::SubtractRow(nr.ring_j.data() + old, w, nr.acc_j.data());
+              sweep::SubtractRow(nr.ring_jj.data() + old, w, nr.acc_jj.data());
+              sweep::SubtractRow(nr.ring_ij.data() + old, w, nr.acc_ij.data());
+            }
+            const size_t o = static_cast<size_t>(yo) * w;
+            sweep::ZnccRowInputs in;
+            in.sum_j = nr.acc_j.data();
+            in.sum_jj = nr.acc_jj.data();
+            in.sum_ij = nr.acc_ij.data();
+            in.inv_count = inv_count.data() + o;
+            in.mean_i = mean_i.data() + o;
+            in.inv_std_i = inv_std_i.data() + o;
+            in.invalid = nr.ring_invalid.data() + static_cast<size_t>(yo % nr.ring_rows) * w;
+            sweep::ZnccCostRow(in, eps, w, cost_row.data());
+            // Occlusion-robust aggregation: mean of the best_k valid neighbours.
+            sweep::InsertSmallest(cost_row.data(), w, best_k, slots.data());
           }
-        };
-        for (int y = 0; y < std::min(r, h); ++y) add_row(y, 1.0f);
-        for (int y = 0; y < h; ++y) {
-          if (y + r < h) add_row(y + r, 1.0f);
-          if (y - r - 1 >= 0) add_row(y - r - 1, -1.0f);
-          const size_t o = static_cast<size_t>(y) * w;
-          const float* ic = inv_count.data() + o;
-          const float* mi = mean_i.data() + o;
-          const float* isi = inv_std_i.data() + o;
-          float* c = cost + o;
-          for (int x = 0; x < w; ++x) {
-            const float mj = acc_j[x] * ic[x];
-            const float var_j = std::max(0.0f, acc_jj[x] * ic[x] - mj * mj);
-            const float cov = acc_ij[x] * ic[x] - mi[x] * mj;
-            const float ncc = cov * isi[x] / std::sqrt(var_j + eps);
-            const float e = std::min(1.0f, std::max(0.0f, 1.0f - ncc));
-            c[x] = c[x] == 0.0f ? e : kInvalidCost;
-          }
+          if (yo >= 0)
+            sweep::MeanOfSlots(slots.data(), w, best_k, plane + static_cast<size_t>(yo) * w);
         }
       }
-      // Occlusion-robust aggregation: mean of the best_k valid neighbours.
-      float* plane = planes.data() + static_cast<size_t>(k) * n;
-      float c[16];
-      for (size_t i = 0; i < n; ++i) {
-        int m = 0;
-        for (int j = 0; j < num_nb && m < 16; ++j) {
-          const float v = nb_cost[static_cast<size_t>(j) * n + i];
-          if (v < kInvalidCost) c[m++] = v;
-        }
-        if (m == 0) {
-          plane[i] = 1.0f;
-          continue;
-        }
-        const int kk = std::min(best_k, m);
-        std::partial_sort(c, c + kk, c + m);
-        float sum = 0.0f;
-        for (int q = 0; q < kk; ++q) sum += c[q];
-        plane[i] = sum / kk;
-      }
+      // Plane-major group to pixel-major volume.
+      sweep::PlanesToPixelMajor(group.data(), n, k1 - k0, vol.cost.data() + k0, num_labels);
     }
   };
   {
     std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+    for (int t = 1; t < std::min(threads, num_groups); ++t) pool.emplace_back(worker);
     worker();
     for (auto& th : pool) th.join();
   }
-
-  // Blocked transpose to pixel-major.
-  vol.cost.resize(n * num_labels);
-  constexpr size_t kBlock = 64;
-  const size_t num_blocks = (n + kBlock - 1) / kBlock;
-  ParallelFor(0, static_cast<int64_t>(num_blocks), threads, [&](int64_t bi) {
-    const size_t p0 = bi * kBlock, p1 = std::min(n, p0 + kBlock);
-    for (int k = 0; k < num_labels; ++k) {
-      const float* src = planes.data() + static_cast<size_t>(k) * n;
-      for (size_t p = p0; p < p1; ++p) vol.cost[p * num_labels + k] = src[p];
-    }
-  }, 16);
   return vol;
 }
 

@@ -13,6 +13,14 @@
 // partial occlusion (a surface hidden in some neighbours still matches in the
 // others). w_photo = var / (var + texture_sigma^2) with var the reference
 // window's intensity variance: low in textureless regions, where ZNCC is noise.
+// Window pixels that a neighbour does not see count as black.
+//
+// Cost: linear in pixels x planes x neighbours (window sums run along rows
+// and down columns, so the radius only adds 2r adds per pixel and moment).
+// Threads take groups of planes; each plane is streamed row by row through
+// cache-resident rows (warp, window sums, ZNCC, best-k aggregation:
+// sweep_kernels.h). Extra memory besides the volume: about 16 planes per
+// thread.
 
 #include <cstdint>
 #include <vector>
@@ -24,13 +32,13 @@
 namespace casual3d::depth {
 
 struct SweepOptions {
-  int num_depths = 220;          // Sec. 4.3.1: depth hypotheses. Range [2, 4096].
-  int window_radius = 3;         // ZNCC window radius at working resolution, pixels. [1, 15].
-  int best_k = 2;                // Neighbours averaged per pixel (best costs first). [1, 16].
-  double ncc_epsilon = 2.5e-5;   // Variance added to both windows (intensity^2); damps ZNCC of
-                                 // flat, noisy windows towards 0. [0, 1].
-  double texture_sigma = 0.02;   // w_photo = var / (var + texture_sigma^2), intensity. (0, 1].
-  int num_threads = 0;           // 0 = all cores.
+  int num_depths = 220;         // Sec. 4.3.1: depth hypotheses. Range [2, 4096].
+  int window_radius = 3;        // ZNCC window radius at working resolution, pixels. [1, 15].
+  int best_k = 2;               // Neighbours averaged per pixel (best costs first). [1, 16].
+  double ncc_epsilon = 2.5e-5;  // Variance added to both windows (intensity^2); damps ZNCC of
+                                // flat, noisy windows towards 0. [0, 1].
+  double texture_sigma = 0.02;  // w_photo = var / (var + texture_sigma^2), intensity. (0, 1].
+  int num_threads = 0;          // 0 = all cores.
 
   Status Check() const;
 };
@@ -42,8 +50,8 @@ struct CostVolume {
   int width = 0;
   int height = 0;
   int num_labels = 0;
-  double inv_near = 0.0;  // 1 / near_m: inverse depth of label 0, 1/m.
-  double inv_far = 0.0;   // 1 / far_m: inverse depth of the last label, 1/m.
+  double inv_near = 0.0;    // 1 / near_m: inverse depth of label 0, 1/m.
+  double inv_far = 0.0;     // 1 / far_m: inverse depth of the last label, 1/m.
   std::vector<float> cost;  // E_photo in [0, 1], index (y * width + x) * num_labels + k.
   ImageF photo_weight;      // w_photo per pixel in [0, 1].
 

@@ -1,0 +1,73 @@
+#pragma once
+
+// Row kernels of the plane sweep (plane_sweep.cc): the loops that run once per
+// pixel x plane x neighbour. Each works on one image row held in cache, so the
+// sweep streams through a plane row by row without whole-image temporaries.
+// On x86-64 the warp, the window sums, the best-k mean and the layout change
+// use SSE2 intrinsics (the baseline of every x86-64 CPU); the other loops are
+// plain loops that GCC and Clang vectorise. Results do not depend on the code
+// path: every lane computes the same IEEE float expression, in the same
+// order, as the scalar fallback.
+
+#include <cstddef>
+
+namespace casual3d::depth::sweep {
+
+// Cost of a neighbour that does not see the pixel; larger than any real cost
+// (costs are in [0, 1]) so that sorting puts it last.
+constexpr float kInvalidCost = 2.0f;
+
+// One row of a plane-induced homography in homogeneous neighbour pixel
+// coordinates: the pixel x of the row maps to p0 + x * step (3-vectors). The
+// reference pixel centre convention of view.h is folded into p0.
+struct HomographyRow {
+  float p0[3] = {0, 0, 0};
+  float step[3] = {0, 0, 0};
+};
+
+// Warps one row of `width` pixels. For pixel x with p = p0 + x * step and
+// p.z > 1e-9, the neighbour position is (p.x / p.z - 0.5, p.y / p.z - 0.5)
+// (pixel indices). If it lies within [-0.5, src_width - 0.5] x
+// [-0.5, src_height - 0.5], values[x] is the bilinear sample of `src`
+// (src_width x src_height, row-major, clamped to the border) and invalid[x] is
+// 0; otherwise values[x] = 0 and invalid[x] = kInvalidCost.
+void WarpRow(const float* src, int src_width, int src_height, const HomographyRow& row, int width,
+             float* values, float* invalid);
+
+// Sums of a (2r+1)-wide window, added to a running total: out[x] = in[x] +
+// ... + in[x + 2r] and acc[x] += out[x] for x in [0, width). `in` holds
+// width + 2r elements (the row padded with r zeros on each side gives the
+// window centred on x, clipped to the row).
+void WindowSumAccumulate(const float* in, int width, int r, float* out, float* acc);
+
+// acc[x] -= sub[x] for x in [0, width).
+void SubtractRow(const float* sub, int width, float* acc);
+
+// Per-pixel inputs of the ZNCC of one row.
+struct ZnccRowInputs {
+  const float* sum_j = nullptr;      // Window sum of the warped neighbour J.
+  const float* sum_jj = nullptr;     // Window sum of J^2.
+  const float* sum_ij = nullptr;     // Window sum of I * J (I = reference grey).
+  const float* inv_count = nullptr;  // 1 / number of window pixels.
+  const float* mean_i = nullptr;     // Window mean of I.
+  const float* inv_std_i = nullptr;  // 1 / sqrt(var(I) + epsilon).
+  const float* invalid = nullptr;    // 0 where the neighbour sees the pixel, else kInvalidCost.
+};
+
+// cost[x] = min(1, max(0, 1 - ZNCC)) with ZNCC = cov(I, J) / sqrt((var I +
+// epsilon)(var J + epsilon)), or kInvalidCost where in.invalid[x] != 0.
+void ZnccCostRow(const ZnccRowInputs& in, float epsilon, int width, float* cost);
+
+// Keeps, per pixel, the k smallest costs seen so far in ascending order:
+// slots holds k rows of `width` (slot q of pixel x at slots[q * width + x]),
+// initialised to kInvalidCost; this inserts cost[x] into pixel x's list.
+void InsertSmallest(const float* cost, int width, int k, float* slots);
+
+// out[x] = mean of pixel x's valid (< kInvalidCost) slots, or 1 if none.
+void MeanOfSlots(const float* slots, int width, int k, float* out);
+
+// Writes `num_planes` plane-major rows of `n` values (planes[g * n + p]) into a
+// pixel-major array: out[p * stride + g] = planes[g * n + p].
+void PlanesToPixelMajor(const float* planes, size_t n, int num_planes, float* out, size_t stride);
+
+}  // namespace casual3d::depth::sweep
