@@ -1,6 +1,8 @@
 #include "format/two_layer.h"
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <string>
 
 namespace casual3d {
@@ -56,6 +58,84 @@ Status ValidateFrame(const PanoramaFrame& f) {
   return Status::Ok();
 }
 
+// kLinkPairs.invalid[code] for the links across one edge between pixels p and q
+// (q to the right of or below p): code bits 0-1 and 2-3 hold the front and
+// back links of p towards q, bits 4-5 and 6-7 those of q towards p. The edge
+// is valid iff no link is the reserved value 3 and every link is answered by
+// its target: a link from layer l to layer t (Link t + 1) needs the link of
+// node t on the other side to be Link l + 1. An answered link also proves its
+// target present, because absent nodes must have no links.
+struct LinkPairTable {
+  bool invalid[256];
+  constexpr LinkPairTable() : invalid() {
+    for (int code = 0; code < 256; ++code) {
+      const int p[2] = {code & 3, (code >> 2) & 3};
+      const int q[2] = {(code >> 4) & 3, (code >> 6) & 3};
+      bool bad = false;
+      for (int l = 0; l < kNumLayers; ++l) {
+        if (p[l] == 3 || q[l] == 3) {
+          bad = true;
+          continue;
+        }
+        if (p[l] != 0 && q[p[l] - 1] != l + 1) bad = true;
+        if (q[l] != 0 && p[q[l] - 1] != l + 1) bad = true;
+      }
+      invalid[code] = bad;
+    }
+  }
+};
+constexpr LinkPairTable kLinkPairs;
+
+// Bits of the packed links byte per direction (two_layer.h, GetLink).
+constexpr unsigned kRightBits = 0, kDownBits = 2, kLeftBits = 4, kUpBits = 6;
+
+inline unsigned PairCode(unsigned front_p, unsigned back_p, unsigned p_shift, unsigned front_q,
+                         unsigned back_q, unsigned q_shift) {
+  return ((front_p >> p_shift) & 3) | (((back_p >> p_shift) & 3) << 2) |
+         (((front_q >> q_shift) & 3) << 4) | (((back_q >> q_shift) & 3) << 6);
+}
+
+// Squared normal lengths that pass |sqrt(len2) - 1| <= kNormalLengthTolerance
+// for sure (a margin well above double rounding); values outside this band
+// but near it are decided by the exact test.
+constexpr double kSureMinLength2 =
+    (1.0 - kNormalLengthTolerance + 1e-9) * (1.0 - kNormalLengthTolerance + 1e-9);
+constexpr double kSureMaxLength2 =
+    (1.0 + kNormalLengthTolerance - 1e-9) * (1.0 + kNormalLengthTolerance - 1e-9);
+
+// The bits of a float without its sign: zero exactly when the float == 0.0f
+// (so -0.0f counts as zero, as in Validate's comparisons; NaN does not).
+inline uint32_t MagnitudeBits(float v) {
+  uint32_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits & 0x7fffffffu;
+}
+
+// Whether node i of layer d breaks a per-node rule of Validate. Nodes come in
+// long runs of present or absent ones, so the branch on `present` predicts
+// well; the checks inside are combined without further branches.
+inline bool NodeInvalid(const LayerData& d, size_t i) {
+  const uint8_t present = d.present[i];
+  const uint8_t* rgb = &d.rgb[3 * i];
+  const float* nrm = &d.normal[3 * i];
+  const float depth = d.depth_m[i];
+  const uint8_t label = d.label[i];
+  if (present == 0) {
+    return ((rgb[0] | rgb[1] | rgb[2] | label | d.links[i]) |
+            (MagnitudeBits(depth) | MagnitudeBits(nrm[0]) | MagnitudeBits(nrm[1]) |
+             MagnitudeBits(nrm[2]))) != 0;
+  }
+  // depth > 0 and <= FLT_MAX is "finite and positive" (NaN fails both). A
+  // non-finite normal component makes len2 infinite or NaN, which fails the
+  // length test, as Validate's explicit finiteness test does.
+  const double len2 = static_cast<double>(nrm[0]) * nrm[0] + static_cast<double>(nrm[1]) * nrm[1] +
+                      static_cast<double>(nrm[2]) * nrm[2];
+  bool normal_ok = (len2 == 0.0) | ((len2 >= kSureMinLength2) & (len2 <= kSureMaxLength2));
+  if (!normal_ok) normal_ok = std::fabs(std::sqrt(len2) - 1.0) <= kNormalLengthTolerance;
+  return (present > 1) | !(depth > 0.0f) | !(depth <= std::numeric_limits<float>::max()) |
+         !normal_ok | (label > static_cast<uint8_t>(NodeLabel::kB));
+}
+
 }  // namespace
 
 TwoLayerPanorama::TwoLayerPanorama(int width, int height) : width_(width), height_(height) {
@@ -94,6 +174,41 @@ bool TwoLayerPanorama::Neighbour(int x, int y, Direction d, int* nx, int* ny) co
   return false;
 }
 
+bool TwoLayerPanorama::NodesAndLinksAreValid() const {
+  const LayerData& front = layers_[kFront];
+  const LayerData& back = layers_[kBack];
+  const uint8_t* front_links = front.links.data();
+  const uint8_t* back_links = back.links.data();
+  const size_t w = static_cast<size_t>(width_);
+  // Links across the top and bottom rows point outside the panorama.
+  for (size_t x = 0; x < w; ++x) {
+    const size_t bottom = static_cast<size_t>(height_ - 1) * w + x;
+    if (((front_links[x] | back_links[x]) >> kUpBits) & 3) return false;
+    if (((front_links[bottom] | back_links[bottom]) >> kDownBits) & 3) return false;
+  }
+  for (int y = 0; y < height_; ++y) {
+    const size_t row = static_cast<size_t>(y) * w;
+    const bool has_below = y + 1 < height_;
+    bool bad = false;
+    for (size_t x = 0; x < w; ++x) {
+      const size_t i = row + x;
+      bad |= NodeInvalid(front, i);
+      bad |= NodeInvalid(back, i);
+      // The edge to the right neighbour (wrapping at the seam) and the one below.
+      const size_t r = x + 1 == w ? row : i + 1;
+      bad |= kLinkPairs.invalid[PairCode(front_links[i], back_links[i], kRightBits, front_links[r],
+                                         back_links[r], kLeftBits)];
+      if (has_below) {
+        const size_t b = i + w;
+        bad |= kLinkPairs.invalid[PairCode(front_links[i], back_links[i], kDownBits, front_links[b],
+                                           back_links[b], kUpBits)];
+      }
+    }
+    if (bad) return false;
+  }
+  return true;
+}
+
 Status TwoLayerPanorama::Validate() const {
   if (width_ < 1 || height_ < 1) {
     return InvalidData("panorama size " + std::to_string(width_) + "x" + std::to_string(height_) +
@@ -115,6 +230,14 @@ Status TwoLayerPanorama::Validate() const {
     CASUAL3D_RETURN_IF_ERROR(CheckSize("label", l, d.label.size(), n));
     CASUAL3D_RETURN_IF_ERROR(CheckSize("links", l, d.links.size(), n));
   }
+  // Valid panoramas (the common case: every level the viewer shows) pass one
+  // fast scan; only a rejected one is scanned again, node by node, to name its
+  // first problem in the order documented below.
+  if (NodesAndLinksAreValid()) return Status::Ok();
+  return FirstNodeOrLinkProblem();
+}
+
+Status TwoLayerPanorama::FirstNodeOrLinkProblem() const {
   // Per-node values first, so that the link pass can rely on `present` being 0 or 1.
   for (int l = 0; l < kNumLayers; ++l) {
     const LayerData& d = layers_[l];

@@ -76,6 +76,13 @@ class TwoLayerPanorama {
   bool operator==(const TwoLayerPanorama& o) const;
 
  private:
+  // Validate's two halves after the size checks: a single branch-light scan
+  // that only says whether every node and link is valid, and the node-by-node
+  // scan that names the first problem (run only when the first one fails).
+  bool NodesAndLinksAreValid() const;
+  Status FirstNodeOrLinkProblem() const;
+  friend struct TwoLayerPanoramaTestAccess;  // two_layer_test.cc compares the two scans.
+
   int width_ = 0;
   int height_ = 0;
   LayerData layers_[kNumLayers];

@@ -3,11 +3,23 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <limits>
+#include <random>
+#include <string>
+#include <vector>
 
 #include "format/testing/test_panoramas.h"
 
 namespace casual3d {
+
+// Runs Validate's two scans separately.
+struct TwoLayerPanoramaTestAccess {
+  static bool FastScanAccepts(const TwoLayerPanorama& p) { return p.NodesAndLinksAreValid(); }
+  static Status NodeByNodeScan(const TwoLayerPanorama& p) { return p.FirstNodeOrLinkProblem(); }
+};
+
 namespace {
 
 // A 4x3 panorama with front nodes everywhere, linked to their 4 neighbours.
@@ -212,6 +224,165 @@ TEST(TwoLayerTest, CrossLayerLinksAreValidWhenMutual) {
   uint8_t& l21 = p.layer(kFront).links[i];
   l21 = SetLink(l21, kLeft, Link::kNone);
   EXPECT_TRUE(p.Validate().ok()) << p.Validate().ToString();
+}
+
+// One corruption of each kind of field, in either layer, and the exact first
+// message it must give.
+TEST(TwoLayerTest, EachKindOfCorruptionGivesItsMessage) {
+  // The fully linked front grid plus a back node at (2, 1) linked left to the
+  // front node (1, 1) (as in CrossLayerLinksAreValidWhenMutual).
+  const auto base = [] {
+    TwoLayerPanorama p = FullyLinked();
+    const size_t i = p.index(2, 1);
+    p.layer(kBack).present[i] = 1;
+    p.layer(kBack).depth_m[i] = 5.0f;
+    p.layer(kBack).normal[3 * i + 1] = 1.0f;
+    p.layer(kBack).label[i] = 1;
+    p.layer(kBack).links[i] = SetLink(0, kLeft, Link::kFront);
+    uint8_t& l11 = p.layer(kFront).links[p.index(1, 1)];
+    l11 = SetLink(l11, kRight, Link::kBack);
+    uint8_t& l21 = p.layer(kFront).links[i];
+    l21 = SetLink(l21, kLeft, Link::kNone);
+    return p;
+  };
+  ASSERT_TRUE(base().Validate().ok()) << base().Validate().ToString();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  struct Case {
+    const char* what;
+    std::function<void(TwoLayerPanorama&)> corrupt;
+    const char* message;
+  };
+  const auto at = [](TwoLayerPanorama& p, int x, int y) { return p.index(x, y); };
+  const std::vector<Case> cases = {
+      {"present flag", [&](TwoLayerPanorama& p) { p.layer(kBack).present[at(p, 2, 1)] = 2; },
+       "back node (2, 1): present flag 2 is not 0 or 1"},
+      {"absent rgb", [&](TwoLayerPanorama& p) { p.layer(kBack).rgb[3 * at(p, 0, 2) + 2] = 1; },
+       "back node (0, 2): absent node has non-zero fields"},
+      {"absent depth", [&](TwoLayerPanorama& p) { p.layer(kBack).depth_m[at(p, 3, 0)] = nan; },
+       "back node (3, 0): absent node has non-zero fields"},
+      {"absent normal",
+       [&](TwoLayerPanorama& p) { p.layer(kBack).normal[3 * at(p, 1, 1)] = -1.0f; },
+       "back node (1, 1): absent node has non-zero fields"},
+      {"absent label", [&](TwoLayerPanorama& p) { p.layer(kBack).label[at(p, 1, 0)] = 1; },
+       "back node (1, 0): absent node has non-zero fields"},
+      {"absent links", [&](TwoLayerPanorama& p) { p.layer(kBack).links[at(p, 3, 2)] = 0x40; },
+       "back node (3, 2): absent node has non-zero fields"},
+      {"negative depth", [&](TwoLayerPanorama& p) { p.layer(kFront).depth_m[at(p, 3, 1)] = -2.0f; },
+       "front node (3, 1): depth -2.000000 m is not finite and positive"},
+      {"zero depth", [&](TwoLayerPanorama& p) { p.layer(kBack).depth_m[at(p, 2, 1)] = 0.0f; },
+       "back node (2, 1): depth 0.000000 m is not finite and positive"},
+      {"infinite depth", [&](TwoLayerPanorama& p) { p.layer(kFront).depth_m[at(p, 0, 0)] = inf; },
+       "front node (0, 0): depth inf m is not finite and positive"},
+      {"infinite normal",
+       [&](TwoLayerPanorama& p) { p.layer(kFront).normal[3 * at(p, 2, 2)] = -inf; },
+       "front node (2, 2): normal is not finite"},
+      {"NaN normal", [&](TwoLayerPanorama& p) { p.layer(kBack).normal[3 * at(p, 2, 1) + 2] = nan; },
+       "back node (2, 1): normal is not finite"},
+      {"short normal",
+       [&](TwoLayerPanorama& p) { p.layer(kFront).normal[3 * at(p, 1, 2) + 2] = 0.99f; },
+       "front node (1, 2): normal has length 0.990000, expected 1 or 0"},
+      {"long normal",
+       [&](TwoLayerPanorama& p) { p.layer(kBack).normal[3 * at(p, 2, 1) + 1] = 1.5f; },
+       "back node (2, 1): normal has length 1.500000, expected 1 or 0"},
+      {"label", [&](TwoLayerPanorama& p) { p.layer(kBack).label[at(p, 2, 1)] = 3; },
+       "back node (2, 1): label 3 is not 0 (F) or 1 (B)"},
+      {"reserved link",
+       [&](TwoLayerPanorama& p) {
+         uint8_t& l = p.layer(kFront).links[at(p, 0, 1)];
+         l = SetLink(l, kDown, static_cast<Link>(3));
+       },
+       "front node (0, 1): down link has the reserved value 3"},
+      {"link past the bottom row",
+       [&](TwoLayerPanorama& p) {
+         uint8_t& l = p.layer(kFront).links[at(p, 1, 2)];
+         l = SetLink(l, kDown, Link::kFront);
+       },
+       "front node (1, 2): down link points outside the panorama (rows do not wrap)"},
+      {"link to an absent node",
+       [&](TwoLayerPanorama& p) {
+         uint8_t& l = p.layer(kFront).links[at(p, 0, 0)];
+         l = SetLink(l, kRight, Link::kBack);
+       },
+       "front node (0, 0): right link points at back node (1, 0), which is absent"},
+      {"one-way link across layers",
+       [&](TwoLayerPanorama& p) {
+         uint8_t& l = p.layer(kBack).links[at(p, 2, 1)];
+         l = SetLink(l, kLeft, Link::kNone);
+       },
+       "front node (1, 1): right link to back node (2, 1) is not mutual"},
+      {"link answered by the wrong layer",
+       [&](TwoLayerPanorama& p) {
+         uint8_t& l = p.layer(kBack).links[at(p, 2, 1)];
+         l = SetLink(l, kDown, Link::kFront);  // (2, 2) answers the front node (2, 1).
+       },
+       "back node (2, 1): down link to front node (2, 2) is not mutual"},
+  };
+  for (const Case& c : cases) {
+    TwoLayerPanorama p = base();
+    c.corrupt(p);
+    const Status s = p.Validate();
+    EXPECT_EQ(s.code(), StatusCode::kInvalidData) << c.what;
+    EXPECT_EQ(s.message(), c.message) << c.what;
+  }
+}
+
+// Random corruptions of valid panoramas: the fast scan accepts exactly what
+// the node-by-node scan accepts.
+TEST(TwoLayerTest, FastScanAgreesWithNodeByNodeScan) {
+  std::mt19937 rng(7);
+  const float specials[] = {0.0f,
+                            -0.0f,
+                            1.0f,
+                            -1.0f,
+                            0.5f,
+                            1.0005f,
+                            0.9995f,
+                            1.002f,
+                            0.998f,
+                            std::numeric_limits<float>::infinity(),
+                            std::numeric_limits<float>::quiet_NaN(),
+                            std::numeric_limits<float>::denorm_min(),
+                            std::numeric_limits<float>::max()};
+  const TwoLayerPanorama bases[] = {testing::MakeRoomPanorama(64, 32), FullyLinked(),
+                                    FullyLinked(1, 3), FullyLinked(5, 1)};
+  int accepted = 0, rejected = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    TwoLayerPanorama p = bases[trial % 4];
+    const int edits = 1 + static_cast<int>(rng() % 3);
+    for (int e = 0; e < edits; ++e) {
+      LayerData& d = p.layer(static_cast<int>(rng() % 2));
+      const size_t i = rng() % d.present.size();
+      switch (rng() % 6) {
+        case 0:
+          d.present[i] = static_cast<uint8_t>(rng() % 3);
+          break;
+        case 1:
+          d.rgb[3 * i + rng() % 3] = static_cast<uint8_t>(rng() % 2);
+          break;
+        case 2:
+          d.depth_m[i] = specials[rng() % 13];
+          break;
+        case 3:
+          d.normal[3 * i + rng() % 3] = specials[rng() % 13];
+          break;
+        case 4:
+          d.label[i] = static_cast<uint8_t>(rng() % 3);
+          break;
+        default:
+          d.links[i] =
+              SetLink(d.links[i], static_cast<Direction>(rng() % 4), static_cast<Link>(rng() % 4));
+          break;
+      }
+    }
+    const bool fast = TwoLayerPanoramaTestAccess::FastScanAccepts(p);
+    const Status slow = TwoLayerPanoramaTestAccess::NodeByNodeScan(p);
+    ASSERT_EQ(fast, slow.ok()) << "trial " << trial << ": " << slow.ToString();
+    (fast ? accepted : rejected) += 1;
+  }
+  // Both outcomes are exercised.
+  EXPECT_GT(accepted, 300);
+  EXPECT_GT(rejected, 300);
 }
 
 TEST(TwoLayerTest, FrameMustBeARotation) {

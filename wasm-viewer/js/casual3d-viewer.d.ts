@@ -68,6 +68,8 @@ export interface ViewerStats {
   bytesBeforeFirstFrame?: number;
   loadMs?: number;
   lastError?: string;
+  /** Frames drawn in the current or last immersive VR session. */
+  xrFrames?: number;
 }
 
 export class Casual3dViewer extends EventTarget {
@@ -87,6 +89,10 @@ export class Casual3dViewer extends EventTarget {
   nextFrame(): Promise<void>;
   isVRSupported(): Promise<boolean>;
   enterVR(): Promise<void>;
+  /** Ends the immersive VR session, if any. */
+  exitVR(): Promise<void>;
+  /** Whether an immersive VR session is running. */
+  readonly inVR: boolean;
   /** Call from a user gesture; resolves false when unavailable or refused. */
   enableDeviceMotion(): Promise<boolean>;
   dispose(): void;

@@ -10,7 +10,7 @@
 //   'error'      {message, fatal}: fatal errors leave nothing to show; others
 //                keep the coarser level that is already on screen.
 
-import { Camera, clamp, lookAlong } from './camera.js';
+import { Camera, clamp, lookAlong, multiply } from './camera.js';
 import { Renderer, DEFAULT_EFFECTS } from './renderer.js';
 
 const DEG = Math.PI / 180;
@@ -134,39 +134,84 @@ export class Casual3dViewer extends EventTarget {
     }
   }
 
-  /** Starts an immersive VR session with per-eye stereo rendering. */
+  /**
+   * Starts an immersive VR session with per-eye stereo rendering; resolves once
+   * the session runs. Each eye is drawn with its own projection matrix and eye
+   * transform from the headset; the 'local' reference space (its origin where
+   * the head was when the session started) is placed at the capture centre,
+   * turned so that the headset starts looking where the viewer looked, and the
+   * head is kept inside the ball of `maxOffset` metres where the 3D photo holds
+   * (both eyes move with it, keeping their baseline).
+   */
   async enterVR() {
+    if (this._xrSession) return;
     if (!(await this.isVRSupported())) throw new Error('immersive VR is not available on this device');
     const session = await navigator.xr.requestSession('immersive-vr', { optionalFeatures: ['local'] });
-    const gl = this.renderer.gl;
-    await gl.makeXRCompatible();
-    session.updateRenderState({ baseLayer: new XRWebGLLayer(session, gl) });
-    const space = await session.requestReferenceSpace('local');
+    let space;
+    try {
+      const gl = this.renderer.gl;
+      await gl.makeXRCompatible();
+      session.updateRenderState({
+        baseLayer: new XRWebGLLayer(session, gl),
+        depthNear: this.camera.near, depthFar: this.camera.far,
+      });
+      space = await session.requestReferenceSpace('local');
+    } catch (err) {
+      await session.end().catch(() => {});
+      throw err;
+    }
     this._xrSession = session;
+    this.stats.xrFrames = 0;
+    // Panorama frame from the reference space: a turn about +Y by the viewer's yaw.
+    const yaw = this.camera.yawDeg * DEG;
+    const c = Math.cos(yaw), s = Math.sin(yaw);
+    const localFromWorld = new Float32Array([c, 0, -s, 0, 0, 1, 0, 0, s, 0, c, 0, 0, 0, 0, 1]);
+    const toWorld = (p) => [c * p.x - s * p.z, p.y, s * p.x + c * p.z];
     session.addEventListener('end', () => {
       this._xrSession = null;
       this._dirty = true;
+      cancelAnimationFrame(this._raf);
       this._raf = requestAnimationFrame((t) => this._tick(t));
     });
     const onFrame = (time, frame) => {
+      if (this._xrSession !== session) return;
       session.requestAnimationFrame(onFrame);
       const pose = frame.getViewerPose(space);
-      if (!pose) return;
       const layer = session.renderState.baseLayer;
+      if (!pose || !layer) return;
+      // Keep the head inside the parallax ball; the eyes follow it rigidly.
+      const head = toWorld(pose.transform.position);
+      const len = Math.hypot(...head);
+      const scale = len > this.camera.maxOffset ? this.camera.maxOffset / len : 1;
+      const shift = head.map((v) => v * scale - v);
+      const unshift = new Float32Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -shift[0], -shift[1], -shift[2], 1]);
+      const localFromPanorama = multiply(localFromWorld, unshift);
       pose.views.forEach((view, i) => {
         const vp = layer.getViewport(view);
-        // The 'local' reference space starts at the capture centre, so the
-        // headset's eye positions give real motion parallax and stereo.
-        const p = view.transform.position;
-        const eye = [p.x, p.y, p.z];
+        if (!vp) return;
+        const eye = toWorld(view.transform.position).map((v, k) => v + shift[k]);
         this.renderer.draw({
-          view: view.transform.inverse.matrix, projection: view.projectionMatrix, eye,
+          view: multiply(view.transform.inverse.matrix, localFromPanorama), projection: view.projectionMatrix, eye,
           effects: this.effects, timeSec: this._effectsSeconds(),
           viewport: [vp.x, vp.y, vp.width, vp.height], framebuffer: layer.framebuffer, clear: i === 0,
         });
       });
+      this.stats.xrFrames += 1;
+      const waiters = this._frameWaiters;
+      this._frameWaiters = [];
+      for (const w of waiters) w();
     };
     session.requestAnimationFrame(onFrame);
+  }
+
+  /** Ends the immersive VR session, if any; the page's canvas is drawn again. */
+  async exitVR() {
+    if (this._xrSession) await this._xrSession.end();
+  }
+
+  /** Whether an immersive VR session is running. */
+  get inVR() {
+    return this._xrSession !== null;
   }
 
   /** Stops loading and rendering and releases GPU resources. */
