@@ -1,5 +1,6 @@
 // `casual3d evaluate <capture> <3d-photo> [more 3d photos] [-o report.html]
-// [--json out.json] [--width 900] [--photos names...] [--holdout-every N]`:
+// [--json out.json] [--width 900] [--photos names...] [--holdout-every N]
+// [--labels names...] [--reference NAME:PSNR:SSIM]`:
 // virtual rephotography (paper Sec. 6.3) of one or more 3D photos of the same
 // capture, with a self-contained HTML report and a JSON summary.
 
@@ -24,6 +25,8 @@ void AddEvaluateCommand(CLI::App& app) {
     std::string json;
     eval::EvaluateOptions options;
     eval::ReportOptions report;
+    std::vector<std::string> labels;
+    std::vector<std::string> references;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -55,28 +58,63 @@ void AddEvaluateCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--threads", args->options.num_threads, "Worker threads; 0 = all cores")
       ->capture_default_str();
+  cmd->add_option("--labels", args->labels,
+                  "Names of the 3D photos in the report, one per 3D photo (default: their paths)");
+  cmd->add_option("--reference", args->references,
+                  "Published result on the same protocol shown in the report, NAME:PSNR_DB:SSIM "
+                  "(repeatable; e.g. LLFF:23.22:0.753)");
+  cmd->add_option("--title", args->report.title, "Title of the HTML report")->capture_default_str();
   cmd->callback([args] {
     if (const std::string why = args->options.Check(); !why.empty())
+      throw std::invalid_argument("evaluate: --" + why);
+    if (!args->labels.empty() && args->labels.size() != args->photo3d.size())
+      throw std::invalid_argument("--labels: " + std::to_string(args->labels.size()) +
+                                  " names for " + std::to_string(args->photo3d.size()) +
+                                  " 3D photos (give one per 3D photo)");
+    for (const std::string& r : args->references) {
+      const size_t a = r.find(':'), b = r.find(':', a == std::string::npos ? a : a + 1);
+      eval::ReferenceResult ref;
+      try {
+        if (a == std::string::npos || b == std::string::npos) throw std::invalid_argument(r);
+        ref.label = r.substr(0, a);
+        size_t used = 0;
+        ref.psnr_db = std::stod(r.substr(a + 1, b - a - 1), &used);
+        if (used != b - a - 1) throw std::invalid_argument(r);
+        ref.ssim = std::stod(r.substr(b + 1), &used);
+        if (used != r.size() - b - 1) throw std::invalid_argument(r);
+      } catch (const std::exception&) {
+        throw std::invalid_argument("--reference " + r + ": expected NAME:PSNR_DB:SSIM");
+      }
+      args->report.references.push_back(ref);
+    }
+    if (const std::string why = args->report.Check(); !why.empty())
       throw std::invalid_argument("evaluate: --" + why);
     const std::filesystem::path html(args->html);
     if (!html.parent_path().empty() && !std::filesystem::is_directory(html.parent_path()))
       throw std::runtime_error(args->html + ": the folder " + html.parent_path().string() +
                                " does not exist (create it or choose another -o)");
     std::vector<eval::PhotoModelEvaluation> evals;
-    for (const std::string& p : args->photo3d) {
+    for (size_t k = 0; k < args->photo3d.size(); ++k) {
+      const std::string& p = args->photo3d[k];
       evals.push_back(eval::EvaluatePhoto3d(args->capture, p, args->options));
-      const eval::PhotoModelEvaluation& e = evals.back();
-      std::printf("%s: %zu photos, error %.4f, completeness %.3f, PSNR %.2f dB, SSIM %.3f",
-                  p.c_str(), e.photos.size(), e.mean_error, e.mean_completeness, e.mean_psnr_db,
-                  e.mean_ssim);
+      eval::PhotoModelEvaluation& e = evals.back();
+      if (!args->labels.empty()) e.label = args->labels[k];
+      std::printf(
+          "%s: %zu photos, error %.4f, completeness %.3f, PSNR %.2f dB, SSIM %.3f (whole frame "
+          "%.2f dB, %.3f)",
+          e.label.c_str(), e.photos.size(), e.mean_error, e.mean_completeness, e.mean_psnr_db,
+          e.mean_ssim, e.mean_psnr_filled_db, e.mean_ssim_filled);
       if (e.has_depth)
         std::printf(", depth median rel. error %.4f, within 3%% %.3f", e.mean_depth_median_rel,
                     e.mean_depth_within);
       std::printf("\n");
       for (const eval::PhotoEvaluation& q : e.photos)
-        std::printf("  %-24s error %.4f completeness %.3f PSNR %6.2f SSIM %.3f%s\n", q.name.c_str(),
-                    q.metrics.error, q.metrics.completeness, q.metrics.psnr_db, q.metrics.ssim,
-                    q.held_out ? " (held out)" : "");
+        std::printf(
+            "  %-24s %dx%d error %.4f completeness %.3f PSNR %6.2f SSIM %.3f whole frame %6.2f "
+            "%.3f%s\n",
+            q.name.c_str(), q.metrics.width, q.metrics.height, q.metrics.error,
+            q.metrics.completeness, q.metrics.psnr_db, q.metrics.ssim, q.metrics.psnr_filled_db,
+            q.metrics.ssim_filled, q.held_out ? " (held out)" : "");
     }
     io::WriteFileAtomic(args->html, eval::RenderHtmlReport(args->capture, evals, args->report));
     std::printf("report: %s\n", args->html.c_str());

@@ -204,7 +204,43 @@ fs::path FindReferencePhoto(const fs::path& model_dir, const fs::path& capture,
                            (capture / "images").string() + " or " + capture.string());
 }
 
-DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r, double tolerance) {
+// Scale from the 3D photo's model units to the capture's ground-truth units:
+// the ratio of the spreads (RMS distance from their mean) of the camera
+// centres of the photos both models hold. 1 when the 3D photo uses the
+// capture's own model, or when fewer than two photos are shared. A fresh
+// structure-from-motion model has an arbitrary scale, so its depths are only
+// comparable with the ground truth after this.
+double ModelToCaptureScale(const geometry::SparseModel& model, const fs::path& model_dir,
+                           const fs::path& capture) {
+  std::error_code ec;
+  fs::path truth_dir;
+  for (const fs::path& d : {capture / "sparse", capture / "sparse" / "0"})
+    if (fs::exists(d / "cameras.bin", ec) || fs::exists(d / "cameras.txt", ec)) truth_dir = d;
+  if (truth_dir.empty() || fs::equivalent(truth_dir, model_dir, ec)) return 1.0;
+  const geometry::SparseModel truth = geometry::ReadModel(truth_dir.string());
+  std::map<std::string, Eigen::Vector3d> truth_centres;
+  for (const auto& [id, image] : truth.images) truth_centres[image.name] = image.pose.Center();
+  std::vector<Eigen::Vector3d> a, b;
+  for (const auto& [id, image] : model.images) {
+    const auto it = truth_centres.find(image.name);
+    if (it == truth_centres.end()) continue;
+    a.push_back(image.pose.Center());
+    b.push_back(it->second);
+  }
+  if (a.size() < 2) return 1.0;
+  const auto spread = [](const std::vector<Eigen::Vector3d>& v) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& c : v) mean += c / static_cast<double>(v.size());
+    double sum = 0;
+    for (const auto& c : v) sum += (c - mean).squaredNorm();
+    return std::sqrt(sum / v.size());
+  };
+  const double sa = spread(a), sb = spread(b);
+  return sa > 0 && sb > 0 ? sb / sa : 1.0;
+}
+
+DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r, double tolerance,
+                             double scale) {
   DepthComparison d;
   const int w = r.depth.width(), h = r.depth.height();
   std::vector<float> rel;
@@ -217,7 +253,7 @@ DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r,
       const int tx = std::min(truth.width() - 1, int((x + 0.5) * truth.width() / w));
       const float t = truth.at(tx, ty);
       if (!std::isfinite(t) || t <= 0) continue;
-      const float e = std::abs(r.depth.at(x, y) - t) / t;
+      const float e = std::abs(static_cast<float>(scale * r.depth.at(x, y)) - t) / t;
       rel.push_back(e);
       within += e <= tolerance;
     }
@@ -274,6 +310,11 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     throw std::runtime_error(model_dir.string() + ": the model has no registered photos");
   const std::vector<int> selected =
       SelectPhotos(names, options.photos, options.holdout_every, eval.holdout);
+  double depth_scale = 1.0;
+  if (fs::is_directory(capture / "depth", ec)) {
+    depth_scale = ModelToCaptureScale(model, model_dir, capture);
+    eval.depth_scale = depth_scale;
+  }
 
   const auto mesh_start = std::chrono::steady_clock::now();
   auto mesh = BuildMesh(photo3d.pano);
@@ -329,8 +370,8 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
                                        options.keep_images ? &error_map : nullptr);
     const fs::path truth = capture / "depth" / (fs::path(name).stem().string() + ".exr");
     if (fs::is_regular_file(truth, ec))
-      pe.depth =
-          CompareDepth(io::ReadExrChannels(truth.string(), {"Z"}), r, options.depth_tolerance);
+      pe.depth = CompareDepth(io::ReadExrChannels(truth.string(), {"Z"}), r,
+                              options.depth_tolerance, depth_scale);
     if (options.keep_images) {
       pe.photo = std::move(photo);
       pe.render = std::move(r.color);
@@ -351,6 +392,8 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     eval.mean_completeness += pe.metrics.completeness / n;
     eval.mean_psnr_db += pe.metrics.psnr_db / n;
     eval.mean_ssim += pe.metrics.ssim / n;
+    eval.mean_psnr_filled_db += pe.metrics.psnr_filled_db / n;
+    eval.mean_ssim_filled += pe.metrics.ssim_filled / n;
     if (pe.depth.available && pe.depth.pixels > 0) {
       ++depth_n;
       eval.mean_depth_median_rel += pe.depth.median_relative_error;

@@ -57,7 +57,10 @@ struct EvaluateOptions {
 
 // Depth of the rephotograph against a synthetic capture's ground truth
 // (CAPTURE/depth/<stem>.exr, camera-frame z): over pixels that are covered
-// and have a finite ground-truth depth.
+// and have a finite ground-truth depth. When the 3D photo was reconstructed
+// with its own camera model (arbitrary scale), its depth is first scaled by
+// the ratio of the spreads of the camera centres in CAPTURE/sparse and in
+// that model (PhotoModelEvaluation::depth_scale).
 struct DepthComparison {
   bool available = false;
   int64_t pixels = 0;
@@ -79,7 +82,7 @@ struct PhotoEvaluation {
 };
 
 struct PhotoModelEvaluation {
-  std::string label;       // The 3D photo's path as given.
+  std::string label;       // The 3D photo's path as given (or a caller's name for it).
   std::string source;      // What was read: "master.exr" path or package path.
   std::string poses_from;  // The sparse model folder used.
   int pano_width = 0, pano_height = 0;
@@ -91,8 +94,13 @@ struct PhotoModelEvaluation {
   std::vector<std::string> holdout;  // Held-out names listed by the 3D photo.
   // Means over the evaluated photos.
   double mean_error = 0, mean_completeness = 0, mean_psnr_db = 0, mean_ssim = 0;
+  double mean_psnr_filled_db = 0, mean_ssim_filled = 0;  // Whole frame, holes filled.
   double mean_depth_median_rel = 0, mean_depth_within = 0;
   bool has_depth = false;
+  // Factor applied to the rendered depth before the ground-truth comparison:
+  // the 3D photo's model units to the capture's (camera-centre spread ratio
+  // when the poses come from the 3D photo's own model), else 1.
+  double depth_scale = 1.0;
   std::vector<int64_t> error_histogram;  // Sum over photos.
   int64_t total_pixels = 0;              // Sum of photo sizes.
 };

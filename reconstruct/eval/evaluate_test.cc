@@ -10,6 +10,7 @@
 #include "encoder/master_file.h"
 #include "encoder/package_writer.h"
 #include "reconstruct/eval/report.h"
+#include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/pipeline/panorama_stage.h"
 #include "reconstruct/synth/synth.h"
 
@@ -112,6 +113,37 @@ TEST_F(EvaluateSyntheticTest, RephotographsMatchThePhotosAndTheGroundTruthDepth)
 
   const std::string html = RenderHtmlReport(dir_.string(), {e});
   EXPECT_NE(html.find("<td class=\"l\">0007.jpg</td>"), std::string::npos);
+}
+
+// A 3D photo reconstructed with its own model has that model's scale: here
+// the whole world (poses, panorama frame and depths) is 2.5 times larger than
+// the capture's, and the depth comparison must undo it.
+TEST_F(EvaluateSyntheticTest, DepthOfAModelAtAnotherScaleIsComparedAfterScaling) {
+  constexpr double kScale = 2.5;
+  const fs::path root = dir_ / "scaled";
+  fs::create_directories(root / "work" / "sparse" / "sparse");
+  geometry::SparseModel model = geometry::ReadModel((dir_ / "sparse").string());
+  for (auto& [id, image] : model.images) image.pose.translation *= kScale;
+  for (auto& [id, point] : model.points) point.xyz *= kScale;
+  geometry::WriteModelBinary(model, (root / "work" / "sparse" / "sparse").string());
+  auto pano = encoder::ReadMasterFile((dir_ / "photo3d" / "master.exr").string());
+  ASSERT_TRUE(pano.ok()) << pano.status().ToString();
+  for (int l = 0; l < kNumLayers; ++l)
+    for (float& d : pano->layer(l).depth_m) d *= static_cast<float>(kScale);
+  for (double& c : pano->frame().centre) c *= kScale;
+  ASSERT_TRUE(encoder::WriteMasterFile(*pano, (root / "master.exr").string()).ok());
+
+  EvaluateOptions options;
+  options.width = 160;
+  options.photos = {"0", "5"};
+  const PhotoModelEvaluation e = EvaluatePhoto3d(dir_.string(), root.string(), options);
+  EXPECT_NEAR(e.depth_scale, 1.0 / kScale, 1e-6);
+  ASSERT_TRUE(e.has_depth);
+  for (const PhotoEvaluation& p : e.photos) {
+    EXPECT_GT(p.metrics.completeness, 0.95) << p.name;
+    EXPECT_LT(p.depth.median_relative_error, 0.01) << p.name;
+  }
+  fs::remove_all(root);
 }
 
 TEST_F(EvaluateSyntheticTest, ReadsSingleFilePackages) {

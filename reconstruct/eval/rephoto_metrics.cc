@@ -50,7 +50,8 @@ cv::Mat SsimMap(const cv::Mat& a8, const cv::Mat& b8) {
 
 RephotoMetrics ComputeRephotoMetrics(ImageView<const uint8_t> photo,
                                      ImageView<const uint8_t> render, ImageView<const uint8_t> mask,
-                                     const RephotoMetricOptions& options, ImageF* error_map) {
+                                     const RephotoMetricOptions& options, ImageF* error_map,
+                                     Image8* filled_out) {
   if (const std::string why = options.Check(); !why.empty())
     throw std::invalid_argument("rephotography metrics: " + why);
   if (photo.channels() != 3 || render.channels() != 3 || mask.channels() != 1)
@@ -124,6 +125,49 @@ RephotoMetrics ComputeRephotoMetrics(ImageView<const uint8_t> photo,
       if (mask.at(x, y)) sum_ssim += row[x] / 3.0;
   }
   m.ssim = sum_ssim / m.covered_pixels;
+
+  // Whole frame with the holes inpainted.
+  cv::Mat holes(h, w, CV_8U);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) holes.at<uint8_t>(y, x) = mask.at(x, y) ? 0 : 255;
+  cv::Mat filled = render_mat.clone();
+  if (m.covered_pixels < total) {
+    // Each hole pixel takes the colour of the nearest covered pixel; labels
+    // number the covered (zero) pixels 1, 2, ... in row-major order.
+    cv::Mat distance, labels;
+    cv::distanceTransform(holes, distance, labels, cv::DIST_L2, cv::DIST_MASK_5,
+                          cv::DIST_LABEL_PIXEL);
+    std::vector<cv::Vec3b> colour_of(1);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        if (!holes.at<uint8_t>(y, x)) colour_of.push_back(render_mat.at<cv::Vec3b>(y, x));
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const int label = labels.at<int>(y, x);
+        if (holes.at<uint8_t>(y, x) && label > 0 && label < static_cast<int>(colour_of.size()))
+          filled.at<cv::Vec3b>(y, x) = colour_of[label];
+      }
+  }
+  double sum_sq_filled = 0;
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* a = photo_mat.ptr<uint8_t>(y);
+    const uint8_t* b = filled.ptr<uint8_t>(y);
+    for (int i = 0; i < 3 * w; ++i)
+      sum_sq_filled += double(int(a[i]) - int(b[i])) * (int(a[i]) - int(b[i]));
+  }
+  const double mse_filled = sum_sq_filled / (3.0 * total);
+  m.psnr_filled_db =
+      mse_filled > 0 ? std::min(options.psnr_cap_db, 10.0 * std::log10(255.0 * 255.0 / mse_filled))
+                     : options.psnr_cap_db;
+  std::vector<cv::Mat> fc;
+  cv::split(filled, fc);
+  cv::Mat ssim_filled = cv::Mat::zeros(h, w, CV_32F);
+  for (int c = 0; c < 3; ++c) ssim_filled += SsimMap(pc[c], fc[c]);
+  m.ssim_filled = cv::mean(ssim_filled)[0] / 3.0;
+  if (filled_out) {
+    *filled_out = Image8(w, h, 3);
+    filled.copyTo(io::ToMat(*filled_out));
+  }
   return m;
 }
 

@@ -20,6 +20,10 @@
 //    K1 = 0.01, K2 = 0.03 on 8-bit values), per channel, averaged over the
 //    channels and over the covered pixels. Windows straddling the coverage
 //    border see the render's background colour there.
+//  * Whole-frame PSNR and SSIM: the same over every pixel of the photo, with
+//    each uncovered pixel of the rendering filled with the colour of the
+//    nearest covered one, for a comparison with methods that render every
+//    pixel (LLFF, NeRF) that does not depend on a viewer's hole filling.
 
 #include <cstdint>
 #include <string>
@@ -49,6 +53,8 @@ struct RephotoMetrics {
   double error_plain = 0.0;    // Mean unshifted error over covered pixels, [0, 1].
   double psnr_db = 0.0;        // Over covered pixels; 0 when nothing is covered.
   double ssim = 0.0;           // Over covered pixels; 0 when nothing is covered.
+  double psnr_filled_db = 0.0; // Whole frame, holes filled; 0 when nothing is covered.
+  double ssim_filled = 0.0;    // Whole frame, holes filled; 0 when nothing is covered.
   // Histogram of the shiftable-window error of the covered pixels over [0, 1]
   // (histogram_bins bins): the error-versus-completeness curve (Fig. 13) is
   // built from it.
@@ -58,13 +64,14 @@ struct RephotoMetrics {
 // Compares `photo` (RGB, 3 channels) with `render` (RGB, same size) where
 // `mask` (1 channel, same size, non-zero = covered) says the rendering covers
 // the pixel. If `error_map` is not null it receives the per-pixel
-// shiftable-window error (width x height x 1; -1 where not covered). Throws
+// shiftable-window error (width x height x 1; -1 where not covered); if
+// `filled` is not null it receives the rendering with its holes filled. Throws
 // std::invalid_argument for mismatched sizes or channel counts, or invalid
 // options.
 RephotoMetrics ComputeRephotoMetrics(ImageView<const uint8_t> photo,
                                      ImageView<const uint8_t> render, ImageView<const uint8_t> mask,
                                      const RephotoMetricOptions& options = {},
-                                     ImageF* error_map = nullptr);
+                                     ImageF* error_map = nullptr, Image8* filled = nullptr);
 
 // The error-versus-completeness curve of one or more photos (paper Fig. 13):
 // keeping only pixels whose error is at most a threshold t, completeness(t) is

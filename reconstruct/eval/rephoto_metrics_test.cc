@@ -82,10 +82,20 @@ TEST(RephotoMetricsTest, CompletenessAndPsnrCountOnlyCoveredPixels) {
       for (int c = 0; c < 3; ++c) render.at(x, y, c) = 110;
     }
   ImageF error_map;
+  Image8 filled;
   const RephotoMetrics m =
       ComputeRephotoMetrics(std::as_const(photo).view(), std::as_const(render).view(),
-                            std::as_const(mask).view(), {}, &error_map);
+                            std::as_const(mask).view(), {}, &error_map, &filled);
   EXPECT_EQ(m.covered_pixels, w * h / 2);
+  // The whole-frame figures see the right half filled from the left one
+  // (110 everywhere), so the same 10-code offset over every pixel.
+  ASSERT_EQ(filled.width(), w);
+  EXPECT_EQ(filled.at(w - 1, h - 1, 0), 110);
+  EXPECT_EQ(filled.at(w - 1, 0, 2), 110);
+  EXPECT_NEAR(m.psnr_filled_db, 10 * std::log10(255.0 * 255.0 / 100.0), 1e-6);
+  // SSIM of two constant images 100 and 110: luminance term only.
+  const double c1 = (0.01 * 255) * (0.01 * 255);
+  EXPECT_NEAR(m.ssim_filled, (2 * 100 * 110 + c1) / (100 * 100 + 110 * 110 + c1), 1e-4);
   EXPECT_DOUBLE_EQ(m.completeness, 0.5);
   EXPECT_NEAR(m.error, 30.0 / 765.0, 1e-12);
   EXPECT_NEAR(m.psnr_db, 10 * std::log10(255.0 * 255.0 / 100.0), 1e-9);  // 28.13 dB.

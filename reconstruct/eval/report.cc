@@ -20,6 +20,10 @@ std::string ReportOptions::Check() const {
     return "thumbnail_width: " + std::to_string(thumbnail_width) + " is outside [32, 2048]";
   if (!(heatmap_max_error > 0 && heatmap_max_error <= 1))
     return "heatmap_max_error: " + std::to_string(heatmap_max_error) + " is outside (0, 1]";
+  for (const ReferenceResult& r : references)
+    if (r.label.empty() || !(r.psnr_db > 0 && r.psnr_db < 1000) || !(r.ssim >= -1 && r.ssim <= 1))
+      return "references: '" + r.label +
+             "' needs a name, a PSNR in (0, 1000) dB and an SSIM in [-1, 1]";
   return {};
 }
 
@@ -57,7 +61,6 @@ void HeatmapColor(float error, double max_error, uint8_t rgb[3]) {
 }
 
 namespace {
-
 
 std::string Fmt(const char* format, double v) {
   char buf[64];
@@ -155,27 +158,55 @@ std::string RenderHtmlReport(const std::string& capture,
        "svg text{font-size:12px;font-family:system-ui,sans-serif}\n"
        ".photo{border-top:1px solid #ddd;padding-top:6px}\n"
        "</style></head><body>\n";
-  s << "<h1>" << util::HtmlEscape(options.title) << "</h1>\n<p>Capture: <code>" << util::HtmlEscape(capture)
+  s << "<h1>" << util::HtmlEscape(options.title) << "</h1>\n<p>Capture: <code>"
+    << util::HtmlEscape(capture)
     << "</code>. Virtual rephotography (Hedman et al. 2017, Sec. 6.3; Waechter et al. 2017): each "
        "photo is re-rendered from the 3D photo at its exact pose and compared with it. Error: per "
        "pixel, the minimum sum of absolute RGB differences within a shiftable window of &plusmn;2 "
        "pixels, divided by 3&times;255, averaged over covered pixels. Completeness: fraction of "
        "the "
-       "photo covered. PSNR and SSIM over covered pixels.</p>\n";
+       "photo covered. PSNR and SSIM over covered pixels; &ldquo;whole frame&rdquo;: over every "
+       "pixel, each uncovered one filled with the colour of the nearest covered one (comparable "
+       "with methods that render every pixel).</p>\n";
 
-  if (evals.size() > 1) {
-    s << "<h2>Ablation comparison</h2>\n<table><tr><th class=\"l\">3D photo</th><th>photos</th>"
-         "<th>error</th><th>completeness</th><th>PSNR (dB)</th><th>SSIM</th><th>depth median rel. "
-         "err.</th>"
-         "<th>depth within 3%</th><th>triangles</th></tr>\n";
+  if (evals.size() > 1 || !options.references.empty()) {
+    // Stages recorded by any of the 3D photos, in order of first appearance.
+    std::vector<std::string> stages;
+    for (const auto& e : evals)
+      for (const auto& [stage, sec] : e.stage_seconds)
+        if (std::find(stages.begin(), stages.end(), stage) == stages.end()) stages.push_back(stage);
+    s << "<h2>" << (evals.size() > 1 ? "Ablation comparison" : "Comparison with published results")
+      << "</h2>\n<table><tr><th class=\"l\">3D photo</th><th>photos</th>"
+         "<th>error</th><th>completeness</th><th>PSNR (dB)</th><th>SSIM</th><th>PSNR whole "
+         "frame</th><th>SSIM whole frame</th><th>depth median rel. err.</th>"
+         "<th>depth within 3%</th><th>triangles</th><th>package (MiB)</th>";
+    for (const std::string& stage : stages) s << "<th>" << util::HtmlEscape(stage) << " (s)</th>";
+    s << "</tr>\n";
     for (const auto& e : evals) {
       s << "<tr><td class=\"l\">" << util::HtmlEscape(e.label) << "</td><td>" << e.photos.size()
         << "</td><td>" << Fmt("%.4f", e.mean_error) << "</td><td>"
         << Fmt("%.3f", e.mean_completeness) << "</td><td>" << Fmt("%.2f", e.mean_psnr_db)
         << "</td><td>" << Fmt("%.3f", e.mean_ssim) << "</td><td>"
-        << (e.has_depth ? Fmt("%.4f", e.mean_depth_median_rel) : "&ndash;") << "</td><td>"
-        << (e.has_depth ? Fmt("%.3f", e.mean_depth_within) : "&ndash;") << "</td><td>"
-        << e.mesh_triangles << "</td></tr>\n";
+        << Fmt("%.2f", e.mean_psnr_filled_db) << "</td><td>" << Fmt("%.3f", e.mean_ssim_filled)
+        << "</td><td>" << (e.has_depth ? Fmt("%.4f", e.mean_depth_median_rel) : "&ndash;")
+        << "</td><td>" << (e.has_depth ? Fmt("%.3f", e.mean_depth_within) : "&ndash;")
+        << "</td><td>" << e.mesh_triangles << "</td><td>"
+        << (e.package_bytes ? Fmt("%.2f", e.package_bytes / 1048576.0) : "&ndash;") << "</td>";
+      for (const std::string& stage : stages) {
+        const auto it = std::find_if(e.stage_seconds.begin(), e.stage_seconds.end(),
+                                     [&](const auto& p) { return p.first == stage; });
+        s << "<td>" << (it == e.stage_seconds.end() ? "&ndash;" : Fmt("%.1f", it->second))
+          << "</td>";
+      }
+      s << "</tr>\n";
+    }
+    for (const ReferenceResult& r : options.references) {
+      s << "<tr><td class=\"l\"><i>" << util::HtmlEscape(r.label)
+        << "</i> (published)</td><td>&ndash;</td><td>&ndash;</td><td>&ndash;</td><td>&ndash;</td>"
+           "<td>&ndash;</td><td>"
+        << Fmt("%.2f", r.psnr_db) << "</td><td>" << Fmt("%.3f", r.ssim) << "</td>";
+      for (size_t k = 0; k < 4 + stages.size(); ++k) s << "<td>&ndash;</td>";
+      s << "</tr>\n";
     }
     s << "</table>\n";
   }
@@ -186,26 +217,30 @@ std::string RenderHtmlReport(const std::string& capture,
     << ErrorCompletenessSvg(evals) << "\n";
 
   for (const auto& e : evals) {
-    s << "<h2>" << util::HtmlEscape(e.label) << "</h2>\n<p>Read from <code>" << util::HtmlEscape(e.source)
-      << "</code>; poses from <code>" << util::HtmlEscape(e.poses_from) << "</code>. Panorama "
-      << e.pano_width << "&times;" << e.pano_height << ", mesh of " << e.mesh_triangles
-      << " triangles";
+    s << "<h2>" << util::HtmlEscape(e.label) << "</h2>\n<p>Read from <code>"
+      << util::HtmlEscape(e.source) << "</code>; poses from <code>"
+      << util::HtmlEscape(e.poses_from) << "</code>. Panorama " << e.pano_width << "&times;"
+      << e.pano_height << ", mesh of " << e.mesh_triangles << " triangles";
     if (e.package_bytes) s << ", package " << Fmt("%.2f", e.package_bytes / 1048576.0) << " MiB";
     s << ". Mean over " << e.photos.size() << " photos: error " << Fmt("%.4f", e.mean_error)
       << ", completeness " << Fmt("%.3f", e.mean_completeness) << ", PSNR "
-      << Fmt("%.2f", e.mean_psnr_db) << " dB, SSIM " << Fmt("%.3f", e.mean_ssim) << ".</p>\n";
+      << Fmt("%.2f", e.mean_psnr_db) << " dB, SSIM " << Fmt("%.3f", e.mean_ssim)
+      << "; whole frame PSNR " << Fmt("%.2f", e.mean_psnr_filled_db) << " dB, SSIM "
+      << Fmt("%.3f", e.mean_ssim_filled) << ".</p>\n";
     s << "<table><tr><th class=\"l\">photo</th><th>index</th><th>held "
          "out</th><th>size</th><th>error</th>"
-         "<th>plain error</th><th>completeness</th><th>PSNR (dB)</th><th>SSIM</th>";
+         "<th>plain error</th><th>completeness</th><th>PSNR (dB)</th><th>SSIM</th>"
+         "<th>PSNR whole frame</th><th>SSIM whole frame</th>";
     if (e.has_depth) s << "<th>depth median rel. err.</th><th>depth within 3%</th>";
     s << "<th>render (s)</th></tr>\n";
     for (const auto& p : e.photos) {
       const RephotoMetrics& m = p.metrics;
-      s << "<tr><td class=\"l\">" << util::HtmlEscape(p.name) << "</td><td>" << p.index << "</td><td>"
-        << (p.held_out ? "yes" : "no") << "</td><td>" << m.width << "&times;" << m.height
-        << "</td><td>" << Fmt("%.4f", m.error) << "</td><td>" << Fmt("%.4f", m.error_plain)
-        << "</td><td>" << Fmt("%.3f", m.completeness) << "</td><td>" << Fmt("%.2f", m.psnr_db)
-        << "</td><td>" << Fmt("%.3f", m.ssim) << "</td>";
+      s << "<tr><td class=\"l\">" << util::HtmlEscape(p.name) << "</td><td>" << p.index
+        << "</td><td>" << (p.held_out ? "yes" : "no") << "</td><td>" << m.width << "&times;"
+        << m.height << "</td><td>" << Fmt("%.4f", m.error) << "</td><td>"
+        << Fmt("%.4f", m.error_plain) << "</td><td>" << Fmt("%.3f", m.completeness) << "</td><td>"
+        << Fmt("%.2f", m.psnr_db) << "</td><td>" << Fmt("%.3f", m.ssim) << "</td><td>"
+        << Fmt("%.2f", m.psnr_filled_db) << "</td><td>" << Fmt("%.3f", m.ssim_filled) << "</td>";
       if (e.has_depth)
         s << "<td>" << (p.depth.pixels ? Fmt("%.4f", p.depth.median_relative_error) : "&ndash;")
           << "</td><td>" << (p.depth.pixels ? Fmt("%.3f", p.depth.within_tolerance) : "&ndash;")
@@ -265,8 +300,11 @@ std::string RenderJsonReport(const std::string& capture,
     m["mean"] = {{"error", e.mean_error},
                  {"completeness", e.mean_completeness},
                  {"psnr_db", e.mean_psnr_db},
-                 {"ssim", e.mean_ssim}};
+                 {"ssim", e.mean_ssim},
+                 {"psnr_filled_db", e.mean_psnr_filled_db},
+                 {"ssim_filled", e.mean_ssim_filled}};
     if (e.has_depth) {
+      m["depth_scale"] = e.depth_scale;
       m["mean"]["depth_median_relative_error"] = e.mean_depth_median_rel;
       m["mean"]["depth_within_tolerance"] = e.mean_depth_within;
     }
@@ -286,6 +324,8 @@ std::string RenderJsonReport(const std::string& capture,
                           {"error_plain", p.metrics.error_plain},
                           {"psnr_db", p.metrics.psnr_db},
                           {"ssim", p.metrics.ssim},
+                          {"psnr_filled_db", p.metrics.psnr_filled_db},
+                          {"ssim_filled", p.metrics.ssim_filled},
                           {"seconds_render", p.seconds_render}};
       if (p.depth.available)
         q["depth"] = {{"pixels", p.depth.pixels},

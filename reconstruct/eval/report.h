@@ -9,7 +9,8 @@
 // synthetic captures, depth error against the ground truth), the error
 // versus completeness plot (paper Fig. 13: one curve per 3D photo), per-photo
 // thumbnails of photo, rendering and error heatmap, and the timings per stage;
-// with several 3D photos, an ablation table comparing their means side by side.
+// with several 3D photos (ablations) or reference results, a comparison table
+// of their means and stage timings side by side.
 
 #include <string>
 #include <vector>
@@ -18,6 +19,14 @@
 
 namespace casual3d::eval {
 
+// Published figures of another method on the same protocol, shown in the
+// comparison table (for example LLFF on fern: 23.22 dB, 0.753).
+struct ReferenceResult {
+  std::string label;
+  double psnr_db = 0.0;  // Whole-frame PSNR, dB.
+  double ssim = 0.0;
+};
+
 struct ReportOptions {
   // Width of the thumbnails embedded per photo, pixels; [32, 2048].
   int thumbnail_width = 300;
@@ -25,6 +34,7 @@ struct ReportOptions {
   // (0, 1].
   double heatmap_max_error = 0.25;
   std::string title = "casual3d rephotography report";
+  std::vector<ReferenceResult> references;  // Shown under the 3D photos' rows.
 
   std::string Check() const;  // Empty if valid, else "field: reason".
 };

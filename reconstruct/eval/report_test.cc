@@ -45,6 +45,8 @@ PhotoModelEvaluation MakeEvaluation(const std::string& label, double error) {
   e.mean_completeness = 700.0 / 768;
   e.mean_psnr_db = 27.5;
   e.mean_ssim = 0.8;
+  e.mean_psnr_filled_db = 21.25;
+  e.mean_ssim_filled = 0.625;
   e.has_depth = true;
   e.mean_depth_median_rel = 0.0123;
   e.mean_depth_within = 0.9;
@@ -54,7 +56,9 @@ PhotoModelEvaluation MakeEvaluation(const std::string& label, double error) {
 TEST(ReportTest, HtmlIsSelfContainedAndHoldsTheTables) {
   const std::vector<PhotoModelEvaluation> evals = {MakeEvaluation("full", 0.04),
                                                    MakeEvaluation("no-near-envelope", 0.07)};
-  const std::string html = RenderHtmlReport("captures/fern", evals);
+  ReportOptions options;
+  options.references = {{"LLFF", 23.22, 0.753}};
+  const std::string html = RenderHtmlReport("captures/fern", evals, options);
   // Nothing is fetched: no URL with a scheme, no external stylesheet or script.
   EXPECT_FALSE(std::regex_search(html, std::regex("https?:", std::regex::icase)));
   EXPECT_EQ(html.find("<link"), std::string::npos);
@@ -65,6 +69,13 @@ TEST(ReportTest, HtmlIsSelfContainedAndHoldsTheTables) {
   EXPECT_NE(html.find("Ablation comparison"), std::string::npos);
   EXPECT_NE(html.find("<td class=\"l\">no-near-envelope</td><td>2</td><td>0.0700</td>"),
             std::string::npos);
+  // Whole-frame figures and the stage timings side by side, then the
+  // published reference.
+  EXPECT_NE(html.find("<td>21.25</td><td>0.625</td>"), std::string::npos);
+  EXPECT_NE(html.find("<th>sparse (s)</th><th>dense (s)</th>"), std::string::npos);
+  EXPECT_NE(html.find("<td>12.5</td><td>40.2</td></tr>"), std::string::npos);
+  EXPECT_NE(html.find("<i>LLFF</i> (published)"), std::string::npos);
+  EXPECT_NE(html.find("<td>23.22</td><td>0.753</td>"), std::string::npos);
   EXPECT_NE(html.find("<svg"), std::string::npos);
   EXPECT_NE(html.find("<polyline"), std::string::npos);
   EXPECT_NE(html.find("0.0123"), std::string::npos);  // Depth error column.
@@ -93,6 +104,14 @@ TEST(ReportTest, JsonCarriesThePerPhotoFigures) {
   EXPECT_DOUBLE_EQ(photos[0]["psnr_db"].get<double>(), 27.5);
   EXPECT_DOUBLE_EQ(photos[0]["depth"]["median_relative_error"].get<double>(), 0.0123);
   EXPECT_EQ(j["options"]["width"], 900);
+  EXPECT_DOUBLE_EQ(j["photo3d"][0]["mean"]["psnr_filled_db"].get<double>(), 21.25);
+}
+
+TEST(ReportTest, RejectsAReferenceWithoutFigures) {
+  ReportOptions options;
+  options.references = {{"NeRF", 0.0, 0.792}};
+  EXPECT_THROW(RenderHtmlReport("c", {MakeEvaluation("full", 0.04)}, options),
+               std::invalid_argument);
 }
 
 TEST(ReportTest, Base64MatchesRfc4648Vectors) {

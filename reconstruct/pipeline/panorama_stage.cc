@@ -5,13 +5,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <stdexcept>
-
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "encoder/master_file.h"
 #include "reconstruct/depth/workspace.h"
 #include "reconstruct/geometry/colmap_model.h"
+#include "reconstruct/io/colour_map.h"
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/io/image_io.h"
@@ -26,18 +26,6 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
-}
-
-// Inverse depth as a colour ramp (near = warm, far = dark blue), for previews.
-void RampColour(double t, uint8_t out[3]) {
-  t = std::clamp(t, 0.0, 1.0);
-  // A perceptually ordered ramp: dark blue -> teal -> yellow -> red.
-  const double r = std::clamp(1.5 - std::abs(4.0 * t - 3.0), 0.0, 1.0);
-  const double g = std::clamp(1.5 - std::abs(4.0 * t - 2.0), 0.0, 1.0);
-  const double b = std::clamp(1.5 - std::abs(4.0 * t - 1.0), 0.0, 1.0);
-  out[0] = static_cast<uint8_t>(std::lround(255 * r));
-  out[1] = static_cast<uint8_t>(std::lround(255 * g));
-  out[2] = static_cast<uint8_t>(std::lround(255 * b));
 }
 
 void WritePreviews(const TwoLayerPanorama& pano, const std::string& dir) {
@@ -61,7 +49,7 @@ void WritePreviews(const TwoLayerPanorama& pano, const std::string& dir) {
         const size_t i = pano.index(x * step, y * step);
         if (!layer.present[i]) continue;
         for (int c = 0; c < 3; ++c) color.at(x, y, c) = layer.rgb[3 * i + c];
-        RampColour(near / layer.depth_m[i], &depth.at(x, y, 0));
+        io::DepthRampColour(near / layer.depth_m[i], &depth.at(x, y, 0));
       }
     }
     const std::string name = l == kFront ? "front" : "back";
@@ -90,6 +78,28 @@ void WritePreviews(const TwoLayerPanorama& pano, const std::string& dir) {
   io::WritePng(dir + "/labels.png", labels);
 }
 
+// The field of view in grey, the front layer's holes in it in red, the rest
+// black; at most 2048 wide (a pixel of the preview is red if any pixel it
+// stands for is a hole, so that small holes stay visible).
+void WriteHolesPreview(const Image8& fov, const Image8& holes, const std::string& path) {
+  const int W = fov.width(), H = fov.height();
+  const int step = std::max(1, W / 2048);
+  Image8 out(W / step, H / step, 3, 0);
+  for (int y = 0; y < out.height() * step; ++y) {
+    for (int x = 0; x < out.width() * step; ++x) {
+      uint8_t* p = &out.at(x / step, y / step, 0);
+      if (holes.at(x, y)) {
+        p[0] = 230;
+        p[1] = 30;
+        p[2] = 30;
+      } else if (fov.at(x, y) && p[1] == 0) {
+        p[0] = p[1] = p[2] = 110;
+      }
+    }
+  }
+  io::WritePng(path, out);
+}
+
 }  // namespace
 
 std::string PanoramaStageOptions::Check() const {
@@ -113,7 +123,8 @@ std::string PanoramaStageOptions::Check() const {
 
 PanoramaFrame LoadOrComputeFrame(const std::string& sparse_dir) {
   const fs::path root(sparse_dir);
-  if (fs::exists(root / "frame.json")) return sfm::ReadPanoramaFrame((root / "frame.json").string());
+  if (fs::exists(root / "frame.json"))
+    return sfm::ReadPanoramaFrame((root / "frame.json").string());
   if (fs::exists(root / "capture.json")) {
     const std::string path = (root / "capture.json").string();
     try {
@@ -154,6 +165,7 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
     geometry::Pose pose;
   };
   std::vector<Loaded> photos;
+  std::vector<CoverageView> coverage_views;
   {
     util::Progress progress("panorama: loading photos", static_cast<int64_t>(model.images.size()));
     for (const auto& [id, image] : model.images) {
@@ -170,6 +182,7 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
       }
       p.camera = cam->second;
       p.pose = image.pose;
+      coverage_views.push_back({p.camera, p.pose});
       p.rgb = io::ReadImage((fs::path(sparse_dir) / "images" / image.name).string());
       const std::string depth_path =
           (fs::path(depth_dir) / "depth" / (depth::OutputStem(image.name) + ".exr")).string();
@@ -254,21 +267,33 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   t = Clock::now();
   fuse::FuseOptions fuse_options = options.fuse;
   if (!options.back_layer) fuse_options.expansion_fraction = 0;
-  TwoLayerPanorama pano =
-      fuse::Fuse({&front.rgb, &front.depth_m, &back.rgb, &back.depth_m, frame}, fuse_options,
-                 &report.fuse);
+  TwoLayerPanorama pano = fuse::Fuse({&front.rgb, &front.depth_m, &back.rgb, &back.depth_m, frame},
+                                     fuse_options, &report.fuse);
   report.seconds_fuse = Seconds(t);
   t = Clock::now();
   report.normals = normals::ComputeNormals(&pano, options.normals);
   report.seconds_normals = Seconds(t);
-  report.front_coverage = static_cast<double>(report.fuse.front_nodes) / (static_cast<double>(W) * H);
+  report.front_coverage =
+      static_cast<double>(report.fuse.front_nodes) / (static_cast<double>(W) * H);
+  Image8 fov, holes;
+  report.front_fov =
+      MeasureCoverage(pano, kFront, coverage_views, options.num_threads, &fov, &holes);
+  util::LogInfo("panorama: front layer covers " +
+                std::to_string(100.0 * report.front_fov.covered_fraction) +
+                "% of the photos' field of view; " + std::to_string(report.front_fov.num_holes) +
+                " holes, the largest " +
+                std::to_string(100.0 * report.front_fov.largest_hole_fraction) + "% of it");
 
   // Write.
   t = Clock::now();
   io::CreateDirectories(out_dir);
-  const Status written = encoder::WriteMasterFile(pano, (fs::path(out_dir) / "master.exr").string());
+  const Status written =
+      encoder::WriteMasterFile(pano, (fs::path(out_dir) / "master.exr").string());
   if (!written.ok()) throw std::runtime_error(written.ToString());
-  if (options.write_previews) WritePreviews(pano, (fs::path(out_dir) / "preview").string());
+  if (options.write_previews) {
+    WritePreviews(pano, (fs::path(out_dir) / "preview").string());
+    WriteHolesPreview(fov, holes, (fs::path(out_dir) / "preview" / "holes.png").string());
+  }
   report.seconds_write = Seconds(t);
   report.seconds_total = Seconds(start);
 
@@ -279,6 +304,17 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   j["back_layer"] = options.back_layer;
   j["sky_depth_m"] = report.sky_depth_m;
   j["front_coverage"] = report.front_coverage;
+  const CoverageStats& c = report.front_fov;
+  j["front_fov"] = {{"fov_pixels", c.fov_pixels},
+                    {"fov_steradians", c.fov_steradians},
+                    {"covered_fraction", c.covered_fraction},
+                    {"holes", c.num_holes},
+                    {"hole_pixels", c.hole_pixels},
+                    {"largest_hole_pixels", c.largest_hole_pixels},
+                    {"largest_hole_fraction", c.largest_hole_fraction},
+                    {"interior_holes", c.num_interior_holes},
+                    {"largest_interior_hole_fraction", c.largest_interior_hole_fraction},
+                    {"reference_depth_m", c.reference_depth_m}};
   j["fuse"] = {{"front_nodes", report.fuse.front_nodes},
                {"back_nodes_in", report.fuse.back_nodes_in},
                {"back_nodes_redundant", report.fuse.back_nodes_redundant},

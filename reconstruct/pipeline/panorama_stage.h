@@ -13,7 +13,8 @@
 //                               axis; +inf or NaN = sky/unknown)
 // Outputs (OUT/, files written atomically):
 //   master.exr                  the two-layer panorama (encoder/master_file.h)
-//   preview/{front,back}_{color,depth}.png, preview/normals.png, preview/labels.png
+//   preview/{front,back}_{color,depth}.png, preview/normals.png, preview/labels.png,
+//   preview/holes.png (field of view: grey; front-layer holes in it: red)
 //   panorama.json               timings, statistics, options
 
 #include <string>
@@ -22,6 +23,7 @@
 #include "format/two_layer.h"
 #include "reconstruct/fuse/fuse.h"
 #include "reconstruct/normals/normals.h"
+#include "reconstruct/pipeline/coverage.h"
 #include "reconstruct/stitch/stitch.h"
 #include "reconstruct/warp/warp.h"
 
@@ -55,6 +57,9 @@ struct PanoramaStageReport {
   fuse::FuseStats fuse;
   normals::NormalStats normals;
   double front_coverage = 0.0;  // Fraction of pixels with a front node.
+  // The front layer inside the photos' field of view: coverage and holes
+  // (coverage.h).
+  CoverageStats front_fov;
 };
 
 // Runs warp, stitch, fuse and normals; writes OUT (created if needed) and

@@ -77,6 +77,15 @@ void CheckAgainstGroundTruth(synth::RigKind rig, int photos, double min_within_3
               c.BackNearEdges(), c.back_edge_pixels, c.edge_pairs_linked, c.edge_pairs);
   EXPECT_GE(c.BackNearEdges(), min_back_near_edges);
   EXPECT_LE(c.LinksAcrossEdges(), 0.01);
+  // Issue 6: the front layer covers the photos' field of view with no hole
+  // larger than 1% of it (with exact depth maps nearly all of it is covered).
+  const CoverageStats& fov = report.front_fov;
+  std::printf("field of view %.3f sr: %.4f covered, %d holes, largest %.5f (interior %.5f)\n",
+              fov.fov_steradians, fov.covered_fraction, fov.num_holes, fov.largest_hole_fraction,
+              fov.largest_interior_hole_fraction);
+  EXPECT_GT(fov.fov_pixels, 0);
+  EXPECT_GE(fov.covered_fraction, 0.99);
+  EXPECT_LE(fov.largest_hole_fraction, 0.002);
   fs::remove_all(dir);
 }
 

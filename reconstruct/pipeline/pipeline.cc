@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
-
-#include <nlohmann/json.hpp>
 
 #include "encoder/master_file.h"
 #include "encoder/package_writer.h"
@@ -23,7 +22,8 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 // Bump when a stage's output format or algorithm changes, so old caches are stale.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-1", "dense-1", "panorama-1", "encode-1"};
+constexpr const char* kStageVersions[kNumStages] = {"sparse-1", "dense-1", "panorama-1",
+                                                    "encode-1"};
 
 std::string HashHex(const std::string& text) {
   return Sha256Hex(reinterpret_cast<const uint8_t*>(text.data()), text.size());
@@ -39,8 +39,8 @@ std::string InputFingerprint(const std::string& input) {
     if (!it->is_regular_file(ec)) continue;
     const auto size = it->file_size(ec);
     const auto mtime = it->last_write_time(ec).time_since_epoch().count();
-    rows.push_back(fs::relative(it->path(), input, ec).string() + " " + std::to_string(size) +
-                   " " + std::to_string(mtime));
+    rows.push_back(fs::relative(it->path(), input, ec).string() + " " + std::to_string(size) + " " +
+                   std::to_string(mtime));
   }
   if (ec) throw std::runtime_error(input + ": cannot list the input folder (" + ec.message() + ")");
   std::sort(rows.begin(), rows.end());
@@ -102,7 +102,9 @@ void RunIntoFolder(const fs::path& dir, const fs::path& key_path, const std::str
   run(tmp);
   fs::remove_all(dir, ec);
   fs::rename(tmp, dir, ec);
-  if (ec) throw std::runtime_error(dir.string() + ": cannot move the stage output in place (" + ec.message() + ")");
+  if (ec)
+    throw std::runtime_error(dir.string() + ": cannot move the stage output in place (" +
+                             ec.message() + ")");
   io::WriteFileAtomic(key_path.string(), key);
 }
 
@@ -110,10 +112,14 @@ void RunIntoFolder(const fs::path& dir, const fs::path& key_path, const std::str
 
 const char* StageName(Stage stage) {
   switch (stage) {
-    case Stage::kSparse: return "sparse";
-    case Stage::kDense: return "dense";
-    case Stage::kPanorama: return "panorama";
-    case Stage::kEncode: return "encode";
+    case Stage::kSparse:
+      return "sparse";
+    case Stage::kDense:
+      return "dense";
+    case Stage::kPanorama:
+      return "panorama";
+    case Stage::kEncode:
+      return "encode";
   }
   return "?";
 }
@@ -159,18 +165,23 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
   const fs::path root(out);
   const fs::path work = root / "work";
   fs::create_directories(work, ec);
-  if (ec) throw std::runtime_error(out + ": cannot create the output folder (" + ec.message() + ")");
+  if (ec)
+    throw std::runtime_error(out + ": cannot create the output folder (" + ec.message() + ")");
 
-  const fs::path dirs[kNumStages] = {work / "sparse", work / "dense", work / "panorama", root / "web"};
+  const fs::path dirs[kNumStages] = {work / "sparse", work / "dense", work / "panorama",
+                                     root / "web"};
   fs::path key_paths[kNumStages];
   std::string keys[kNumStages];
   for (int s = 0; s < kNumStages; ++s) {
     key_paths[s] = work / (std::string(StageName(static_cast<Stage>(s))) + ".key");
   }
-  keys[0] = HashHex(std::string(kStageVersions[0]) + "\n" + fs::absolute(input).string() + "\n" +
+  // The canonical path, so that "a/../b" and "b" share the cache.
+  keys[0] = HashHex(std::string(kStageVersions[0]) + "\n" +
+                    fs::weakly_canonical(fs::absolute(input)).string() + "\n" +
                     InputFingerprint(input) + SparseOptionsText(options.sparse));
-  keys[1] = HashHex(std::string(kStageVersions[1]) + "\n" + keys[0] + "\n" + DenseOptionsText(options.dense) +
-                    (options.holdout_every > 0 ? "\nholdout " + std::to_string(options.holdout_every) : ""));
+  keys[1] = HashHex(
+      std::string(kStageVersions[1]) + "\n" + keys[0] + "\n" + DenseOptionsText(options.dense) +
+      (options.holdout_every > 0 ? "\nholdout " + std::to_string(options.holdout_every) : ""));
   // The dense and panorama stages read the training workspace (holdout.h)
   // when photos are held out, written once the sparse output exists.
   std::vector<std::string> holdout;
@@ -189,8 +200,30 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
   };
   keys[2] = HashHex(std::string(kStageVersions[2]) + "\n" + keys[1] + "\n" +
                     PanoramaOptionsText(options.panorama));
-  keys[3] = HashHex(std::string(kStageVersions[3]) + "\n" + keys[2] + "\n" +
-                    std::to_string(options.color_quality) + " " + std::to_string(options.tile_size));
+  keys[3] =
+      HashHex(std::string(kStageVersions[3]) + "\n" + keys[2] + "\n" +
+              std::to_string(options.color_quality) + " " + std::to_string(options.tile_size));
+
+  // The previous report.json, if any: cached stages keep the timings and
+  // results recorded when they ran (matched by their key).
+  nlohmann::json previous;
+  if (fs::exists(root / "report.json", ec)) {
+    try {
+      previous = nlohmann::json::parse(io::ReadFile((root / "report.json").string()));
+    } catch (const std::exception&) {
+      previous = nullptr;  // Unreadable: start afresh.
+    }
+  }
+  const auto previous_stage = [&](int s) -> nlohmann::json {
+    if (!previous.is_object() || !previous.contains("stages") || !previous["stages"].is_array())
+      return nullptr;
+    for (const auto& e : previous["stages"]) {
+      if (e.is_object() && e.value("stage", "") == StageName(static_cast<Stage>(s)) &&
+          e.value("key", "") == keys[s])
+        return e;
+    }
+    return nullptr;
+  };
 
   PipelineReport report;
   nlohmann::json stage_json = nlohmann::json::object();
@@ -242,12 +275,16 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
       case Stage::kPanorama: {
         RunIntoFolder(dirs[s], key_paths[s], keys[s], [&](const fs::path& tmp) {
           PanoramaStageReport r;
-          RunPanoramaStage(input_workspace().string(), dirs[1].string(), tmp.string(), options.panorama,
-                           &r);
-          stage_json["panorama"] = {{"width", r.width},
-                                    {"front_coverage", r.front_coverage},
-                                    {"back_nodes", r.fuse.back_nodes_in - r.fuse.back_nodes_redundant +
-                                                       r.fuse.back_nodes_hallucinated}};
+          RunPanoramaStage(input_workspace().string(), dirs[1].string(), tmp.string(),
+                           options.panorama, &r);
+          stage_json["panorama"] = {
+              {"width", r.width},
+              {"front_coverage", r.front_coverage},
+              {"fov_covered_fraction", r.front_fov.covered_fraction},
+              {"fov_holes", r.front_fov.num_holes},
+              {"fov_largest_hole_fraction", r.front_fov.largest_hole_fraction},
+              {"back_nodes", r.fuse.back_nodes_in - r.fuse.back_nodes_redundant +
+                                 r.fuse.back_nodes_hallucinated}};
         });
         break;
       }
@@ -294,8 +331,33 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
   nlohmann::json j;
   j["input"] = fs::absolute(input).string();
   j["seconds_total"] = report.seconds_total;
-  for (const StageRun& r : report.stages) {
-    j["stages"].push_back({{"stage", r.stage}, {"cached", r.cached}, {"ran", r.ran}, {"seconds", r.seconds}});
+  for (size_t s = 0; s < report.stages.size(); ++s) {
+    const StageRun& r = report.stages[s];
+    nlohmann::json e = {{"stage", r.stage},
+                        {"cached", r.cached},
+                        {"ran", r.ran},
+                        {"seconds", r.seconds},
+                        {"key", keys[s]}};
+    // A cached stage reports the time it took when it ran, and its results.
+    if (r.cached) {
+      const nlohmann::json old = previous_stage(static_cast<int>(s));
+      if (old.is_object() && old.contains("seconds") && old["seconds"].is_number()) {
+        e["seconds"] = old["seconds"];
+        if (previous.contains("results") && previous["results"].contains(r.stage) &&
+            !stage_json.contains(r.stage))
+          stage_json[r.stage] = previous["results"][r.stage];
+      }
+    }
+    j["stages"].push_back(e);
+  }
+  // Stages after --to keep their entries while their inputs are unchanged.
+  for (int s = static_cast<int>(report.stages.size()); s < kNumStages; ++s) {
+    const nlohmann::json old = previous_stage(s);
+    if (!old.is_object()) continue;
+    j["stages"].push_back(old);
+    const std::string name = StageName(static_cast<Stage>(s));
+    if (previous.contains("results") && previous["results"].contains(name))
+      stage_json[name] = previous["results"][name];
   }
   j["results"] = stage_json;
   if (options.holdout_every > 0 && fs::exists(dirs[0] / "sparse", ec)) {

@@ -12,7 +12,9 @@
 //   OUT/photo.c3d       the same package as one file
 //   OUT/master.exr      the lossless two-layer panorama (archival form)
 //   OUT/preview/        stitched colour, depth, normals and labels as PNG
-//   OUT/report.json     options, timings and statistics of every stage
+//   OUT/report.json     timings and statistics of every stage, with the key of
+//                       its cache; a cached stage keeps the figures of the run
+//                       that computed it
 //   OUT/work/{sparse,dense,panorama}/ and OUT/work/<stage>.key   stage caches
 
 #include <functional>

@@ -1,0 +1,71 @@
+#pragma once
+
+// How well a layer of the 3D photo covers what the photos saw: the photos'
+// field of view in the central panorama, and the holes of the front layer
+// inside it (issue 6: "no hole larger than 1% of the field of view").
+//
+// Field of view: panorama pixel p is inside when the 3D point along p's ray
+// at distance r(p) from the panorama centre projects inside at least one
+// photo (pinhole part of its camera, in front of it). r(p) is the layer's own
+// depth where the layer has a node, else the depth of the nearest node (in
+// the image plane), so that the field of view follows the photos' parallax;
+// `reference_depth_m` (the median depth of the layer's nodes by default)
+// only serves an empty layer.
+//
+// Holes: 4-connected components of pixels inside the field of view without a
+// node; columns wrap around at +-180 degrees. Areas are solid angles (an
+// equirectangular pixel at latitude lat covers cos(lat) times the solid angle
+// of an equatorial one), so that fractions do not depend on where the photos
+// look.
+
+#include <cstdint>
+#include <vector>
+
+#include "format/equirect.h"
+#include "format/image.h"
+#include "format/two_layer.h"
+#include "reconstruct/geometry/camera.h"
+#include "reconstruct/geometry/pose.h"
+
+namespace casual3d::pipeline {
+
+struct CoverageView {
+  geometry::Camera camera;  // Its pinhole part is used.
+  geometry::Pose pose;      // World to camera.
+};
+
+struct CoverageStats {
+  int64_t fov_pixels = 0;         // Panorama pixels inside the field of view.
+  double fov_steradians = 0.0;    // Their solid angle.
+  double covered_fraction = 0.0;  // Solid angle with a node / field of view, [0, 1].
+  int num_holes = 0;              // Components of uncovered pixels inside the field of view.
+  int64_t hole_pixels = 0;        // Pixels in all of them.
+  int64_t largest_hole_pixels = 0;
+  // Solid angle of the largest hole / field of view, [0, 1].
+  double largest_hole_fraction = 0.0;
+  // The same over holes that do not touch the border of the field of view
+  // (true holes, as opposed to ragged edges of the photos' footprints).
+  int num_interior_holes = 0;
+  double largest_interior_hole_fraction = 0.0;
+  double reference_depth_m = 0.0;  // Depth used where the layer has no node.
+};
+
+// The field-of-view mask (width x height x 1; 255 inside, 0 outside) of
+// `views` for `layer` of `pano`, as described above. `reference_depth_m` <= 0
+// means the median depth of the layer's nodes (1 m for an empty layer).
+// `num_threads`: 0 = all cores.
+Image8 FieldOfViewMask(const TwoLayerPanorama& pano, int layer,
+                       const std::vector<CoverageView>& views, double reference_depth_m = 0.0,
+                       int num_threads = 0, double* used_reference_depth_m = nullptr);
+
+// The holes of `layer` of `pano` inside `fov` (same size as the panorama).
+// If `holes` is not null it receives a mask (255 = hole pixel).
+CoverageStats MeasureHoles(const TwoLayerPanorama& pano, int layer, const Image8& fov,
+                           Image8* holes = nullptr);
+
+// FieldOfViewMask then MeasureHoles; fills reference_depth_m.
+CoverageStats MeasureCoverage(const TwoLayerPanorama& pano, int layer,
+                              const std::vector<CoverageView>& views, int num_threads = 0,
+                              Image8* fov = nullptr, Image8* holes = nullptr);
+
+}  // namespace casual3d::pipeline

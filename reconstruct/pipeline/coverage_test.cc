@@ -1,0 +1,160 @@
+#include "reconstruct/pipeline/coverage.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "reconstruct/warp/test_scene.h"
+
+namespace casual3d::pipeline {
+namespace {
+
+using warp::testing::ForwardPose;
+using warp::testing::MakeCamera;
+
+constexpr int kW = 720, kH = 360;  // Half a degree per pixel.
+
+// Pixel of the panorama at (lon, lat) in degrees.
+void PixelAt(double lon_deg, double lat_deg, int* x, int* y) {
+  *x = static_cast<int>(std::floor((lon_deg / 360.0 + 0.5) * kW));
+  *y = static_cast<int>(std::floor((0.5 - lat_deg / 180.0) * kH));
+}
+
+TwoLayerPanorama FullFront(float depth_m) {
+  TwoLayerPanorama pano(kW, kH);
+  LayerData& f = pano.layer(kFront);
+  for (size_t i = 0; i < f.present.size(); ++i) {
+    f.present[i] = 1;
+    f.depth_m[i] = depth_m;
+  }
+  return pano;
+}
+
+bool Inside(const Image8& mask, double lon_deg, double lat_deg) {
+  int x, y;
+  PixelAt(lon_deg, lat_deg, &x, &y);
+  return mask.at(x, y) != 0;
+}
+
+TEST(CoverageTest, FieldOfViewOfACentredCameraIsItsFrustum) {
+  const TwoLayerPanorama pano = FullFront(2.0f);
+  const std::vector<CoverageView> views = {{MakeCamera(400, 300, 90.0), ForwardPose({0, 0, 0})}};
+  const Image8 fov = FieldOfViewMask(pano, kFront, views);
+  EXPECT_TRUE(Inside(fov, 0, 0));
+  EXPECT_TRUE(Inside(fov, 43, 0));
+  EXPECT_FALSE(Inside(fov, 47, 0));
+  EXPECT_TRUE(Inside(fov, 0, 35));
+  EXPECT_FALSE(Inside(fov, 0, 38.5));
+  EXPECT_FALSE(Inside(fov, 180, 0));
+  const CoverageStats stats = MeasureHoles(pano, kFront, fov);
+  // Solid angle of a frustum with half-angles a, b: 4 asin(sin a sin b);
+  // here a = 45 degrees and tan b = 0.75.
+  const double expected = 4.0 * std::asin(std::sin(kPi / 4) * std::sin(std::atan(0.75)));
+  EXPECT_NEAR(stats.fov_steradians, expected, 0.01 * expected);
+  EXPECT_DOUBLE_EQ(stats.covered_fraction, 1.0);
+  EXPECT_EQ(stats.num_holes, 0);
+  EXPECT_EQ(stats.largest_hole_fraction, 0.0);
+}
+
+TEST(CoverageTest, FieldOfViewFollowsParallaxAtTheLayersDepth) {
+  // A camera 0.5 m right of the centre, looking forward with 45 degrees of
+  // horizontal field of view. At 1 m from the centre it sees longitudes 5 to
+  // 50 degrees (sin(lon) - 0.5 = +-tan(22.5 deg) cos(lon)); at 100 m about
+  // -22 to 23 degrees.
+  const std::vector<CoverageView> views = {{MakeCamera(400, 300, 45.0), ForwardPose({0.5, 0, 0})}};
+  const Image8 near_mask = FieldOfViewMask(FullFront(1.0f), kFront, views);
+  EXPECT_TRUE(Inside(near_mask, 26.6, 0));
+  EXPECT_TRUE(Inside(near_mask, 6, 0));
+  EXPECT_FALSE(Inside(near_mask, 3, 0));
+  EXPECT_TRUE(Inside(near_mask, 48, 0));
+  EXPECT_FALSE(Inside(near_mask, 52, 0));
+  const Image8 far_mask = FieldOfViewMask(FullFront(100.0f), kFront, views);
+  EXPECT_TRUE(Inside(far_mask, -20, 0));
+  EXPECT_FALSE(Inside(far_mask, 26.6, 0));
+  // Pixels without a node take the depth of the nearest node: a layer with
+  // nodes at 1 m at longitudes 10 to 20 degrees only gives the 1 m footprint.
+  TwoLayerPanorama patch(kW, kH);
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      const double lon = (x + 0.5) / kW * 360.0 - 180.0;
+      if (lon < 10 || lon > 20) continue;
+      patch.layer(kFront).present[patch.index(x, y)] = 1;
+      patch.layer(kFront).depth_m[patch.index(x, y)] = 1.0f;
+    }
+  }
+  const Image8 patch_mask = FieldOfViewMask(patch, kFront, views, 100.0);
+  EXPECT_TRUE(Inside(patch_mask, 48, 0));
+  EXPECT_FALSE(Inside(patch_mask, -10, 0));
+  EXPECT_FALSE(Inside(patch_mask, 3, 10));
+  // An empty layer uses the reference depth.
+  TwoLayerPanorama empty(kW, kH);
+  double used = 0;
+  const Image8 ref_mask = FieldOfViewMask(empty, kFront, views, 1.0, 1, &used);
+  EXPECT_EQ(used, 1.0);
+  EXPECT_TRUE(Inside(ref_mask, 26.6, 0));
+  EXPECT_FALSE(Inside(ref_mask, 3, 0));
+}
+
+TEST(CoverageTest, HolesAreComponentsMeasuredBySolidAngle) {
+  TwoLayerPanorama pano = FullFront(2.0f);
+  const std::vector<CoverageView> views = {{MakeCamera(400, 300, 90.0), ForwardPose({0, 0, 0})}};
+  const Image8 fov = FieldOfViewMask(pano, kFront, views);
+  LayerData& f = pano.layer(kFront);
+  // An interior 10 x 10 hole around the forward direction...
+  int cx, cy;
+  PixelAt(0, 0, &cx, &cy);
+  for (int y = cy - 5; y < cy + 5; ++y)
+    for (int x = cx - 5; x < cx + 5; ++x) f.present[pano.index(x, y)] = 0;
+  // ... a 3 x 4 one ...
+  PixelAt(-20, 10, &cx, &cy);
+  for (int y = cy; y < cy + 4; ++y)
+    for (int x = cx; x < cx + 3; ++x) f.present[pano.index(x, y)] = 0;
+  // ... and a strip along the right edge of the field of view (and beyond).
+  PixelAt(40, 0, &cx, &cy);
+  for (int y = cy - 20; y < cy + 20; ++y)
+    for (int x = cx; x < cx + 30; ++x) f.present[pano.index(x, y)] = 0;
+
+  Image8 holes;
+  const CoverageStats stats = MeasureHoles(pano, kFront, fov, &holes);
+  EXPECT_EQ(stats.num_holes, 3);
+  EXPECT_EQ(stats.num_interior_holes, 2);
+  // The edge strip: columns 40.0 .. 45 degrees (10 inside), 40 rows.
+  EXPECT_GE(stats.largest_hole_pixels, 9 * 40);
+  EXPECT_LE(stats.largest_hole_pixels, 11 * 40);
+  const double pixel_sr = (2 * kPi / kW) * (kPi / kH);  // At the equator.
+  EXPECT_NEAR(stats.largest_interior_hole_fraction, 100 * pixel_sr / stats.fov_steradians,
+              0.01 * 100 * pixel_sr / stats.fov_steradians);
+  EXPECT_EQ(stats.hole_pixels, 100 + 12 + stats.largest_hole_pixels);
+  EXPECT_NEAR(stats.covered_fraction,
+              1.0 - (112 + stats.largest_hole_pixels) * pixel_sr / stats.fov_steradians, 2e-3);
+  PixelAt(0, 0, &cx, &cy);
+  EXPECT_EQ(holes.at(cx, cy), 255);
+  EXPECT_EQ(holes.at(cx + 6, cy), 0);
+}
+
+TEST(CoverageTest, HolesWrapAroundTheSeam) {
+  TwoLayerPanorama pano = FullFront(2.0f);
+  // A camera looking backwards (+Z): its view straddles the +-180 degree seam.
+  Eigen::Matrix3d R;
+  R << -1, 0, 0, 0, -1, 0, 0, 0, 1;
+  const std::vector<CoverageView> views = {
+      {MakeCamera(400, 300, 60.0), geometry::Pose::FromCenter(R, {0, 0, 0})}};
+  const Image8 fov = FieldOfViewMask(pano, kFront, views);
+  EXPECT_TRUE(Inside(fov, 179.9, 0));
+  EXPECT_TRUE(Inside(fov, -179.9, 0));
+  LayerData& f = pano.layer(kFront);
+  for (int y = kH / 2 - 4; y < kH / 2 + 4; ++y)
+    for (int x : {0, 1, 2, kW - 3, kW - 2, kW - 1}) f.present[pano.index(x, y)] = 0;
+  const CoverageStats stats = MeasureHoles(pano, kFront, fov);
+  EXPECT_EQ(stats.num_holes, 1);
+  EXPECT_EQ(stats.num_interior_holes, 1);
+  EXPECT_EQ(stats.hole_pixels, 48);
+}
+
+TEST(CoverageTest, RejectsAMaskOfTheWrongSize) {
+  const TwoLayerPanorama pano = FullFront(2.0f);
+  EXPECT_THROW(MeasureHoles(pano, kFront, Image8(10, 5, 1, 0)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace casual3d::pipeline
