@@ -7,11 +7,14 @@
 // (Levin et al. 2004) and w_i = unary_scale * sigma_i^2 (+ unary_floor) at anchors, sigma_i^2
 // the colour variance of the surrounding patch (Kopf et al. 2013). The normal
 // equations (W + L) x = W x' are symmetric positive definite whenever one
-// anchor exists; they are solved with Eigen's preconditioned conjugate
-// gradient. We propagate inverse depth rather than depth: the sweep samples
-// inverse depth uniformly, and interpolating inverse depth between a near and
-// a far anchor stays nearer (more conservative for a lower bound) than
-// interpolating depth.
+// anchor exists; they are solved with Eigen's Jacobi-preconditioned conjugate
+// gradient, started from the solution of the same problem on a 2x coarser
+// grid (recursively, see coarse_levels; the coarse grid box-averages colour,
+// sums anchor weights and weight-averages anchor values). We propagate
+// inverse depth rather than depth: the sweep samples inverse depth
+// uniformly, and interpolating inverse depth between a near and a far anchor
+// stays nearer (more conservative for a lower bound) than interpolating
+// depth.
 //
 // Final envelope: the propagated depth times `scale` (0.9), then a
 // morphological minimum filter of diameter min_filter_fraction (about 3%) of
@@ -31,6 +34,10 @@ struct EnvelopeOptions {
   double min_filter_fraction = 0.03; // Sec. 4.3.2: min-filter diameter / image diagonal. [0, 0.5].
   double cg_tolerance = 1e-5;        // Relative residual of the conjugate gradient. (0, 0.1].
   int cg_max_iterations = 3000;      // [1, 100000].
+  // Coarse-to-fine: the problem is first solved on up to this many 2x
+  // coarser grids (down to 16 pixels a side), each solution upsampled as the
+  // next finer level's initial guess. 0 = single level. [0, 16].
+  int coarse_levels = 4;
 
   Status Check() const;
 };

@@ -1,5 +1,6 @@
 #include "reconstruct/depth/near_envelope.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -33,6 +34,61 @@ TEST(PropagateAnchors, FollowsColourEdges) {
   EXPECT_NEAR(p.at(25, 35), 2.0f, 0.1f);
   EXPECT_NEAR(p.at(35, 2), 8.0f, 0.6f);
   EXPECT_NEAR(p.at(6, 6), 2.0f, 0.02f);
+}
+
+// The coarse-to-fine start changes only the initial guess: the result must
+// match a tightly converged single-level solve.
+TEST(PropagateAnchors, CoarseToFineMatchesSingleLevel) {
+  const int w = 150, h = 110;
+  ImageF color(w, h, 3);
+  ImageF anchors(w, h, 1, 0.0f);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> tex(-0.04f, 0.04f);
+  std::uniform_int_distribution<int> pick(0, 49);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      // Three colour regions (a disc, a band and the background).
+      const bool disc = (x - 40) * (x - 40) + (y - 50) * (y - 50) < 900;
+      const float base = disc ? 0.15f : (y > 80 ? 0.5f : 0.85f);
+      for (int c = 0; c < 3; ++c) color.at(x, y, c) = base + (c == 1 ? 0.1f : 0.0f) + tex(rng);
+      // Sparse anchors: about 2% of the pixels, depth smooth within a region.
+      if (pick(rng) == 0) anchors.at(x, y) = disc ? 1.5f + 0.01f * x : (y > 80 ? 4.0f : 15.0f + 0.02f * y);
+    }
+  EnvelopeOptions single;
+  single.variance_radius = 4;
+  single.coarse_levels = 0;
+  single.cg_tolerance = 1e-9;
+  single.cg_max_iterations = 20000;
+  const ImageF reference = PropagateAnchors(anchors, color, single);
+  EnvelopeOptions multi;
+  multi.variance_radius = 4;
+  PropagationStats st_multi, st_single;
+  const ImageF p = PropagateAnchors(anchors, color, multi, &st_multi);
+  single.cg_tolerance = multi.cg_tolerance;
+  PropagateAnchors(anchors, color, single, &st_single);
+  ASSERT_EQ(p.width(), w);
+  EXPECT_LT(st_multi.residual, multi.cg_tolerance);
+  // The coarse guess saves iterations at the same tolerance.
+  EXPECT_LT(st_multi.iterations, st_single.iterations);
+  auto max_rel_diff = [&](const ImageF& q) {
+    double m = 0;
+    for (size_t i = 0; i < q.vector().size(); ++i)
+      m = std::max(m, std::abs(1.0 - static_cast<double>(q.vector()[i]) / reference.vector()[i]));
+    return m;
+  };
+  // Default tolerance: about 0.8% here, well inside the envelope's 10% margin (scale 0.9).
+  EXPECT_LT(max_rel_diff(p), 0.015);
+  // A tighter tolerance converges to the reference.
+  multi.cg_tolerance = 1e-7;
+  EXPECT_LT(max_rel_diff(PropagateAnchors(anchors, color, multi)), 2e-4);
+}
+
+TEST(EnvelopeOptions, RejectsBadCoarseLevels) {
+  EnvelopeOptions o;
+  o.coarse_levels = -1;
+  EXPECT_FALSE(o.Check().ok());
+  o.coarse_levels = 17;
+  EXPECT_FALSE(o.Check().ok());
 }
 
 TEST(PropagateAnchors, ReturnsEmptyWithoutAnchors) {
