@@ -17,6 +17,7 @@ struct DenseCommandOptions {
   std::string out;
   bool no_near_envelope = false;
   bool no_gc_filter = false;
+  bool refine = false;
   depth::DenseOptions dense;
 };
 
@@ -24,6 +25,7 @@ void RunDense(const DenseCommandOptions& o) {
   depth::DenseOptions opt = o.dense;
   opt.use_near_envelope = !o.no_near_envelope;
   opt.use_gc_filter = !o.no_gc_filter;
+  opt.refine.enabled = o.refine;
   const Status st = opt.Check();
   if (!st.ok()) throw std::invalid_argument("dense: " + st.message());
   const depth::DenseReport report = depth::RunDenseStage(o.workspace, o.out, opt);
@@ -54,6 +56,8 @@ void AddDenseCommand(CLI::App& app) {
   cmd->add_flag("--no-near-envelope", opts->no_near_envelope,
                 "Ablation: MRF without the near envelope term (Eq. 4)");
   cmd->add_flag("--no-gc-filter", opts->no_gc_filter, "Ablation: build anchors without the GC filter");
+  cmd->add_flag("--refine", opts->refine,
+                "Continuous depth search within one label of the MRF's (slower; helps wide baselines)");
   cmd->add_option("--threads", opts->dense.num_threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--scale", opts->dense.working_scale,

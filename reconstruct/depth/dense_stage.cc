@@ -155,7 +155,7 @@ Status DenseOptions::Check() const {
   if (!(reference_diagonal > 0)) return InvalidArgument("reference_diagonal must be > 0");
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   for (const Status& s : {neighbors.Check(), sweep.Check(), gc.Check(), prune.Check(), envelope.Check(),
-                          mrf.Check(), edge_median.Check(), sublabel.Check(), upsample.Check()})
+                          mrf.Check(), edge_median.Check(), sublabel.Check(), refine.Check(), upsample.Check()})
     if (!s.ok()) return s;
   return Status::Ok();
 }
@@ -334,7 +334,23 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       // Edge-aware median (window fattening), sub-label refinement, depth and confidence.
       const std::vector<int> labels = EdgeAwareMedian(std::vector<int>(res.labels.begin(), res.labels.end()),
                                                       L, v.color, options.edge_median, inner);
-      const std::vector<float> fl = RefineSubLabel(vol, labels, v.color, options.sublabel, inner);
+      std::vector<float> fl = FitSubLabel(vol, labels, options.sublabel, inner);
+      pr.t_mrf = Since(t0);
+      ImageF trws_depth;
+      if (options.debug) {
+        trws_depth = ImageF(w, h, 1);
+        for (size_t p = 0; p < np; ++p) trws_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(res.labels[p]));
+      }
+      t0 = Clock::now();
+      if (options.refine.enabled) {
+        std::vector<const DenseView*> nbs;
+        for (int j : ws.ranked_neighbors[i]) {
+          if (static_cast<int>(nbs.size()) >= options.num_neighbors) break;
+          nbs.push_back(&ws.views[j]);
+        }
+        fl = RefineContinuous(v, nbs, vol, labels, fl, options.sweep, options.refine, inner);
+      }
+      fl = SmoothSubLabel(vol, std::move(fl), v.color, options.sublabel, inner);
       ImageF low_depth(w, h, 1), low_conf(w, h, 1);
       for (size_t p = 0; p < np; ++p) {
         const float* c = vol.cost.data() + p * L;
@@ -344,7 +360,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       vol.cost.clear();
       vol.cost.shrink_to_fit();
       final_low[i] = low_depth;
-      pr.t_mrf = Since(t0);
+      pr.t_refine = Since(t0);
 
       // Full resolution (Sec. 4.3.1: joint bilateral weighted median).
       t0 = Clock::now();
@@ -374,7 +390,12 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
         png("bilateral", bil);
         if (!propagated.empty()) png("propagated", propagated);
         if (!envelope.empty()) png("envelope", envelope);
+        png("trws", trws_depth);
         png("mrf", low_depth);
+        Image8 texture(w, h, 1);
+        for (size_t p = 0; p < np; ++p)
+          texture.data()[p] = static_cast<uint8_t>(std::lround(255.0f * vol.photo_weight.data()[p]));
+        io::WritePng((fs::path(debug_dir) / (stem + "_texture.png")).string(), texture);
         png("depth", depth);
       }
       pr.t_upsample = Since(t0);
@@ -389,11 +410,13 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
             io::WritePng(base + "_gt.png", gt_rgb.view());
             io::WritePng(base + "_error.png", err_rgb.view());
           }
-          const DepthAccuracy acc = EvaluateDepth(depth, gt, 0.5 * v.range.far_m);
+          const DepthAccuracy acc = EvaluateDepth(depth, gt, 0.5 * v.range.far_m, grid.InvStep());
           pr.median_rel_error = acc.median_rel_error;
           pr.within_3pct = acc.within_3pct;
           pr.near_floaters = acc.near_floaters;
           pr.sky_near = acc.sky_near;
+          pr.within_half_label = acc.within_half_label;
+          pr.within_two_labels = acc.within_two_labels;
           const double tol = 2.0 * grid.InvStep();
           const char* names[] = {"wta", "gc", "median", "bilateral"};
           const ImageF* maps[] = {&wta[i], &gc, &med, &bil};
@@ -437,12 +460,16 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     report.median_rel_error += pr.median_rel_error * px;
     report.within_3pct += pr.within_3pct * px;
     report.near_floaters += pr.near_floaters * px;
+    report.within_half_label += pr.within_half_label * px;
+    report.within_two_labels += pr.within_two_labels * px;
     weight += px;
   }
   if (weight > 0) {
     report.median_rel_error /= weight;
     report.within_3pct /= weight;
     report.near_floaters /= weight;
+    report.within_half_label /= weight;
+    report.within_two_labels /= weight;
   }
   report.seconds_total = Since(t_start);
   report.peak_rss_bytes = PeakRssBytes();
@@ -457,11 +484,14 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   j["use_gc_filter"] = options.use_gc_filter;
   j["num_depths"] = options.sweep.num_depths;
   j["working_scale"] = options.working_scale;
+  j["continuous_refine"] = options.refine.enabled;
   j["cross_view_consistency"] = report.cross_view_consistency;
   if (report.evaluated) {
     j["accuracy"] = {{"median_rel_error", report.median_rel_error},
                      {"within_3pct", report.within_3pct},
-                     {"near_floaters", report.near_floaters}};
+                     {"near_floaters", report.near_floaters},
+                     {"within_half_label", report.within_half_label},
+                     {"within_two_labels", report.within_two_labels}};
   }
   for (const PhotoReport& pr : report.photos) {
     nlohmann::json p;
@@ -477,11 +507,12 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     p["mrf_energy"] = pr.mrf_energy;
     p["mrf_iterations"] = pr.mrf_iterations;
     p["cross_view_consistency"] = pr.cross_view_consistency;
-    p["seconds"] = {{"sweep", pr.t_sweep}, {"envelope", pr.t_envelope}, {"mrf", pr.t_mrf},
+    p["seconds"] = {{"sweep", pr.t_sweep}, {"envelope", pr.t_envelope}, {"mrf", pr.t_mrf}, {"refine", pr.t_refine},
                     {"upsample_write", pr.t_upsample}};
     if (pr.evaluated) {
       p["accuracy"] = {{"median_rel_error", pr.median_rel_error}, {"within_3pct", pr.within_3pct},
-                       {"near_floaters", pr.near_floaters}, {"sky_near", pr.sky_near}};
+                       {"near_floaters", pr.near_floaters}, {"sky_near", pr.sky_near},
+                       {"within_half_label", pr.within_half_label}, {"within_two_labels", pr.within_two_labels}};
       for (const StageQuality& s : pr.stages)
         p["anchor_quality"][s.stage] = {{"completeness", s.completeness}, {"precision", s.precision}};
       p["envelope_quality"] = {{"error", pr.envelope_error}, {"tightness", pr.envelope_tightness}};

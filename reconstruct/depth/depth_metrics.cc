@@ -16,10 +16,10 @@ inline float SampleGt(const ImageF& gt, int x, int y, int w, int h) {
 
 }  // namespace
 
-DepthAccuracy EvaluateDepth(const ImageF& depth, const ImageF& gt, double sky_near_m) {
+DepthAccuracy EvaluateDepth(const ImageF& depth, const ImageF& gt, double sky_near_m, double inv_step) {
   DepthAccuracy a;
   std::vector<float> rel;
-  long long within = 0, floaters = 0, sky_near = 0;
+  long long within = 0, floaters = 0, sky_near = 0, half_label = 0, two_labels = 0;
   const int w = depth.width(), h = depth.height();
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -35,12 +35,19 @@ DepthAccuracy EvaluateDepth(const ImageF& depth, const ImageF& gt, double sky_ne
       rel.push_back(e);
       if (e <= 0.03f) ++within;
       if (!(d >= 0.85f * g)) ++floaters;
+      if (inv_step > 0 && d > 0) {
+        const double e_inv = std::abs(1.0 / d - 1.0 / g);
+        half_label += e_inv <= 0.5 * inv_step;
+        two_labels += e_inv <= 2.0 * inv_step;
+      }
     }
   if (a.pixels > 0) {
     std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
     a.median_rel_error = rel[rel.size() / 2];
     a.within_3pct = static_cast<double>(within) / a.pixels;
     a.near_floaters = static_cast<double>(floaters) / a.pixels;
+    a.within_half_label = static_cast<double>(half_label) / a.pixels;
+    a.within_two_labels = static_cast<double>(two_labels) / a.pixels;
   }
   if (a.sky_pixels > 0) a.sky_near = static_cast<double>(sky_near) / a.sky_pixels;
   return a;

@@ -18,12 +18,18 @@ struct DepthAccuracy {
   double median_rel_error = 0.0;   // median |d - g| / g.
   double within_3pct = 0.0;        // Fraction with |d - g| / g <= 0.03.
   double near_floaters = 0.0;      // Fraction with d < 0.85 g (or d missing).
+  // Error in label steps (|1/d - 1/g| / inv_step), when inv_step > 0 is given:
+  // tells quantisation (well under a label) from gross errors.
+  double within_half_label = 0.0;  // Fraction with |1/d - 1/g| <= 0.5 inv_step.
+  double within_two_labels = 0.0;  // Fraction with |1/d - 1/g| <= 2 inv_step.
   long long sky_pixels = 0;        // Pixels with infinite ground truth.
   double sky_near = 0.0;           // Fraction of sky pixels with d < sky_near_m.
 };
 // `sky_near_m`: depth below which an estimate on a sky pixel counts as a
-// near floater (callers pass half the sweep's far bound).
-DepthAccuracy EvaluateDepth(const ImageF& depth, const ImageF& ground_truth, double sky_near_m);
+// near floater (callers pass half the sweep's far bound). `inv_step`: the
+// sweep's inverse-depth label spacing (1/m), 0 = no label statistics.
+DepthAccuracy EvaluateDepth(const ImageF& depth, const ImageF& ground_truth, double sky_near_m,
+                            double inv_step = 0.0);
 
 // Completeness and precision of a pruned anchor map (Fig. 6, left).
 // An anchor is an inlier when |1/d - 1/g| <= inv_tolerance (1/m), which also

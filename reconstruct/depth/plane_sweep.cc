@@ -102,6 +102,8 @@ Status SweepOptions::Check() const {
     return InvalidArgument("ncc_epsilon " + std::to_string(ncc_epsilon) + " outside [0, 1]");
   if (!(texture_sigma > 0.0 && texture_sigma <= 1.0))
     return InvalidArgument("texture_sigma " + std::to_string(texture_sigma) + " outside (0, 1]");
+  if (!(texture_color_sigma >= 0.0 && texture_color_sigma <= 10.0))
+    return InvalidArgument("texture_color_sigma outside [0, 10]");
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   return Status::Ok();
 }
@@ -148,6 +150,34 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
     var_i[i] = var;
     inv_std_i[i] = 1.0f / std::sqrt(var + eps);
     vol.photo_weight.data()[i] = var / (var + tsig2);
+  }
+  if (options.texture_color_sigma > 0.0 && ref.color.width() == w && ref.color.height() == h &&
+      ref.color.channels() == 3) {
+    // Texture of the pixel's own surface: the window's grey variance with
+    // colour-similarity weights to the centre pixel.
+    const float inv2s2 =
+        static_cast<float>(1.0 / (2.0 * options.texture_color_sigma * options.texture_color_sigma));
+    ParallelFor(0, h, threads, [&](int64_t yy) {
+      const int y = static_cast<int>(yy);
+      for (int x = 0; x < w; ++x) {
+        const float* c0 = &ref.color.at(x, y, 0);
+        float sw = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v)
+          for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) {
+            const float* c = &ref.color.at(u, v, 0);
+            const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
+                             (c[2] - c0[2]) * (c[2] - c0[2]);
+            const float wq = std::exp(-d2 * inv2s2);
+            const float g = gi[static_cast<size_t>(v) * w + u];
+            sw += wq;
+            s1 += wq * g;
+            s2 += wq * g * g;
+          }
+        const float m = s1 / sw;
+        const float var = std::max(0.0f, s2 / sw - m * m);
+        vol.photo_weight.data()[static_cast<size_t>(y) * w + x] = var / (var + tsig2);
+      }
+    });
   }
 
   // Homography parts per neighbour: A (3x3, float) and b.

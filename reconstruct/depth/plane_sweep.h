@@ -12,7 +12,9 @@
 // the costs of the `best_k` best neighbours are averaged, which tolerates
 // partial occlusion (a surface hidden in some neighbours still matches in the
 // others). w_photo = var / (var + texture_sigma^2) with var the reference
-// window's intensity variance: low in textureless regions, where ZNCC is noise.
+// window's intensity variance, weighted by colour similarity to the centre
+// pixel: low in textureless regions, where ZNCC is noise, and on flat pixels
+// whose window borrows its texture from a differently coloured neighbour.
 // Window pixels that a neighbour does not see count as black.
 //
 // Cost: linear in pixels x planes x neighbours (window sums run along rows
@@ -33,11 +35,21 @@ namespace casual3d::depth {
 
 struct SweepOptions {
   int num_depths = 220;         // Sec. 4.3.1: depth hypotheses. Range [2, 4096].
-  int window_radius = 3;        // ZNCC window radius at working resolution, pixels. [1, 15].
+  // ZNCC window radius at working resolution, pixels. 2 (5x5): radius 3
+  // fattened near objects by one more pixel (spec/stage-dense.md). [1, 15].
+  int window_radius = 2;
   int best_k = 2;               // Neighbours averaged per pixel (best costs first). [1, 16].
   double ncc_epsilon = 2.5e-5;  // Variance added to both windows (intensity^2); damps ZNCC of
                                 // flat, noisy windows towards 0. [0, 1].
   double texture_sigma = 0.02;  // w_photo = var / (var + texture_sigma^2), intensity. (0, 1].
+  // Colour sigma of the texture measure (RGB distance, colour in [0, 1]):
+  // var is the window's grey variance with each window pixel weighted by
+  // exp(-|c_q - c_p|^2 / (2 sigma^2)) against the centre's colour, so that it
+  // measures the texture of the pixel's own surface. A flat pixel next to a
+  // textured object (a blank wall beside a pole) gets a low w_photo although
+  // its window, and so its ZNCC, is dominated by the object's edge (window
+  // fattening). 0 = the plain window variance. [0, 10].
+  double texture_color_sigma = 0.1;
   int num_threads = 0;          // 0 = all cores.
 
   Status Check() const;

@@ -225,7 +225,9 @@ TEST(PlaneSweep, RecoversAPlaneDespiteExposureChanges) {
   // Away from the image border (where neighbours do not overlap), nearly all
   // pixels pick the true plane's label or its neighbour.
   EXPECT_GE(FractionWithinLabels(vol, wta, gt, 1.0, 12), 0.97);
-  // Costs are normalised to [0, 1] and the textured plane gets w_photo near 1.
+  // Costs are normalised to [0, 1] and the textured plane gets a high w_photo
+  // (its texture is random colour cells, which the colour-weighted texture
+  // measure partly discounts: 0.46 here, 0.60 with the plain variance).
   float mn = 2, mx = -1;
   for (float v : vol.cost) {
     mn = std::min(mn, v);
@@ -233,7 +235,10 @@ TEST(PlaneSweep, RecoversAPlaneDespiteExposureChanges) {
   }
   EXPECT_GE(mn, 0.0f);
   EXPECT_LE(mx, 1.0f);
-  EXPECT_GT(vol.photo_weight.at(80, 60), 0.7f);
+  EXPECT_GT(vol.photo_weight.at(80, 60), 0.4f);
+  SweepOptions plain = opt;
+  plain.texture_color_sigma = 0.0;
+  EXPECT_GT(ComputeCostVolume(ref, {&a, &b, &c}, plain).photo_weight.at(80, 60), 0.55f);
 }
 
 TEST(PlaneSweep, BestKAveragingSurvivesAnOccludingNeighbour) {
@@ -269,6 +274,48 @@ TEST(PlaneSweep, RejectsInvalidOptionsAndInputs) {
   DenseView bad = ref;
   bad.range = {5.0, 2.0};
   EXPECT_THROW(ComputeCostVolume(bad, {&ref}, SweepOptions()), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace casual3d::depth
+
+namespace casual3d::depth {
+namespace {
+
+// A flat grey wall (left) beside a textured yellow stripe (right, x >= 20):
+// the wall pixels two columns from the stripe see its texture in their 7x7
+// window. The colour-weighted texture measure must call them flat; the plain
+// window variance calls them textured.
+TEST(PlaneSweep, TextureWeightIgnoresADifferentlyColouredNeighbour) {
+  const int w = 40, h = 20;
+  DenseView v;
+  v.name = "stripe";
+  v.camera = testing::ToyCamera({0, 0, 0}, w, h, 30);
+  v.range = {1.0, 10.0};
+  v.gray = ImageF(w, h, 1);
+  v.color = ImageF(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const bool stripe = x >= 20;
+      const float t = stripe ? ((x * 7 + y * 13) % 5) * 0.08f : 0.0f;
+      const float rgb[3] = {stripe ? 0.8f + 0.5f * t : 0.6f, stripe ? 0.7f + 0.5f * t : 0.6f,
+                            stripe ? 0.15f + t : 0.57f};
+      for (int c = 0; c < 3; ++c) v.color.at(x, y, c) = rgb[c];
+      v.gray.at(x, y) = 0.3f * rgb[0] + 0.59f * rgb[1] + 0.11f * rgb[2];
+    }
+  DenseView nb = v;
+  nb.camera = testing::ToyCamera({0.1, 0, 0}, w, h, 30);
+  SweepOptions opt;
+  opt.num_depths = 8;
+  const CostVolume weighted = ComputeCostVolume(v, {&nb}, opt);
+  opt.texture_color_sigma = 0.0;
+  const CostVolume plain = ComputeCostVolume(v, {&nb}, opt);
+  EXPECT_GT(plain.photo_weight.at(18, 10), 0.5f);
+  EXPECT_LT(weighted.photo_weight.at(18, 10), 0.05f);
+  EXPECT_LT(weighted.photo_weight.at(5, 10), 0.01f);   // Far from the stripe: flat either way.
+  EXPECT_GT(weighted.photo_weight.at(30, 10), 0.5f);  // The stripe's own texture stays.
+  opt.texture_color_sigma = -1.0;
+  EXPECT_THROW(ComputeCostVolume(v, {&nb}, opt), std::invalid_argument);
 }
 
 }  // namespace

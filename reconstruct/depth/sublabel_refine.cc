@@ -22,20 +22,29 @@ Status SubLabelOptions::Check() const {
   return Status::Ok();
 }
 
-std::vector<float> RefineSubLabel(const CostVolume& volume, const std::vector<int>& labels,
-                                  const ImageF& color, const SubLabelOptions& options,
-                                  int num_threads) {
-  const Status st = options.Check();
-  if (!st.ok()) throw std::invalid_argument(st.message());
-  const int w = volume.width, h = volume.height, L = volume.num_labels;
-  const size_t np = static_cast<size_t>(w) * h;
-  if (labels.size() != np || color.width() != w || color.height() != h || color.channels() != 3 ||
-      volume.cost.size() != np * L)
+namespace {
+
+void CheckSizes(const CostVolume& volume, size_t labels, const ImageF* color) {
+  const size_t np = static_cast<size_t>(volume.width) * volume.height;
+  if (labels != np || volume.cost.size() != np * volume.num_labels ||
+      (color && (color->width() != volume.width || color->height() != volume.height ||
+                 color->channels() != 3)))
     throw std::invalid_argument(
         "sub-label refinement: label map, colour guide and cost volume differ in size");
+}
+
+}  // namespace
+
+std::vector<float> FitSubLabel(const CostVolume& volume, const std::vector<int>& labels,
+                               const SubLabelOptions& options, int num_threads) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument(st.message());
+  CheckSizes(volume, labels.size(), nullptr);
+  const int w = volume.width, h = volume.height, L = volume.num_labels;
+  const size_t np = static_cast<size_t>(w) * h;
   const int threads = ResolveThreads(num_threads);
 
-  // Step 1: parabola through the cost around the best label next to k.
+  // Parabola through the cost around the best label next to k.
   std::vector<float> f(np);
   ParallelFor(0, h, threads, [&](int64_t y) {
     for (int x = 0; x < w; ++x) {
@@ -58,8 +67,20 @@ std::vector<float> RefineSubLabel(const CostVolume& volume, const std::vector<in
       f[p] = static_cast<float>(kf);
     }
   });
+  return f;
+}
 
-  // Step 2: edge-aware weighted mean, Jacobi passes.
+std::vector<float> SmoothSubLabel(const CostVolume& volume, std::vector<float> f,
+                                  const ImageF& color, const SubLabelOptions& options,
+                                  int num_threads) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument(st.message());
+  CheckSizes(volume, f.size(), &color);
+  const int w = volume.width, h = volume.height;
+  const size_t np = static_cast<size_t>(w) * h;
+  const int threads = ResolveThreads(num_threads);
+
+  // Edge-aware weighted mean, Jacobi passes.
   const int r = options.smooth_radius;
   if (r == 0 || options.smooth_iterations == 0) return f;
   const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
@@ -93,6 +114,14 @@ std::vector<float> RefineSubLabel(const CostVolume& volume, const std::vector<in
     f.swap(next);
   }
   return f;
+}
+
+std::vector<float> RefineSubLabel(const CostVolume& volume, const std::vector<int>& labels,
+                                  const ImageF& color, const SubLabelOptions& options,
+                                  int num_threads) {
+  CheckSizes(volume, labels.size(), &color);
+  return SmoothSubLabel(volume, FitSubLabel(volume, labels, options, num_threads), color, options,
+                        num_threads);
 }
 
 }  // namespace casual3d::depth

@@ -43,4 +43,13 @@ std::vector<float> RefineSubLabel(const CostVolume& volume, const std::vector<in
                                   const ImageF& color, const SubLabelOptions& options,
                                   int num_threads = 0);
 
+// The two steps on their own, so that another per-pixel refinement
+// (continuous_refine.h) can run between them: RefineSubLabel(...) equals
+// SmoothSubLabel(volume, FitSubLabel(volume, labels, ...), color, ...).
+std::vector<float> FitSubLabel(const CostVolume& volume, const std::vector<int>& labels,
+                               const SubLabelOptions& options, int num_threads = 0);
+std::vector<float> SmoothSubLabel(const CostVolume& volume, std::vector<float> labels,
+                                  const ImageF& color, const SubLabelOptions& options,
+                                  int num_threads = 0);
+
 }  // namespace casual3d::depth

@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 // Bump when a stage's output format or algorithm changes, so old caches are stale.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-1", "dense-1", "panorama-1",
+constexpr const char* kStageVersions[kNumStages] = {"sparse-1", "dense-2", "panorama-1",
                                                     "encode-1"};
 
 std::string HashHex(const std::string& text) {
@@ -67,7 +67,7 @@ std::string DenseOptionsText(const depth::DenseOptions& o) {
     << " num_depths=" << o.sweep.num_depths << " window_radius=" << o.sweep.window_radius
     << " lambda_smooth=" << o.mrf.lambda_smooth << " lambda_near=" << o.mrf.lambda_near
     << " use_near_envelope=" << o.use_near_envelope << " use_gc_filter=" << o.use_gc_filter
-    << " envelope_scale=" << o.envelope.scale;
+    << " envelope_scale=" << o.envelope.scale << " continuous_refine=" << o.refine.enabled;
   return s.str();
 }
 
