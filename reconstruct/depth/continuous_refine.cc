@@ -10,12 +10,10 @@
 namespace casual3d::depth {
 namespace {
 
-// A neighbour's plane-induced homography parts, as in the sweep:
-// x_n ~ A x_ref + inv_d * b with A = K_n R_rel K_ref^-1, b = K_n t_rel.
+// A neighbour's image and plane-induced homography, as in the sweep.
 struct Neighbor {
   const ImageF* gray = nullptr;
-  float a[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  float b[3] = {0, 0, 0};
+  PlaneHomography h;
 };
 
 constexpr int kMaxWindow = 31;  // 2 * 15 + 1: the sweep's largest window.
@@ -47,8 +45,8 @@ float WindowCost(const Context& ctx, const Neighbor& nb, int x, int y, float inv
     sweep::HomographyRow row;
     const float vc = static_cast<float>(v) + 0.5f;
     for (int c = 0; c < 3; ++c) {
-      row.p0[c] = nb.a[c][0] * u0 + nb.a[c][1] * vc + nb.a[c][2] + nb.b[c] * inv_d;
-      row.step[c] = nb.a[c][0];
+      row.p0[c] = nb.h.a[c][0] * u0 + nb.h.a[c][1] * vc + nb.h.a[c][2] + nb.h.b[c] * inv_d;
+      row.step[c] = nb.h.a[c][0];
     }
     sweep::WarpRow(nb.gray->data(), nb.gray->width(), nb.gray->height(), row, ww, values, invalid);
     if (v == y) centre_seen = invalid[x - x0] == 0.0f;
@@ -119,18 +117,9 @@ std::vector<float> RefineContinuous(const DenseView& ref, const std::vector<cons
   });
 
   std::vector<Neighbor> nbs(neighbors.size());
-  const Eigen::Matrix3d kinv_ref = ref.camera.KInverse();
   for (size_t j = 0; j < neighbors.size(); ++j) {
-    const DenseView& nb = *neighbors[j];
-    const Eigen::Matrix3d r_rel = nb.camera.R * ref.camera.R.transpose();
-    const Eigen::Vector3d t_rel = nb.camera.t - r_rel * ref.camera.t;
-    const Eigen::Matrix3d a = nb.camera.K() * r_rel * kinv_ref;
-    const Eigen::Vector3d b = nb.camera.K() * t_rel;
-    nbs[j].gray = &nb.gray;
-    for (int rr = 0; rr < 3; ++rr) {
-      for (int c = 0; c < 3; ++c) nbs[j].a[rr][c] = static_cast<float>(a(rr, c));
-      nbs[j].b[rr] = static_cast<float>(b[rr]);
-    }
+    nbs[j].gray = &neighbors[j]->gray;
+    nbs[j].h = ComputePlaneHomography(ref.camera, neighbors[j]->camera);
   }
   Context ctx;
   ctx.ref_gray = &ref.gray;

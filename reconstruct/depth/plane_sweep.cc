@@ -108,6 +108,19 @@ Status SweepOptions::Check() const {
   return Status::Ok();
 }
 
+PlaneHomography ComputePlaneHomography(const PinholeCamera& ref, const PinholeCamera& neighbor) {
+  const Eigen::Matrix3d r_rel = neighbor.R * ref.R.transpose();
+  const Eigen::Vector3d t_rel = neighbor.t - r_rel * ref.t;
+  const Eigen::Matrix3d a = neighbor.K() * r_rel * ref.KInverse();
+  const Eigen::Vector3d b = neighbor.K() * t_rel;
+  PlaneHomography h;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) h.a[r][c] = static_cast<float>(a(r, c));
+    h.b[r] = static_cast<float>(b[r]);
+  }
+  return h;
+}
+
 CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const DenseView*>& neighbors,
                              const SweepOptions& options) {
   const Status st = options.Check();
@@ -180,20 +193,12 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
     });
   }
 
-  // Homography parts per neighbour: A (3x3, float) and b.
-  const Eigen::Matrix3d kinv_ref = ref.camera.KInverse();
   std::vector<NeighborWarp> warps(neighbors.size());
   for (size_t j = 0; j < neighbors.size(); ++j) {
-    const DenseView& nb = *neighbors[j];
-    const Eigen::Matrix3d r_rel = nb.camera.R * ref.camera.R.transpose();
-    const Eigen::Vector3d t_rel = nb.camera.t - r_rel * ref.camera.t;
-    const Eigen::Matrix3d a = nb.camera.K() * r_rel * kinv_ref;
-    const Eigen::Vector3d b = nb.camera.K() * t_rel;
-    warps[j].view = &nb;
-    for (int rr = 0; rr < 3; ++rr) {
-      for (int c = 0; c < 3; ++c) warps[j].a[rr][c] = static_cast<float>(a(rr, c));
-      warps[j].b[rr] = static_cast<float>(b[rr]);
-    }
+    const PlaneHomography hom = ComputePlaneHomography(ref.camera, neighbors[j]->camera);
+    warps[j].view = neighbors[j];
+    std::copy(&hom.a[0][0], &hom.a[0][0] + 9, &warps[j].a[0][0]);
+    std::copy(hom.b, hom.b + 3, warps[j].b);
   }
 
   // Planes are handed out in groups of kGroup. A thread sweeps each plane of

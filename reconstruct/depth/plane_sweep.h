@@ -81,6 +81,16 @@ struct CostVolume {
   }
 };
 
+// The parts of the homography that the fronto-parallel plane Z_ref = d
+// induces from `ref` to `neighbor` (Hartley & Zisserman, Sec. 13.1):
+// x_n ~ a x_ref + (1/d) b with a = K_n R_rel K_ref^-1 and b = K_n t_rel
+// (pixel coordinates in COLMAP's convention, view.h), in float for the kernels.
+struct PlaneHomography {
+  float a[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  float b[3] = {0, 0, 0};
+};
+PlaneHomography ComputePlaneHomography(const PinholeCamera& ref, const PinholeCamera& neighbor);
+
 // Builds the cost volume of `ref` against `neighbors` (all at the working
 // resolution, same size or not). Requires ref.range with 0 < near < far and at
 // least one neighbour. Throws std::invalid_argument on bad options or input.
