@@ -71,6 +71,18 @@ void AddDenseCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--lambda-near", opts->dense.mrf.lambda_near, "Near envelope penalty (Eq. 4)")
       ->capture_default_str();
+  cmd->add_option("--window-radius", opts->dense.sweep.window_radius,
+                  "ZNCC window radius at working resolution (2: 5x5)")
+      ->capture_default_str();
+  cmd->add_option("--texture-color-sigma", opts->dense.sweep.texture_color_sigma,
+                  "Colour sigma of the texture measure w_photo; 0 = plain window variance")
+      ->capture_default_str();
+  cmd->add_option("--min-far-over-near", opts->dense.min_far_over_near,
+                  "The sweep's far plane is at least this many times farther than its near plane")
+      ->capture_default_str();
+  cmd->add_option("--far-bias", opts->dense.mrf.far_bias,
+                  "Cost leaning textureless pixels away from the camera (MRF data term)")
+      ->capture_default_str();
   cmd->add_option("--ground-truth", opts->dense.ground_truth_dir,
                   "Folder of ground-truth depth <stem>.exr (e.g. a synthetic capture's depth/) "
                   "to evaluate against; results go to dense.json");

@@ -153,6 +153,8 @@ Status DenseOptions::Check() const {
   if (num_neighbors < 1 || num_neighbors > 16)
     return InvalidArgument("num_neighbors " + std::to_string(num_neighbors) + " outside [1, 16]");
   if (!(reference_diagonal > 0)) return InvalidArgument("reference_diagonal must be > 0");
+  if (!(min_far_over_near >= 1 && min_far_over_near <= 1e6))
+    return InvalidArgument("min_far_over_near outside [1, 1e6]");
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   for (const Status& s : {neighbors.Check(), sweep.Check(), gc.Check(), prune.Check(), envelope.Check(),
                           mrf.Check(), edge_median.Check(), sublabel.Check(), refine.Check(), upsample.Check()})
@@ -170,6 +172,8 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     throw std::runtime_error(options.ground_truth_dir + ": ground-truth folder does not exist");
 
   LoadedWorkspace ws = LoadWorkspace(workspace_dir, options.working_scale, options.neighbors);
+  for (DenseView& v : ws.views)
+    v.range.far_m = std::max(v.range.far_m, options.min_far_over_near * v.range.near_m);
   const int n = static_cast<int>(ws.views.size());
   DenseReport report;
   report.seconds_load = Since(t_start);

@@ -66,6 +66,14 @@ struct DenseOptions {
   // Filter sizes below are given for a 900x1350 image (Sec. 4.3.2) and scaled
   // with the working image's diagonal.
   double reference_diagonal = 1622.5;  // sqrt(900^2 + 1350^2), pixels.
+  // The sweep's far plane lies at least this many times farther than its near
+  // plane. Structure-from-motion triangulates no point whose triangulation
+  // angle is tiny, so with a casual capture's short baseline the sparse
+  // points, and the far bound taken from them, stop at a few metres while
+  // facades and trees stand at tens. Labels are uniform in inverse depth, so
+  // pushing the far plane from 1/10 to 1/100 of the near plane's distance
+  // costs about 10% of label resolution. [1, 1e6].
+  double min_far_over_near = 100.0;
   NeighborOptions neighbors;
   SweepOptions sweep;
   GcFilterOptions gc;

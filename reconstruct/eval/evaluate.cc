@@ -243,8 +243,9 @@ DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r,
                              double scale) {
   DepthComparison d;
   const int w = r.depth.width(), h = r.depth.height();
-  std::vector<float> rel;
+  std::vector<float> rel, ratio;
   rel.reserve(static_cast<size_t>(w) * h);
+  ratio.reserve(static_cast<size_t>(w) * h);
   int64_t within = 0;
   for (int y = 0; y < h; ++y) {
     const int ty = std::min(truth.height() - 1, int((y + 0.5) * truth.height() / h));
@@ -253,8 +254,10 @@ DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r,
       const int tx = std::min(truth.width() - 1, int((x + 0.5) * truth.width() / w));
       const float t = truth.at(tx, ty);
       if (!std::isfinite(t) || t <= 0) continue;
-      const float e = std::abs(static_cast<float>(scale * r.depth.at(x, y)) - t) / t;
+      const float z = static_cast<float>(scale * r.depth.at(x, y));
+      const float e = std::abs(z - t) / t;
       rel.push_back(e);
+      ratio.push_back(z / t);
       within += e <= tolerance;
     }
   }
@@ -263,8 +266,21 @@ DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r,
   if (rel.empty()) return d;
   std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
   d.median_relative_error = rel[rel.size() / 2];
+  std::nth_element(ratio.begin(), ratio.begin() + ratio.size() / 2, ratio.end());
+  d.median_ratio = ratio[ratio.size() / 2];
   d.within_tolerance = double(within) / rel.size();
   return d;
+}
+
+double MaxFiniteDepth(const TwoLayerPanorama& pano) {
+  double m = 0.0;
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& layer = pano.layer(l);
+    for (size_t i = 0; i < layer.depth_m.size(); ++i)
+      if (layer.present[i] && std::isfinite(layer.depth_m[i]))
+        m = std::max(m, static_cast<double>(layer.depth_m[i]));
+  }
+  return m;
 }
 
 }  // namespace
@@ -327,6 +343,9 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
 
   render::RenderOptions render_options;
   render_options.num_threads = options.num_threads;
+  // The far plane beyond the farthest node, as the viewer sets it: the
+  // model's units are arbitrary (COLMAP's), so a fixed far plane could clip.
+  render_options.far_m = std::max(render_options.far_m, 1.5 * MaxFiniteDepth(photo3d.pano));
   util::Progress progress("rephotography", static_cast<int64_t>(selected.size()));
   eval.error_histogram.assign(options.metrics.histogram_bins, 0);
   for (const int index : selected) {

@@ -66,6 +66,9 @@ struct DepthComparison {
   int64_t pixels = 0;
   double median_relative_error = 0.0;  // median of |z - z_true| / z_true.
   double within_tolerance = 0.0;       // Fraction with relative error <= depth_tolerance.
+  // Median of z / z_true: near 1 when the errors are noise around the truth,
+  // away from 1 when the whole 3D photo is too near or too far (a scale error).
+  double median_ratio = 0.0;
 };
 
 struct PhotoEvaluation {

@@ -101,6 +101,7 @@ TEST_F(EvaluateSyntheticTest, RephotographsMatchThePhotosAndTheGroundTruthDepth)
     EXPECT_GT(p.metrics.ssim, 0.6) << p.name;
     ASSERT_TRUE(p.depth.available) << p.name;
     EXPECT_LT(p.depth.median_relative_error, 0.01) << p.name;
+    EXPECT_NEAR(p.depth.median_ratio, 1.0, 0.01) << p.name;
     // Depth edges: the 240-px rendering and the 320-px ground truth sample
     // different points near them.
     EXPECT_GT(p.depth.within_tolerance, 0.85) << p.name;
@@ -142,6 +143,7 @@ TEST_F(EvaluateSyntheticTest, DepthOfAModelAtAnotherScaleIsComparedAfterScaling)
   for (const PhotoEvaluation& p : e.photos) {
     EXPECT_GT(p.metrics.completeness, 0.95) << p.name;
     EXPECT_LT(p.depth.median_relative_error, 0.01) << p.name;
+    EXPECT_NEAR(p.depth.median_ratio, 1.0, 0.01) << p.name;
   }
   fs::remove_all(root);
 }

@@ -330,6 +330,7 @@ std::string RenderJsonReport(const std::string& capture,
       if (p.depth.available)
         q["depth"] = {{"pixels", p.depth.pixels},
                       {"median_relative_error", p.depth.median_relative_error},
+                      {"median_ratio", p.depth.median_ratio},
                       {"within_tolerance", p.depth.within_tolerance}};
       m["photos"].push_back(q);
     }

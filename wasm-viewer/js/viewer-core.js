@@ -249,6 +249,8 @@ export class Casual3dViewer extends EventTarget {
         break;
       case 'level': {
         const t0 = performance.now();
+        // Keep the whole scene inside the far plane (near plane unchanged).
+        if (msg.depthFarM > 0) this.camera.far = Math.max(this.camera.far, 1.5 * msg.depthFarM);
         try {
           this.renderer.setMesh(msg.mesh, msg.atlas);
         } catch (err) {

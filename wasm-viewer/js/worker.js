@@ -90,6 +90,15 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
   const manifestBytes = await fetchBytes(url, 'manifest.json');
   check();
   const reader = format.openPackage(manifestBytes);
+  // The farthest depth of the panorama (the package's depth code range), so
+  // that the camera's far plane never clips the scene: a model in COLMAP
+  // units can lie thousands of units away.
+  let depthFarM = 0;
+  try {
+    depthFarM = Number(JSON.parse(new TextDecoder().decode(manifestBytes)).depth_encoding.far_m) || 0;
+  } catch (err) {
+    depthFarM = 0;  // openPackage has validated the manifest; this cannot fail in practice.
+  }
   try {
     const numLevels = reader.numLevels;
     // Coarsest first; finer levels while they fit maxLevelWidth.
@@ -158,7 +167,7 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
         progress(level, true);
         self.postMessage(
           {
-            type: 'level', id, level, levels: numLevels, width: info.width, height: info.height,
+            type: 'level', id, level, levels: numLevels, width: info.width, height: info.height, depthFarM,
             mesh: { positions: mesh.positions, normals: mesh.normals, uvs: mesh.uvs, indices: mesh.indices },
             atlas, timing,
           },
