@@ -172,9 +172,18 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     throw std::runtime_error(options.ground_truth_dir + ": ground-truth folder does not exist");
 
   LoadedWorkspace ws = LoadWorkspace(workspace_dir, options.working_scale, options.neighbors);
-  for (DenseView& v : ws.views)
-    v.range.far_m = std::max(v.range.far_m, options.min_far_over_near * v.range.near_m);
   const int n = static_cast<int>(ws.views.size());
+  // Far-plane extension (dense_stage.h): labels are added beyond the sparse
+  // range at the sparse range's spacing, so near content keeps its precision.
+  std::vector<int> num_labels(n, options.sweep.num_depths);
+  for (int i = 0; i < n; ++i) {
+    DepthRange& r = ws.views[i].range;
+    const double far = std::max(r.far_m, options.min_far_over_near * r.near_m);
+    const double grow = (1.0 / r.near_m - 1.0 / far) / (1.0 / r.near_m - 1.0 / r.far_m);
+    num_labels[i] = std::min(4 * options.sweep.num_depths,
+                             static_cast<int>(std::ceil(options.sweep.num_depths * grow - 1e-9)));
+    r.far_m = far;
+  }
   DenseReport report;
   report.seconds_load = Since(t_start);
 
@@ -214,6 +223,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       pr.far_m = v.range.far_m;
       pr.work_width = v.camera.width;
       pr.work_height = v.camera.height;
+      pr.num_labels = num_labels[i];
       pr.width = v.full_width;
       pr.height = v.full_height;
       std::vector<const DenseView*> nbs;
@@ -222,6 +232,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
         nbs.push_back(&ws.views[j]);
         pr.neighbors.push_back(ws.views[j].name);
       }
+      sweep.num_depths = num_labels[i];
       CostVolume vol = ComputeCostVolume(v, nbs, sweep);
       wta[i] = WinnerTakesAll(vol, threads);
       WriteCostCache(cache_path(i), vol);
@@ -505,6 +516,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     p["far_m"] = pr.far_m;
     p["size"] = {pr.width, pr.height};
     p["work_size"] = {pr.work_width, pr.work_height};
+    p["num_labels"] = pr.num_labels;
     p["anchors"] = {{"wta", pr.anchors[0]}, {"gc", pr.anchors[1]}, {"median", pr.anchors[2]},
                     {"bilateral", pr.anchors[3]}};
     p["cg_iterations"] = pr.cg_iterations;

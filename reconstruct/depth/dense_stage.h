@@ -49,8 +49,9 @@ struct MrfTermOptions {
   // * (1 - k / (L - 1)) on label k leans them away from the camera rather than
   // letting the smoothness term extend nearby near objects over them. On the
   // default synthetic capture 0.02 / 0.04 / 0.06 gave near floaters 5.66 /
-  // 4.59 / 4.20% and within 3% 64.0 / 63.7 / 63.4%. [0, 1].
-  double far_bias = 0.06;
+  // 4.59 / 4.20% and within 3% 64.0 / 63.7 / 63.4%, but 0.06 lost 0.6 dB on
+  // fern's held-out views (docs/RESULTS.md). [0, 1].
+  double far_bias = 0.02;
   int truncation_labels = 8;    // w_depth = min(|k_i - k_j|, T) / T, labels (inverse depth). [1, 4096].
   // TRW-S passes. 6: on the synthetic capture the energy is within 0.15% of
   // 8 passes' and the accuracy figures within 0.6% (docs/PERFORMANCE.md);
@@ -70,9 +71,11 @@ struct DenseOptions {
   // plane. Structure-from-motion triangulates no point whose triangulation
   // angle is tiny, so with a casual capture's short baseline the sparse
   // points, and the far bound taken from them, stop at a few metres while
-  // facades and trees stand at tens. Labels are uniform in inverse depth, so
-  // pushing the far plane from 1/10 to 1/100 of the near plane's distance
-  // costs about 10% of label resolution. [1, 1e6].
+  // facades and trees stand at tens. Labels are added beyond the sparse far
+  // bound at the sparse range's spacing (sweep.num_depths over the sparse
+  // range; at most 4 * num_depths in all), so near content keeps its
+  // precision: stretching 220 labels instead cost 0.45 dB on fern.
+  // [1, 1e6].
   double min_far_over_near = 100.0;
   NeighborOptions neighbors;
   SweepOptions sweep;
@@ -107,6 +110,7 @@ struct PhotoReport {
   double near_m = 0.0, far_m = 0.0;
   int width = 0, height = 0;              // Output size.
   int work_width = 0, work_height = 0;    // Working size.
+  int num_labels = 0;                     // Depth labels swept (far-plane extension included).
   std::vector<int> anchors;               // Surviving pixels after wta, gc, median, bilateral.
   int cg_iterations = 0;
   double mrf_energy = 0.0;
