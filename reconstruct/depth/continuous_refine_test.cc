@@ -112,11 +112,20 @@ TEST(RefineContinuous, StaysWithinTheSearchRangeAndLeavesFlatPixels) {
   EXPECT_GT(moved_towards_truth, 0.9 * interior);
 }
 
-TEST(RefineContinuous, DisabledOrWithoutNeighboursReturnsTheStart) {
+// A plane case with every pixel at MRF label 10 and start value `start_label`.
+struct FlatStart {
   PlaneCase pc = MakePlane(4.0);
-  const size_t np = static_cast<size_t>(pc.vol.width) * pc.vol.height;
-  std::vector<int> labels(np, 10);
-  std::vector<float> start(np, 10.25f);
+  size_t np = static_cast<size_t>(pc.vol.width) * pc.vol.height;
+  std::vector<int> labels = std::vector<int>(np, 10);
+  std::vector<float> start;
+  explicit FlatStart(float start_label) : start(np, start_label) {}
+};
+
+TEST(RefineContinuous, DisabledOrWithoutNeighboursReturnsTheStart) {
+  FlatStart f(10.25f);
+  PlaneCase& pc = f.pc;
+  const std::vector<int>& labels = f.labels;
+  const std::vector<float>& start = f.start;
   ContinuousRefineOptions off;
   off.enabled = false;
   EXPECT_EQ(RefineContinuous(pc.ref, {&pc.a}, pc.vol, labels, start, pc.sweep, off), start);
@@ -126,10 +135,11 @@ TEST(RefineContinuous, DisabledOrWithoutNeighboursReturnsTheStart) {
 }
 
 TEST(RefineContinuous, RejectsBadOptionsAndSizes) {
-  PlaneCase pc = MakePlane(4.0);
-  const size_t np = static_cast<size_t>(pc.vol.width) * pc.vol.height;
-  std::vector<int> labels(np, 10);
-  std::vector<float> start(np, 10.0f);
+  FlatStart f(10.0f);
+  PlaneCase& pc = f.pc;
+  const std::vector<int>& labels = f.labels;
+  const std::vector<float>& start = f.start;
+  const size_t np = f.np;
   ContinuousRefineOptions bad;
   bad.coarse_step = 2.0;  // Larger than search_labels.
   EXPECT_THROW(RefineContinuous(pc.ref, {&pc.a}, pc.vol, labels, start, pc.sweep, bad),

@@ -204,6 +204,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   report.photos.resize(n);
   std::vector<ImageF> wta(n);
   std::vector<CostVolume> shells(n);  // Sizes and depth grid; costs live in the cache.
+  std::vector<std::vector<const DenseView*>> swept(n);  // Each photo's swept neighbours.
   auto cache_path = [&](int i) {
     return (fs::path(cache_dir) / (OutputStem(ws.views[i].name) + ".cost")).string();
   };
@@ -226,7 +227,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       pr.num_labels = num_labels[i];
       pr.width = v.full_width;
       pr.height = v.full_height;
-      std::vector<const DenseView*> nbs;
+      std::vector<const DenseView*>& nbs = swept[i];
       for (int j : ws.ranked_neighbors[i]) {
         if (static_cast<int>(nbs.size()) >= options.num_neighbors) break;
         nbs.push_back(&ws.views[j]);
@@ -357,14 +358,8 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
         for (size_t p = 0; p < np; ++p) trws_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(res.labels[p]));
       }
       t0 = Clock::now();
-      if (options.refine.enabled) {
-        std::vector<const DenseView*> nbs;
-        for (int j : ws.ranked_neighbors[i]) {
-          if (static_cast<int>(nbs.size()) >= options.num_neighbors) break;
-          nbs.push_back(&ws.views[j]);
-        }
-        fl = RefineContinuous(v, nbs, vol, labels, fl, options.sweep, options.refine, inner);
-      }
+      if (options.refine.enabled)
+        fl = RefineContinuous(v, swept[i], vol, labels, fl, options.sweep, options.refine, inner);
       fl = SmoothSubLabel(vol, std::move(fl), v.color, options.sublabel, inner);
       ImageF low_depth(w, h, 1), low_conf(w, h, 1);
       for (size_t p = 0; p < np; ++p) {
