@@ -38,6 +38,8 @@ void AddPanoramaCommand(CLI::App& app) {
   cmd->add_option("--solve-width", args->options.stitch.solve_width,
                   "Width at which the stitching MRF is solved (height = width / 2)")
       ->capture_default_str();
+  cmd->add_flag("--no-gap-fill", "Leave the front layer's gaps inside the photos' field of view empty")
+      ->each([args](const std::string&) { args->options.fill_front_gaps = false; });
   cmd->add_flag("--front-only", "Front layer only (no back layer)")
       ->each([args](const std::string&) { args->options.back_layer = false; });
   cmd->add_flag("--no-gc", "Stitch without the geometric-consistency cost")

@@ -89,6 +89,9 @@ void AddSparseCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-features", s.max_features, "SIFT features per photo [500, 100000]")
       ->capture_default_str();
+  cmd->add_option("--sift-first-octave", s.sift_first_octave,
+                  "First SIFT octave: 0 at the photo's size, -1 doubled (slower, finer features) [-1, 2]")
+      ->capture_default_str();
   cmd->add_option("--threads", s.num_threads, "Threads for COLMAP (0: all cores)")
       ->capture_default_str();
   cmd->add_option("--init-tri-angle", s.init_min_tri_angle_deg,

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -30,8 +31,33 @@ Image8 FieldOfViewMask(const TwoLayerPanorama& pano, int layer,
                        const std::vector<CoverageView>& views, double reference_depth_m,
                        int num_threads, double* used_reference_depth_m) {
   if (layer < 0 || layer >= kNumLayers) throw std::invalid_argument("coverage: no such layer");
-  const int W = pano.width(), H = pano.height();
   const LayerData& data = pano.layer(layer);
+  ImageF depth(pano.width(), pano.height(), 1, 0.0f);
+  for (size_t i = 0; i < data.present.size(); ++i)
+    if (data.present[i]) depth.data()[i] = std::max(data.depth_m[i], 1e-30f);
+  return FieldOfViewMask(depth, pano.frame(), views, reference_depth_m, num_threads,
+                         used_reference_depth_m);
+}
+
+Image8 FieldOfViewMask(const ImageF& depth_m, const PanoramaFrame& frame,
+                       const std::vector<CoverageView>& views, double reference_depth_m,
+                       int num_threads, double* used_reference_depth_m) {
+  const int W = depth_m.width(), H = depth_m.height();
+  if (depth_m.channels() != 1 || W != 2 * H)
+    throw std::invalid_argument("coverage: the depth is not a one-channel equirectangular image");
+  // The layer's nodes: pixels with a depth above 0.
+  struct Nodes {
+    const ImageF& d;
+    std::vector<uint8_t> present;
+    std::vector<float> depth_m;
+  } data{depth_m, {}, {}};
+  data.present.resize(static_cast<size_t>(W) * H);
+  data.depth_m.assign(depth_m.data(), depth_m.data() + data.present.size());
+  for (size_t i = 0; i < data.present.size(); ++i) data.present[i] = data.depth_m[i] > 0 ? 1 : 0;
+  struct Indexer {
+    int W;
+    size_t index(int x, int y) const { return static_cast<size_t>(y) * W + x; }
+  } pano{W};
   if (!(reference_depth_m > 0)) {
     std::vector<float> depths;
     for (size_t i = 0; i < data.present.size(); ++i)
@@ -46,7 +72,6 @@ Image8 FieldOfViewMask(const TwoLayerPanorama& pano, int layer,
 
   // World point of panorama direction d at depth r: centre + R_frame^T (r d).
   // Camera point: R_cam (centre + R_frame^T r d) + t_cam.
-  const PanoramaFrame& frame = pano.frame();
   Eigen::Matrix3d R_frame;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) R_frame(r, c) = frame.rotation[3 * r + c];
@@ -120,6 +145,111 @@ Image8 FieldOfViewMask(const TwoLayerPanorama& pano, int layer,
       },
       4);
   return mask;
+}
+
+Image8 FootprintMask(const std::vector<warp::WarpedView>& warps, int width, int height) {
+  Image8 mask(width, height, 1, 0);
+  for (const warp::WarpedView& w : warps) {
+    const warp::WarpedLayer& f = w.front;
+    for (int cy = 0; cy < f.height(); ++cy) {
+      const int y = f.y0 + cy;
+      if (y < 0 || y >= height) continue;
+      for (int cx = 0; cx < f.width(); ++cx)
+        if (f.depth_m.at(cx, cy) > 0) mask.at(WrapColumn(f.x0 + cx, width), y) = 255;
+    }
+  }
+  return mask;
+}
+
+int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<int16_t>* label) {
+  const int W = depth_m->width(), H = depth_m->height();
+  if (mask.width() != W || mask.height() != H || rgb->width() != W || rgb->height() != H ||
+      rgb->channels() != 3 || (label && !label->empty() && (label->width() != W || label->height() != H)))
+    throw std::invalid_argument("coverage: gap filling needs images of one size");
+  const bool with_label = label && !label->empty();
+  float* depth = depth_m->data();
+  const auto gap = [&](int x, int y) { return mask.at(x, y) != 0 && !(depth[static_cast<size_t>(y) * W + x] > 0); };
+  // The farthest filled 8-neighbour of (x, y), or -1.
+  const auto farthest_neighbour = [&](int x, int y) {
+    int64_t best = -1;
+    float best_depth = 0;
+    for (int dy = -1; dy <= 1; ++dy) {
+      const int yy = y + dy;
+      if (yy < 0 || yy >= H) continue;
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0) continue;
+        const int64_t j = static_cast<int64_t>(yy) * W + WrapColumn(x + dx, W);
+        if (depth[j] > best_depth) {
+          best_depth = depth[j];
+          best = j;
+        }
+      }
+    }
+    return best;
+  };
+  std::vector<int64_t> ring;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      if (gap(x, y) && farthest_neighbour(x, y) >= 0) ring.push_back(static_cast<int64_t>(y) * W + x);
+  std::vector<uint8_t> queued(static_cast<size_t>(W) * H, 0);
+  for (int64_t i : ring) queued[i] = 1;
+  std::vector<std::pair<int64_t, int64_t>> sources;  // (pixel, its source), for one ring.
+  std::vector<std::array<uint8_t, 3>> fills;
+  std::vector<int64_t> next;
+  int64_t filled = 0;
+  while (!ring.empty()) {
+    // Each pixel of the ring: depth of its farthest filled 8-neighbour,
+    // colour the mean of the filled neighbours within 5% of that depth (a
+    // smooth extension of the background, not streaks of one pixel's colour).
+    sources.clear();
+    fills.clear();
+    for (int64_t i : ring) {
+      const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
+      const int64_t far = farthest_neighbour(x, y);
+      sources.emplace_back(i, far);
+      const float limit = 0.95f * depth[far];
+      float sum[3] = {0, 0, 0};
+      int count = 0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        const int yy = y + dy;
+        if (yy < 0 || yy >= H) continue;
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int64_t j = static_cast<int64_t>(yy) * W + WrapColumn(x + dx, W);
+          if (j == i || !(depth[j] >= limit)) continue;
+          for (int c = 0; c < 3; ++c) sum[c] += rgb->data()[3 * j + c];
+          ++count;
+        }
+      }
+      std::array<uint8_t, 3> colour;
+      for (int c = 0; c < 3; ++c) colour[c] = static_cast<uint8_t>(std::lround(sum[c] / count));
+      fills.push_back(colour);
+    }
+    // Written after the whole ring is chosen, so a ring only grows from the previous ones.
+    for (size_t k = 0; k < sources.size(); ++k) {
+      const auto [i, j] = sources[k];
+      depth[i] = depth[j];
+      for (int c = 0; c < 3; ++c) rgb->data()[3 * i + c] = fills[k][c];
+      if (with_label) label->data()[i] = label->data()[j];
+    }
+    filled += static_cast<int64_t>(sources.size());
+    next.clear();
+    for (int64_t i : ring) {
+      const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
+      for (int dy = -1; dy <= 1; ++dy) {
+        const int yy = y + dy;
+        if (yy < 0 || yy >= H) continue;
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = WrapColumn(x + dx, W);
+          const int64_t j = static_cast<int64_t>(yy) * W + xx;
+          if (queued[j] || !gap(xx, yy)) continue;
+          queued[j] = 1;
+          next.push_back(j);
+        }
+      }
+    }
+    ring.swap(next);
+  }
+  return filled;
 }
 
 CoverageStats MeasureHoles(const TwoLayerPanorama& pano, int layer, const Image8& fov,

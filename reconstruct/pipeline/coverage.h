@@ -26,6 +26,7 @@
 #include "format/two_layer.h"
 #include "reconstruct/geometry/camera.h"
 #include "reconstruct/geometry/pose.h"
+#include "reconstruct/warp/warp.h"
 
 namespace casual3d::pipeline {
 
@@ -57,6 +58,30 @@ struct CoverageStats {
 Image8 FieldOfViewMask(const TwoLayerPanorama& pano, int layer,
                        const std::vector<CoverageView>& views, double reference_depth_m = 0.0,
                        int num_threads = 0, double* used_reference_depth_m = nullptr);
+
+// The same for a layer given as its depth (one channel, width = 2 height;
+// pixels with depth > 0 are its nodes), e.g. a stitched layer before fusion.
+Image8 FieldOfViewMask(const ImageF& depth_m, const PanoramaFrame& frame,
+                       const std::vector<CoverageView>& views, double reference_depth_m = 0.0,
+                       int num_threads = 0, double* used_reference_depth_m = nullptr);
+
+// The photos' footprint: the union of the panorama pixels their front warps
+// cover (width x height x 1; 255 inside). Unlike FieldOfViewMask it needs no
+// guess of the depth in gaps: it holds exactly where the photos' surfaces land
+// (stretched triangles across depth edges included), so holes inside it are
+// surfaces the photos saw that the layer lost. The ragged edge of a footprint
+// (near leaves at a photo's border, with background never seen between them)
+// is not a hole.
+Image8 FootprintMask(const std::vector<warp::WarpedView>& warps, int width, int height);
+
+// Fills the gaps of a stitched layer inside `mask` (same size; 255 inside)
+// ring by ring from their rims: each ring's pixels take the depth and label
+// of their farthest already filled 8-neighbour (a gap inside what the photos
+// saw shows the background behind its rim) and the mean colour of the filled
+// neighbours within 5% of that depth. Columns wrap. Gaps
+// outside the mask, or with no filled pixel around them, stay empty.
+// `label` may be empty. Returns the number of pixels filled.
+int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<int16_t>* label);
 
 // The holes of `layer` of `pano` inside `fov` (same size as the panorama).
 // If `holes` is not null it receives a mask (255 = hole pixel).

@@ -151,6 +151,37 @@ TEST(CoverageTest, HolesWrapAroundTheSeam) {
   EXPECT_EQ(stats.hole_pixels, 48);
 }
 
+TEST(CoverageTest, FootprintIsTheUnionOfTheFrontWarpsAcrossTheSeam) {
+  // Two cropped warps: one straddling the +-180 degree seam, one with a gap.
+  std::vector<warp::WarpedView> warps(2);
+  warp::WarpedLayer& a = warps[0].front;
+  a.x0 = kW - 4;
+  a.y0 = 10;
+  a.depth_m = ImageF(8, 3, 1, 2.0f);
+  warp::WarpedLayer& b = warps[1].front;
+  b.x0 = 100;
+  b.y0 = 200;
+  b.depth_m = ImageF(5, 5, 1, 3.0f);
+  b.depth_m.at(2, 2) = 0.0f;  // Nothing landed here.
+  const Image8 mask = FootprintMask(warps, kW, kH);
+  int inside = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) inside += mask.at(x, y) != 0;
+  EXPECT_EQ(inside, 24 + 24);
+  EXPECT_EQ(mask.at(kW - 4, 10), 255);
+  EXPECT_EQ(mask.at(3, 12), 255);
+  EXPECT_EQ(mask.at(4, 12), 0);
+  EXPECT_EQ(mask.at(102, 202), 0);
+  EXPECT_EQ(mask.at(104, 204), 255);
+  // Holes of a layer inside the footprint: the layer has nodes on warp a only.
+  TwoLayerPanorama pano(kW, kH);
+  for (int y = 10; y < 13; ++y)
+    for (int x : {kW - 4, kW - 3, kW - 2, kW - 1, 0, 1, 2, 3}) pano.layer(kFront).present[pano.index(x, y)] = 1;
+  const CoverageStats stats = MeasureHoles(pano, kFront, mask);
+  EXPECT_EQ(stats.num_holes, 1);
+  EXPECT_EQ(stats.hole_pixels, 24);
+}
+
 TEST(CoverageTest, RejectsAMaskOfTheWrongSize) {
   const TwoLayerPanorama pano = FullFront(2.0f);
   EXPECT_THROW(MeasureHoles(pano, kFront, Image8(10, 5, 1, 0)), std::invalid_argument);

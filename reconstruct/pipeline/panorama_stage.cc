@@ -241,6 +241,7 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
     coarse = warp::WarpViews(views, frame, warp_coarse, options.num_threads);
   }
   photos.clear();  // The warps hold everything needed from here on.
+  const Image8 footprint = FootprintMask(full, W, H);
   report.seconds_warp = Seconds(t);
 
   // Stitch front, then back.
@@ -263,8 +264,16 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   full.clear();
   coarse.clear();
 
-  // Fuse and normals.
+  // The photos' field of view, from the stitched front layer; its gaps
+  // inside the field of view are filled from their rims.
   t = Clock::now();
+  double reference_depth = 0.0;
+  const Image8 fov = FieldOfViewMask(front.depth_m, frame, coverage_views, 0.0,
+                                     options.num_threads, &reference_depth);
+  if (options.fill_front_gaps)
+    report.front_gaps_filled = FillGapsInside(fov, &front.rgb, &front.depth_m, &front.label);
+
+  // Fuse and normals.
   fuse::FuseOptions fuse_options = options.fuse;
   if (!options.back_layer) fuse_options.expansion_fraction = 0;
   TwoLayerPanorama pano = fuse::Fuse({&front.rgb, &front.depth_m, &back.rgb, &back.depth_m, frame},
@@ -275,14 +284,19 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   report.seconds_normals = Seconds(t);
   report.front_coverage =
       static_cast<double>(report.fuse.front_nodes) / (static_cast<double>(W) * H);
-  Image8 fov, holes;
-  report.front_fov =
-      MeasureCoverage(pano, kFront, coverage_views, options.num_threads, &fov, &holes);
+  Image8 holes;
+  report.front_fov = MeasureHoles(pano, kFront, fov, &holes);
+  report.front_fov.reference_depth_m = reference_depth;
   util::LogInfo("panorama: front layer covers " +
                 std::to_string(100.0 * report.front_fov.covered_fraction) +
                 "% of the photos' field of view; " + std::to_string(report.front_fov.num_holes) +
                 " holes, the largest " +
                 std::to_string(100.0 * report.front_fov.largest_hole_fraction) + "% of it");
+  report.front_footprint = MeasureHoles(pano, kFront, footprint);
+  util::LogInfo("panorama: front layer covers " +
+                std::to_string(100.0 * report.front_footprint.covered_fraction) +
+                "% of the photos' footprint; the largest hole " +
+                std::to_string(100.0 * report.front_footprint.largest_hole_fraction) + "% of it");
 
   // Write.
   t = Clock::now();
@@ -304,17 +318,21 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   j["back_layer"] = options.back_layer;
   j["sky_depth_m"] = report.sky_depth_m;
   j["front_coverage"] = report.front_coverage;
-  const CoverageStats& c = report.front_fov;
-  j["front_fov"] = {{"fov_pixels", c.fov_pixels},
-                    {"fov_steradians", c.fov_steradians},
-                    {"covered_fraction", c.covered_fraction},
-                    {"holes", c.num_holes},
-                    {"hole_pixels", c.hole_pixels},
-                    {"largest_hole_pixels", c.largest_hole_pixels},
-                    {"largest_hole_fraction", c.largest_hole_fraction},
-                    {"interior_holes", c.num_interior_holes},
-                    {"largest_interior_hole_fraction", c.largest_interior_hole_fraction},
-                    {"reference_depth_m", c.reference_depth_m}};
+  auto coverage_json = [](const CoverageStats& c) {
+    return nlohmann::json{{"fov_pixels", c.fov_pixels},
+                          {"fov_steradians", c.fov_steradians},
+                          {"covered_fraction", c.covered_fraction},
+                          {"holes", c.num_holes},
+                          {"hole_pixels", c.hole_pixels},
+                          {"largest_hole_pixels", c.largest_hole_pixels},
+                          {"largest_hole_fraction", c.largest_hole_fraction},
+                          {"interior_holes", c.num_interior_holes},
+                          {"largest_interior_hole_fraction", c.largest_interior_hole_fraction},
+                          {"reference_depth_m", c.reference_depth_m}};
+  };
+  j["front_fov"] = coverage_json(report.front_fov);
+  j["front_gaps_filled"] = report.front_gaps_filled;
+  j["front_footprint"] = coverage_json(report.front_footprint);
   j["fuse"] = {{"front_nodes", report.fuse.front_nodes},
                {"back_nodes_in", report.fuse.back_nodes_in},
                {"back_nodes_redundant", report.fuse.back_nodes_redundant},

@@ -39,6 +39,10 @@ struct PanoramaStageOptions {
   normals::NormalOptions normals;
   // false: front layer only (the ablation of the paper's Fig. 15 / issue 8).
   bool back_layer = true;
+  // Fill the front layer's gaps inside the photos' field of view
+  // (coverage.h, FillGapsInside) before fusion: the ragged edges of the
+  // photos' footprints, where near leaves or poles end at a photo's border.
+  bool fill_front_gaps = true;
   // Depth given to photo pixels without a finite depth (sky), metres; 0 =
   // automatic: 1.5 x the largest finite depth of all photos.
   double sky_depth_m = 0.0;
@@ -58,8 +62,15 @@ struct PanoramaStageReport {
   normals::NormalStats normals;
   double front_coverage = 0.0;  // Fraction of pixels with a front node.
   // The front layer inside the photos' field of view: coverage and holes
-  // (coverage.h).
+  // (coverage.h); the field of view comes from the stitched front layer
+  // before its gaps are filled.
   CoverageStats front_fov;
+  // Front pixels filled by fill_front_gaps (already counted in front_fov).
+  int64_t front_gaps_filled = 0;
+  // The front layer inside the photos' footprint (union of their front
+  // warps, FootprintMask): holes here are surfaces the photos saw that
+  // stitching or fusion lost.
+  CoverageStats front_footprint;
 };
 
 // Runs warp, stitch, fuse and normals; writes OUT (created if needed) and

@@ -86,6 +86,11 @@ void CheckAgainstGroundTruth(synth::RigKind rig, int photos, double min_within_3
   EXPECT_GT(fov.fov_pixels, 0);
   EXPECT_GE(fov.covered_fraction, 0.99);
   EXPECT_LE(fov.largest_hole_fraction, 0.002);
+  const CoverageStats& foot = report.front_footprint;
+  std::printf("footprint %.3f sr: %.4f covered, %d holes, largest %.5f\n", foot.fov_steradians,
+              foot.covered_fraction, foot.num_holes, foot.largest_hole_fraction);
+  EXPECT_GE(foot.covered_fraction, 0.99);
+  EXPECT_LE(foot.largest_hole_fraction, 0.002);
   fs::remove_all(dir);
 }
 

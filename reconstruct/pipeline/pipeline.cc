@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 // Bump when a stage's output format or algorithm changes, so old caches are stale.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-1", "dense-2", "panorama-1",
+constexpr const char* kStageVersions[kNumStages] = {"sparse-1", "dense-2", "panorama-2",
                                                     "encode-1"};
 
 std::string HashHex(const std::string& text) {
@@ -57,6 +57,7 @@ std::string SparseOptionsText(const sfm::SparseStageOptions& o) {
     << " allow_mixed_devices=" << o.import.allow_mixed_devices << " focal_px=" << o.import.focal_px
     << " camera_model=" << o.camera_model << " shared_camera=" << o.shared_camera
     << " matcher=" << static_cast<int>(o.matcher) << " max_features=" << o.max_features
+    << " sift_first_octave=" << o.sift_first_octave
     << " min_registered_fraction=" << o.min_registered_fraction;
   return s.str();
 }
@@ -75,7 +76,8 @@ std::string DenseOptionsText(const depth::DenseOptions& o) {
 std::string PanoramaOptionsText(const PanoramaStageOptions& o) {
   std::ostringstream s;
   s << "pano_width=" << o.pano_width << " solve=" << o.stitch.solve_width
-    << " back_layer=" << o.back_layer << " tau_stretch=" << o.warp.tau_stretch_deg
+    << " back_layer=" << o.back_layer << " fill_front_gaps=" << o.fill_front_gaps
+    << " tau_stretch=" << o.warp.tau_stretch_deg
     << " lambda_gc=" << o.stitch.lambda_gc << " tau_dratio=" << o.fuse.tau_dratio
     << " expansion=" << o.fuse.expansion_fraction << " sky_depth=" << o.sky_depth_m;
   return s.str();
@@ -284,6 +286,8 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
               {"fov_covered_fraction", r.front_fov.covered_fraction},
               {"fov_holes", r.front_fov.num_holes},
               {"fov_largest_hole_fraction", r.front_fov.largest_hole_fraction},
+              {"footprint_covered_fraction", r.front_footprint.covered_fraction},
+              {"footprint_largest_hole_fraction", r.front_footprint.largest_hole_fraction},
               {"back_nodes", r.fuse.back_nodes_in - r.fuse.back_nodes_redundant +
                                  r.fuse.back_nodes_hallucinated}};
         });

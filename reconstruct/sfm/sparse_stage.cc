@@ -238,6 +238,7 @@ Json OptionsJson(const SparseStageOptions& o) {
           {"exhaustive_max_photos", o.exhaustive_max_photos},
           {"sequential_overlap", o.sequential_overlap},
           {"max_features", o.max_features},
+          {"sift_first_octave", o.sift_first_octave},
           {"num_threads", o.num_threads},
           {"init_min_tri_angle_deg", o.init_min_tri_angle_deg},
           {"min_registered_fraction", o.min_registered_fraction},
@@ -274,6 +275,10 @@ Status SparseStageOptions::Check() const {
   if (max_features < 500 || max_features > 100000) {
     return InvalidArgument("max_features " + std::to_string(max_features) +
                            " is outside [500, 100000]");
+  }
+  if (sift_first_octave < -1 || sift_first_octave > 2) {
+    return InvalidArgument("sift_first_octave " + std::to_string(sift_first_octave) +
+                           " is outside [-1, 2]");
   }
   if (num_threads < 0 || num_threads > 1024) {
     return InvalidArgument("num_threads " + std::to_string(num_threads) + " is outside [0, 1024]");
@@ -390,7 +395,8 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
           list.string(), "--ImageReader.camera_model", options.camera_model,
           "--ImageReader.single_camera", options.shared_camera ? "1" : "0",
           "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
-          "--SiftExtraction.max_num_features", std::to_string(options.max_features)};
+          "--SiftExtraction.max_num_features", std::to_string(options.max_features),
+          "--SiftExtraction.first_octave", std::to_string(options.sift_first_octave)};
       if (group.focal_px > 0) {
         args.push_back("--ImageReader.camera_params");
         args.push_back(CameraParams(options.camera_model, group.focal_px, group.width, group.height));

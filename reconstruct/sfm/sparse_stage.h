@@ -58,6 +58,12 @@ struct SparseStageOptions {
   // fern, fountain-P11 and the default synthetic capture with rotation errors
   // under 0.05 degree (fountain: 0.31); raise it for weakly textured scenes.
   int max_features = 4096;  // Range [500, 1e5].
+  // First octave of the SIFT pyramid. COLMAP's -1 doubles each photo before
+  // detection, for features finer than a pixel; at the working size of about
+  // 1.2 MP that triples extraction and doubles matching time for features the
+  // mapper hardly needs (docs/PERFORMANCE.md, "Sparse stage"). -1 for tiny
+  // photos or weak texture.
+  int sift_first_octave = 0;  // Range [-1, 2].
   int num_threads = 0;             // Range [0, 1024]; 0 = all cores.
   // Smallest triangulation angle of the mapper's initial pair, degrees.
   // COLMAP's 16 suits walk-around captures; a casual capture's photos sit on a
