@@ -57,7 +57,7 @@ struct SparseStageOptions {
   // 4096 matches 4x faster than COLMAP's 8192 and registered every photo of
   // fern, fountain-P11 and the default synthetic capture with rotation errors
   // under 0.05 degree (fountain: 0.31); raise it for weakly textured scenes.
-  int max_features = 4096;  // Range [500, 1e5].
+  int max_features = 2048;  // Range [500, 1e5].
   // First octave of the SIFT pyramid. COLMAP's -1 doubles each photo before
   // detection, for features finer than a pixel; at the working size of about
   // 1.2 MP that triples extraction and doubles matching time for features the
