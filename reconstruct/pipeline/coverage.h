@@ -76,9 +76,10 @@ Image8 FootprintMask(const std::vector<warp::WarpedView>& warps, int width, int 
 
 // Fills the gaps of a stitched layer inside `mask` (same size; 255 inside)
 // ring by ring from their rims: each ring's pixels take the depth and label
-// of their farthest already filled 8-neighbour (a gap inside what the photos
-// saw shows the background behind its rim) and the mean colour of the filled
-// neighbours within 5% of that depth. Columns wrap. Gaps
+// of their farthest already filled 8-neighbour (where a ring touches a nearer
+// and a farther surface, the farther one, the background, continues) and the
+// mean colour of the filled neighbours within 5% of that depth. A gap between
+// two surfaces closes from both sides. Columns wrap. Gaps
 // outside the mask, or with no filled pixel around them, stay empty.
 // `label` may be empty. Returns the number of pixels filled.
 int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<int16_t>* label);

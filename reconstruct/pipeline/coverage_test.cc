@@ -182,6 +182,56 @@ TEST(CoverageTest, FootprintIsTheUnionOfTheFrontWarpsAcrossTheSeam) {
   EXPECT_EQ(stats.hole_pixels, 24);
 }
 
+TEST(CoverageTest, GapsInsideTheMaskCloseRingByRingFromTheirRims) {
+  constexpr int W = 16, H = 8;
+  Image8 rgb(W, H, 3, 0), mask(W, H, 1, 0);
+  ImageF depth(W, H, 1, 0.0f);
+  Image<int16_t> label(W, H, 1, -1);
+  auto set = [&](int x, int y, float d, uint8_t grey, int16_t l) {
+    depth.at(x, y) = d;
+    for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = grey;
+    label.at(x, y) = l;
+  };
+  // Row 2..5: a near object (1 m, grey 200) in columns 0..3, a gap in 4..7,
+  // a far wall (10 m, grey 60 or 80 in alternate rows) in 8..12; columns
+  // 13..15 are a gap that wraps around to the near object.
+  for (int y = 2; y <= 5; ++y) {
+    for (int x = 0; x <= 3; ++x) set(x, y, 1.0f, 200, 1);
+    for (int x = 8; x <= 12; ++x) set(x, y, 10.0f, y % 2 ? 60 : 80, 2);
+  }
+  for (int y = 2; y <= 5; ++y)
+    for (int x = 0; x < W; ++x) mask.at(x, y) = 255;
+  mask.at(13, 5) = 0;  // Outside the field of view: stays empty.
+  const int64_t filled = FillGapsInside(mask, &rgb, &depth, &label);
+  EXPECT_EQ(filled, 4 * 4 + 3 * 4 - 1);
+  for (int y = 2; y <= 5; ++y) {
+    // The gap between the object and the wall closes from both sides, one
+    // ring a step: columns 4 and 5 continue the object, 6 and 7 the wall.
+    for (int x = 4; x <= 7; ++x) {
+      const bool wall = x >= 6;
+      EXPECT_FLOAT_EQ(depth.at(x, y), wall ? 10.0f : 1.0f) << x << "," << y;
+      EXPECT_EQ(label.at(x, y), wall ? 2 : 1);
+    }
+    // Columns 13..15 between the wall (column 12) and the object (column 0,
+    // across the seam): 13 from the wall, 15 from the object, and 14, which
+    // both rings reach at once, from the farther of the two.
+    if (y < 5) EXPECT_FLOAT_EQ(depth.at(13, y), 10.0f) << y;
+    EXPECT_FLOAT_EQ(depth.at(14, y), 10.0f) << y;
+    EXPECT_FLOAT_EQ(depth.at(15, y), 1.0f) << y;
+  }
+  // Colour: the mean of the filled neighbours at the chosen depth (the
+  // wall's greys 80, 60, 80 next to (7, 3)).
+  EXPECT_EQ(rgb.at(7, 3, 0), 73);
+  EXPECT_EQ(rgb.at(5, 3, 0), 200);
+  EXPECT_FLOAT_EQ(depth.at(13, 5), 0.0f);
+  // Rows outside the mask stay empty.
+  for (int x = 0; x < W; ++x) EXPECT_FLOAT_EQ(depth.at(x, 0), 0.0f);
+  // Nothing to fill from: an empty layer stays empty.
+  ImageF empty(W, H, 1, 0.0f);
+  Image8 empty_rgb(W, H, 3, 0);
+  EXPECT_EQ(FillGapsInside(mask, &empty_rgb, &empty, nullptr), 0);
+}
+
 TEST(CoverageTest, RejectsAMaskOfTheWrongSize) {
   const TwoLayerPanorama pano = FullFront(2.0f);
   EXPECT_THROW(MeasureHoles(pano, kFront, Image8(10, 5, 1, 0)), std::invalid_argument);

@@ -53,10 +53,11 @@ struct SparseStageOptions {
   int exhaustive_max_photos = 60;  // Range [3, 1e5]; kAuto's switch-over.
   int sequential_overlap = 10;     // Range [1, 1000]; neighbours matched by kSequential.
   // SIFT features per photo (COLMAP keeps the coarsest ones when it caps;
-  // orientations add about half again). Matching time grows with the square:
-  // 4096 matches 4x faster than COLMAP's 8192 and registered every photo of
-  // fern, fountain-P11 and the default synthetic capture with rotation errors
-  // under 0.05 degree (fountain: 0.31); raise it for weakly textured scenes.
+  // orientations add about half again). Matching time grows with the square.
+  // With sift_first_octave 0, 2048 registered every photo of fern,
+  // fountain-P11 and the default synthetic capture with poses as accurate as
+  // 4096 or COLMAP's 8192 (docs/PERFORMANCE.md, "Sparse stage"); raise it for
+  // weakly textured scenes.
   int max_features = 2048;  // Range [500, 1e5].
   // First octave of the SIFT pyramid. COLMAP's -1 doubles each photo before
   // detection, for features finer than a pixel; at the working size of about
