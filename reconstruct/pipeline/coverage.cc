@@ -46,22 +46,13 @@ Image8 FieldOfViewMask(const ImageF& depth_m, const PanoramaFrame& frame,
   if (depth_m.channels() != 1 || W != 2 * H)
     throw std::invalid_argument("coverage: the depth is not a one-channel equirectangular image");
   // The layer's nodes: pixels with a depth above 0.
-  struct Nodes {
-    const ImageF& d;
-    std::vector<uint8_t> present;
-    std::vector<float> depth_m;
-  } data{depth_m, {}, {}};
-  data.present.resize(static_cast<size_t>(W) * H);
-  data.depth_m.assign(depth_m.data(), depth_m.data() + data.present.size());
-  for (size_t i = 0; i < data.present.size(); ++i) data.present[i] = data.depth_m[i] > 0 ? 1 : 0;
-  struct Indexer {
-    int W;
-    size_t index(int x, int y) const { return static_cast<size_t>(y) * W + x; }
-  } pano{W};
+  const float* depth = depth_m.data();
+  const size_t num_pixels = static_cast<size_t>(W) * H;
+  const auto index = [W](int x, int y) { return static_cast<size_t>(y) * W + x; };
   if (!(reference_depth_m > 0)) {
     std::vector<float> depths;
-    for (size_t i = 0; i < data.present.size(); ++i)
-      if (data.present[i]) depths.push_back(data.depth_m[i]);
+    for (size_t i = 0; i < num_pixels; ++i)
+      if (depth[i] > 0) depths.push_back(depth[i]);
     reference_depth_m = 1.0;
     if (!depths.empty()) {
       std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
@@ -96,12 +87,10 @@ Image8 FieldOfViewMask(const ImageF& depth_m, const PanoramaFrame& frame,
   // reach there), or the reference depth when the layer is empty.
   cv::Mat nearest_label;
   std::vector<float> label_depth;
-  if (!data.present.empty() &&
-      std::find(data.present.begin(), data.present.end(), 1) != data.present.end()) {
+  if (std::any_of(depth, depth + num_pixels, [](float d) { return d > 0; })) {
     cv::Mat absent(H, W, CV_8U);
     for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x)
-        absent.at<uint8_t>(y, x) = data.present[pano.index(x, y)] ? 0 : 255;
+      for (int x = 0; x < W; ++x) absent.at<uint8_t>(y, x) = depth[index(x, y)] > 0 ? 0 : 255;
     cv::Mat distance;
     cv::distanceTransform(absent, distance, nearest_label, cv::DIST_L2, cv::DIST_MASK_5,
                           cv::DIST_LABEL_PIXEL);
@@ -109,7 +98,7 @@ Image8 FieldOfViewMask(const ImageF& depth_m, const PanoramaFrame& frame,
     label_depth.push_back(static_cast<float>(reference_depth_m));
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x)
-        if (data.present[pano.index(x, y)]) label_depth.push_back(data.depth_m[pano.index(x, y)]);
+        if (depth[index(x, y)] > 0) label_depth.push_back(depth[index(x, y)]);
   }
 
   Image8 mask(W, H, 1, 0);
@@ -119,10 +108,10 @@ Image8 FieldOfViewMask(const ImageF& depth_m, const PanoramaFrame& frame,
         const int y = static_cast<int>(y64);
         size_t last_hit = 0;  // Neighbouring pixels usually fall in the same photo.
         for (int x = 0; x < W; ++x) {
-          const size_t i = pano.index(x, y);
+          const size_t i = index(x, y);
           double r = reference_depth_m;
-          if (data.present[i]) {
-            r = data.depth_m[i];
+          if (depth[i] > 0) {
+            r = depth[i];
           } else if (!label_depth.empty()) {
             const int label = nearest_label.at<int>(y, x);
             if (label > 0 && label < static_cast<int>(label_depth.size())) r = label_depth[label];
