@@ -7,6 +7,10 @@
 
 #include <CLI/CLI.hpp>
 
+namespace casual3d::sfm {
+struct SparseStageOptions;
+}
+
 namespace casual3d::cli {
 
 // Options every command understands (set by main before the command runs).
@@ -21,6 +25,10 @@ void AddViewCommand(CLI::App& app);
 
 // `casual3d sparse <photos-or-workspace> -o <out>` (cli/sparse_command.cc).
 void AddSparseCommand(CLI::App& app);
+
+// --max-features and --sift-first-octave, shared by `sparse` and
+// `reconstruct` (cli/sparse_command.cc).
+void AddSiftOptions(CLI::App* cmd, sfm::SparseStageOptions* options);
 
 // `casual3d dense <workspace> -o <out>` (cli/dense_command.cc).
 void AddDenseCommand(CLI::App& app);

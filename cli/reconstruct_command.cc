@@ -47,12 +47,7 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_option("--working-megapixels", args->working_megapixels,
                   "Photos are downscaled to about this size before matching and depth")
       ->capture_default_str();
-  cmd->add_option("--max-features", args->options.sparse.max_features,
-                  "SIFT features per photo for structure from motion [500, 100000]")
-      ->capture_default_str();
-  cmd->add_option("--sift-first-octave", args->options.sparse.sift_first_octave,
-                  "First SIFT octave: 0 at the photo's size, -1 doubled (slower, finer features) [-1, 2]")
-      ->capture_default_str();
+  AddSiftOptions(cmd, &args->options.sparse);
   cmd->add_flag("--no-gap-fill", "Leave the front layer's gaps inside the photos' field of view empty")
       ->each([args](const std::string&) { args->options.panorama.fill_front_gaps = false; });
   cmd->add_flag("--no-near-envelope", args->no_near_envelope,

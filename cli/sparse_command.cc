@@ -56,6 +56,15 @@ void RunSparse(SparseCommandOptions options) {
 
 }  // namespace
 
+void AddSiftOptions(CLI::App* cmd, sfm::SparseStageOptions* options) {
+  cmd->add_option("--max-features", options->max_features,
+                  "SIFT features per photo for structure from motion [500, 100000]")
+      ->capture_default_str();
+  cmd->add_option("--sift-first-octave", options->sift_first_octave,
+                  "First SIFT octave: 0 at the photo's size, -1 doubled (slower, finer features) [-1, 2]")
+      ->capture_default_str();
+}
+
 void AddSparseCommand(CLI::App& app) {
   auto options = std::make_shared<SparseCommandOptions>();
   sfm::SparseStageOptions& s = options->stage;
@@ -87,11 +96,7 @@ void AddSparseCommand(CLI::App& app) {
   cmd->add_option("--matcher", options->matcher, "auto, exhaustive or sequential")
       ->check(CLI::IsMember({"auto", "exhaustive", "sequential"}))
       ->capture_default_str();
-  cmd->add_option("--max-features", s.max_features, "SIFT features per photo [500, 100000]")
-      ->capture_default_str();
-  cmd->add_option("--sift-first-octave", s.sift_first_octave,
-                  "First SIFT octave: 0 at the photo's size, -1 doubled (slower, finer features) [-1, 2]")
-      ->capture_default_str();
+  AddSiftOptions(cmd, &s);
   cmd->add_option("--threads", s.num_threads, "Threads for COLMAP (0: all cores)")
       ->capture_default_str();
   cmd->add_option("--init-tri-angle", s.init_min_tri_angle_deg,

@@ -37,21 +37,9 @@ int AutomaticLevels(int width, int height) {
 }
 
 DepthQuantization DepthRange(const TwoLayerPanorama& pano) {
-  double near_m = 0, far_m = 0;
-  bool any = false;
-  for (int l = 0; l < kNumLayers; ++l) {
-    const LayerData& L = pano.layer(l);
-    for (size_t i = 0; i < L.present.size(); ++i) {
-      if (!L.present[i]) continue;
-      const double d = L.depth_m[i];
-      near_m = any ? std::min(near_m, d) : d;
-      far_m = any ? std::max(far_m, d) : d;
-      any = true;
-    }
-  }
   DepthQuantization q;
-  q.near_m = any ? near_m : 1.0;
-  q.far_m = any ? far_m : 1.0;
+  q.near_m = q.far_m = 1.0;  // An empty panorama.
+  pano.NodeDepthRange(&q.near_m, &q.far_m);
   return q;
 }
 

@@ -1,5 +1,6 @@
 #include "format/two_layer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -148,6 +149,21 @@ TwoLayerPanorama::TwoLayerPanorama(int width, int height) : width_(width), heigh
     layer.label.assign(n, 0);
     layer.links.assign(n, 0);
   }
+}
+
+bool TwoLayerPanorama::NodeDepthRange(double* near_m, double* far_m) const {
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (const LayerData& L : layers_) {
+    for (size_t i = 0; i < L.present.size(); ++i) {
+      if (!L.present[i] || !std::isfinite(L.depth_m[i])) continue;
+      lo = std::min(lo, L.depth_m[i]);
+      hi = std::max(hi, L.depth_m[i]);
+    }
+  }
+  if (!(lo <= hi)) return false;
+  *near_m = lo;
+  *far_m = hi;
+  return true;
 }
 
 bool TwoLayerPanorama::Neighbour(int x, int y, Direction d, int* nx, int* ny) const {

@@ -66,6 +66,10 @@ class TwoLayerPanorama {
   // The pixel next to (x, y) in direction d; false past the top or bottom row.
   bool Neighbour(int x, int y, Direction d, int* nx, int* ny) const;
 
+  // Smallest and largest depth of the present nodes of both layers (finite
+  // ones only); false, leaving both untouched, when there is no such node.
+  bool NodeDepthRange(double* near_m, double* far_m) const;
+
   PanoramaFrame& frame() { return frame_; }
   const PanoramaFrame& frame() const { return frame_; }
 

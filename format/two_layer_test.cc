@@ -59,6 +59,26 @@ TEST(TwoLayerTest, ConstructorMakesAllNodesAbsentAndValid) {
   EXPECT_TRUE(p.Validate().ok()) << p.Validate().ToString();
 }
 
+TEST(TwoLayerTest, NodeDepthRangeSpansThePresentNodesOfBothLayers) {
+  TwoLayerPanorama pano(8, 4);
+  double near_m = -1, far_m = -1;
+  EXPECT_FALSE(pano.NodeDepthRange(&near_m, &far_m));
+  EXPECT_EQ(near_m, -1);
+  EXPECT_EQ(far_m, -1);
+  LayerData& f = pano.layer(kFront);
+  LayerData& b = pano.layer(kBack);
+  f.present[pano.index(1, 1)] = 1;
+  f.depth_m[pano.index(1, 1)] = 2.5f;
+  f.present[pano.index(2, 1)] = 1;
+  f.depth_m[pano.index(2, 1)] = 4.0f;
+  b.present[pano.index(2, 1)] = 1;
+  b.depth_m[pano.index(2, 1)] = 30.0f;
+  f.depth_m[pano.index(5, 2)] = 0.1f;  // Absent: not counted.
+  ASSERT_TRUE(pano.NodeDepthRange(&near_m, &far_m));
+  EXPECT_EQ(near_m, 2.5);
+  EXPECT_EQ(far_m, 30.0);
+}
+
 TEST(TwoLayerTest, LinkPackingRoundTrips) {
   uint8_t links = 0;
   links = SetLink(links, kRight, Link::kBack);

@@ -134,6 +134,24 @@ ImageF ReadGroundTruth(const std::string& dir, const std::string& stem) {
   return gt;
 }
 
+// Runs body(i) for every photo of `views`, `outer` photos at a time. A
+// photo's failure does not stop the others; the first one, named by its
+// photo, is thrown once all have run.
+template <typename Body>
+void ForEachPhoto(const std::vector<DenseView>& views, int outer, Body&& body) {
+  std::mutex mutex;
+  std::string first_error;
+  ParallelFor(0, static_cast<int64_t>(views.size()), outer, [&](int64_t i) {
+    try {
+      body(static_cast<int>(i));
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (first_error.empty()) first_error = views[i].name + ": " + e.what();
+    }
+  });
+  if (!first_error.empty()) throw std::runtime_error(first_error);
+}
+
 }  // namespace
 
 Status MrfTermOptions::Check() const {
@@ -209,6 +227,10 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     return (fs::path(cache_dir) / (OutputStem(ws.views[i].name) + ".cost")).string();
   };
 
+  // Photos run `outer` at a time in both passes, `inner` threads each.
+  const int outer = std::min(threads, n);
+  const int inner = std::max(1, threads / outer);
+
   // Pass 1: cost volumes and WTA depth maps of every photo (the GC filter
   // needs all WTA maps before any envelope can be built). Photos run
   // concurrently, one thread each: a sweep splits its planes over threads
@@ -216,11 +238,8 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   // (docs/PERFORMANCE.md, "Dense"). Results do not depend on the split.
   {
     util::Progress progress("dense: plane sweep", n);
-    const int outer1 = std::min(threads, n);
     SweepOptions sweep = options.sweep;
-    sweep.num_threads = std::max(1, threads / outer1);
-    std::mutex sweep_error_mutex;
-    std::string sweep_error;
+    sweep.num_threads = inner;
     for (int i = 0; i < n; ++i) {
       const DenseView& v = ws.views[i];
       PhotoReport& pr = report.photos[i];
@@ -239,28 +258,21 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
         pr.neighbors.push_back(ws.views[j].name);
       }
     }
-    ParallelFor(0, n, outer1, [&](int64_t ii) {
-      const int i = static_cast<int>(ii);
-      try {
-        const auto t0 = Clock::now();
-        SweepOptions photo_sweep = sweep;
-        photo_sweep.num_depths = num_labels[i];
-        CostVolume vol = ComputeCostVolume(ws.views[i], swept[i], photo_sweep);
-        wta[i] = WinnerTakesAll(vol, photo_sweep.num_threads);
-        WriteCostCache(cache_path(i), vol);
-        shells[i].width = vol.width;
-        shells[i].height = vol.height;
-        shells[i].num_labels = vol.num_labels;
-        shells[i].inv_near = vol.inv_near;
-        shells[i].inv_far = vol.inv_far;
-        report.photos[i].t_sweep = Since(t0);
-        progress.Advance();
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lock(sweep_error_mutex);
-        if (sweep_error.empty()) sweep_error = ws.views[i].name + ": " + e.what();
-      }
+    ForEachPhoto(ws.views, outer, [&](int i) {
+      const auto t0 = Clock::now();
+      SweepOptions photo_sweep = sweep;
+      photo_sweep.num_depths = num_labels[i];
+      CostVolume vol = ComputeCostVolume(ws.views[i], swept[i], photo_sweep);
+      wta[i] = WinnerTakesAll(vol, photo_sweep.num_threads);
+      WriteCostCache(cache_path(i), vol);
+      shells[i].width = vol.width;
+      shells[i].height = vol.height;
+      shells[i].num_labels = vol.num_labels;
+      shells[i].inv_near = vol.inv_near;
+      shells[i].inv_far = vol.inv_far;
+      report.photos[i].t_sweep = Since(t0);
+      progress.Advance();
     });
-    if (!sweep_error.empty()) throw std::runtime_error(sweep_error);
   }
 
   // Pass 2: envelope, MRF, upsampling and outputs. Photos run concurrently,
@@ -275,196 +287,184 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   const double diag_ratio =
       std::hypot(ws.views[0].camera.width, ws.views[0].camera.height) / options.reference_diagonal;
   util::Progress progress("dense: envelope + MRF", n);
-  std::mutex error_mutex;
-  std::string first_error;
-  const int outer = std::min(threads, n);
-  const int inner = std::max(1, threads / outer);
+  ForEachPhoto(ws.views, outer, [&](int i) {
+    const DenseView& v = ws.views[i];
+    PhotoReport& pr = report.photos[i];
+    const std::string stem = OutputStem(v.name);
+    const LabelGrid grid{shells[i].inv_near, shells[i].inv_far, shells[i].num_labels};
+    auto t0 = Clock::now();
 
-  ParallelFor(0, n, outer, [&](int64_t ii) {
-    const int i = static_cast<int>(ii);
-    try {
-      const DenseView& v = ws.views[i];
-      PhotoReport& pr = report.photos[i];
-      const std::string stem = OutputStem(v.name);
-      const LabelGrid grid{shells[i].inv_near, shells[i].inv_far, shells[i].num_labels};
-      auto t0 = Clock::now();
+    // Anchors (Fig. 4a-d).
+    const ImageF gc = options.use_gc_filter
+                          ? GeometricConsistencyFilter(i, view_ptrs, wta_ptrs, ws.ranked_neighbors[i],
+                                                       grid.InvStep(), options.gc, inner)
+                          : wta[i];
+    MedianPruneOptions prune = options.prune;
+    prune.small_radius = ScaledRadius(options.prune.small_radius, diag_ratio);
+    prune.large_radius = ScaledRadius(options.prune.large_radius, diag_ratio);
+    const ImageF med = MedianPrune(gc, grid, prune, inner);
+    const ImageF bil = BilateralMedianPrune(med, v.color, grid, prune, inner);
+    pr.anchors = {CountValid(wta[i]), CountValid(gc), CountValid(med), CountValid(bil)};
 
-      // Anchors (Fig. 4a-d).
-      const ImageF gc = options.use_gc_filter
-                            ? GeometricConsistencyFilter(i, view_ptrs, wta_ptrs, ws.ranked_neighbors[i],
-                                                         grid.InvStep(), options.gc, inner)
-                            : wta[i];
-      MedianPruneOptions prune = options.prune;
-      prune.small_radius = ScaledRadius(options.prune.small_radius, diag_ratio);
-      prune.large_radius = ScaledRadius(options.prune.large_radius, diag_ratio);
-      const ImageF med = MedianPrune(gc, grid, prune, inner);
-      const ImageF bil = BilateralMedianPrune(med, v.color, grid, prune, inner);
-      pr.anchors = {CountValid(wta[i]), CountValid(gc), CountValid(med), CountValid(bil)};
+    // Propagation and envelope (Fig. 4e-f).
+    EnvelopeOptions env_opt = options.envelope;
+    env_opt.variance_radius = ScaledRadius(options.envelope.variance_radius, diag_ratio);
+    PropagationStats ps;
+    const ImageF propagated = PropagateAnchors(bil, v.color, env_opt, &ps);
+    pr.cg_iterations = ps.iterations;
+    ImageF envelope;
+    if (!propagated.empty()) envelope = FinalizeEnvelope(propagated, env_opt);
+    pr.t_envelope = Since(t0);
 
-      // Propagation and envelope (Fig. 4e-f).
-      EnvelopeOptions env_opt = options.envelope;
-      env_opt.variance_radius = ScaledRadius(options.envelope.variance_radius, diag_ratio);
-      PropagationStats ps;
-      const ImageF propagated = PropagateAnchors(bil, v.color, env_opt, &ps);
-      pr.cg_iterations = ps.iterations;
-      ImageF envelope;
-      if (!propagated.empty()) envelope = FinalizeEnvelope(propagated, env_opt);
-      pr.t_envelope = Since(t0);
-
-      // MRF (Eq. 1-4).
-      t0 = Clock::now();
-      CostVolume vol = shells[i];
-      ReadCostCache(cache_path(i), &vol);
-      const int w = vol.width, h = vol.height, L = vol.num_labels;
-      const size_t np = static_cast<size_t>(w) * h;
-      GridMrf mrf;
-      mrf.width = w;
-      mrf.height = h;
-      mrf.num_labels = L;
-      mrf.truncation = options.mrf.truncation_labels;
-      mrf.unary.resize(np * L);
-      const bool near_term = options.use_near_envelope && !envelope.empty() && options.mrf.lambda_near > 0;
-      for (size_t p = 0; p < np; ++p) {
-        const float wp = vol.photo_weight.data()[p];
-        const float* c = vol.cost.data() + p * L;
-        float* u = mrf.unary.data() + p * L;
-        const float bias = static_cast<float>(options.mrf.far_bias) * (1.0f - wp) / (L - 1);
-        for (int k = 0; k < L; ++k) u[k] = wp * c[k] + bias * static_cast<float>(L - 1 - k);
-        if (near_term) {
-          // Eq. 4: labels nearer than the envelope (k < label of n_i) pay lambda_near.
-          const double kn = grid.LabelOf(envelope.data()[p]);
-          const int kmax = std::min(L, static_cast<int>(std::ceil(kn)));
-          for (int k = 0; k < kmax; ++k) u[k] += static_cast<float>(options.mrf.lambda_near);
-        }
+    // MRF (Eq. 1-4).
+    t0 = Clock::now();
+    CostVolume vol = shells[i];
+    ReadCostCache(cache_path(i), &vol);
+    const int w = vol.width, h = vol.height, L = vol.num_labels;
+    const size_t np = static_cast<size_t>(w) * h;
+    GridMrf mrf;
+    mrf.width = w;
+    mrf.height = h;
+    mrf.num_labels = L;
+    mrf.truncation = options.mrf.truncation_labels;
+    mrf.unary.resize(np * L);
+    const bool near_term = options.use_near_envelope && !envelope.empty() && options.mrf.lambda_near > 0;
+    for (size_t p = 0; p < np; ++p) {
+      const float wp = vol.photo_weight.data()[p];
+      const float* c = vol.cost.data() + p * L;
+      float* u = mrf.unary.data() + p * L;
+      const float bias = static_cast<float>(options.mrf.far_bias) * (1.0f - wp) / (L - 1);
+      for (int k = 0; k < L; ++k) u[k] = wp * c[k] + bias * static_cast<float>(L - 1 - k);
+      if (near_term) {
+        // Eq. 4: labels nearer than the envelope (k < label of n_i) pay lambda_near.
+        const double kn = grid.LabelOf(envelope.data()[p]);
+        const int kmax = std::min(L, static_cast<int>(std::ceil(kn)));
+        for (int k = 0; k < kmax; ++k) u[k] += static_cast<float>(options.mrf.lambda_near);
       }
-      mrf.weight_right.assign(np, 0.0f);
-      mrf.weight_down.assign(np, 0.0f);
-      const double inv2s2 = 1.0 / (2.0 * options.mrf.sigma_color * options.mrf.sigma_color);
-      const double scale = options.mrf.lambda_smooth / options.mrf.truncation_labels;
-      auto wcolor = [&](int x0, int y0, int x1, int y1) {
-        double d2 = 0;
-        for (int c = 0; c < 3; ++c) {
-          const double e = v.color.at(x0, y0, c) - v.color.at(x1, y1, c);
-          d2 += e * e;
-        }
-        return static_cast<float>(scale * std::max(options.mrf.color_floor, std::exp(-d2 * inv2s2)));
+    }
+    mrf.weight_right.assign(np, 0.0f);
+    mrf.weight_down.assign(np, 0.0f);
+    const double inv2s2 = 1.0 / (2.0 * options.mrf.sigma_color * options.mrf.sigma_color);
+    const double scale = options.mrf.lambda_smooth / options.mrf.truncation_labels;
+    auto wcolor = [&](int x0, int y0, int x1, int y1) {
+      double d2 = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double e = v.color.at(x0, y0, c) - v.color.at(x1, y1, c);
+        d2 += e * e;
+      }
+      return static_cast<float>(scale * std::max(options.mrf.color_floor, std::exp(-d2 * inv2s2)));
+    };
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t p = static_cast<size_t>(y) * w + x;
+        if (x + 1 < w) mrf.weight_right[p] = wcolor(x, y, x + 1, y);
+        if (y + 1 < h) mrf.weight_down[p] = wcolor(x, y, x, y + 1);
+      }
+    TrwsOptions trws;
+    trws.max_iterations = options.mrf.max_iterations;
+    const TrwsResult res = SolveTrws(mrf, trws);
+    mrf.unary.clear();
+    mrf.unary.shrink_to_fit();
+    pr.mrf_energy = res.energy;
+    pr.mrf_iterations = res.iterations;
+
+    // Edge-aware median (window fattening), sub-label refinement, depth and confidence.
+    const std::vector<int> labels = EdgeAwareMedian(std::vector<int>(res.labels.begin(), res.labels.end()),
+                                                    L, v.color, options.edge_median, inner);
+    std::vector<float> fl = FitSubLabel(vol, labels, options.sublabel, inner);
+    pr.t_mrf = Since(t0);
+    ImageF trws_depth;
+    if (options.debug) {
+      trws_depth = ImageF(w, h, 1);
+      for (size_t p = 0; p < np; ++p) trws_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(res.labels[p]));
+    }
+    t0 = Clock::now();
+    if (options.refine.enabled)
+      fl = RefineContinuous(v, swept[i], vol, labels, fl, options.sweep, options.refine, inner);
+    fl = SmoothSubLabel(vol, std::move(fl), v.color, options.sublabel, inner);
+    ImageF low_depth(w, h, 1), low_conf(w, h, 1);
+    for (size_t p = 0; p < np; ++p) {
+      const float* c = vol.cost.data() + p * L;
+      low_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(fl[p]));
+      low_conf.data()[p] = vol.photo_weight.data()[p] * std::max(0.0f, 1.0f - c[labels[p]]);
+    }
+    vol.cost.clear();
+    vol.cost.shrink_to_fit();
+    final_low[i] = low_depth;
+    pr.t_refine = Since(t0);
+
+    // Full resolution (Sec. 4.3.1: joint bilateral weighted median).
+    t0 = Clock::now();
+    const ImageF full_color = ReadPhotoFloat((fs::path(ws.images_dir) / v.name).string());
+    UpsampleOptions up = options.upsample;
+    up.num_threads = inner;
+    const ImageF depth = JointBilateralMedianUpsample(low_depth, v.color, full_color, up);
+    const ImageF conf = ResizeLinear(low_conf, v.full_width, v.full_height);
+    ImageF env_full;
+    if (!envelope.empty()) {
+      env_full = ResizeLinear(envelope, v.full_width, v.full_height);
+    } else {
+      env_full = ImageF(v.full_width, v.full_height, 1, static_cast<float>(v.range.near_m));
+    }
+    io::WriteExr((fs::path(out_dir) / "depth" / (stem + ".exr")).string(), depth.view(), {"Z"});
+    io::WriteExr((fs::path(out_dir) / "confidence" / (stem + ".exr")).string(), conf.view(), {"Y"});
+    io::WriteExr((fs::path(out_dir) / "envelope" / (stem + ".exr")).string(),
+                 static_cast<const ImageF&>(env_full).view(), {"Z"});
+    if (options.debug) {
+      auto png = [&](const char* what, const ImageF& img) {
+        const Image8 rgb = Colorize(img, v.range);
+        io::WritePng((fs::path(debug_dir) / (stem + "_" + what + ".png")).string(), rgb.view());
       };
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          const size_t p = static_cast<size_t>(y) * w + x;
-          if (x + 1 < w) mrf.weight_right[p] = wcolor(x, y, x + 1, y);
-          if (y + 1 < h) mrf.weight_down[p] = wcolor(x, y, x, y + 1);
+      png("wta", wta[i]);
+      png("gc", gc);
+      png("median", med);
+      png("bilateral", bil);
+      if (!propagated.empty()) png("propagated", propagated);
+      if (!envelope.empty()) png("envelope", envelope);
+      png("trws", trws_depth);
+      png("mrf", low_depth);
+      Image8 texture(w, h, 1);
+      for (size_t p = 0; p < np; ++p)
+        texture.data()[p] = static_cast<uint8_t>(std::lround(255.0f * vol.photo_weight.data()[p]));
+      io::WritePng((fs::path(debug_dir) / (stem + "_texture.png")).string(), texture);
+      png("depth", depth);
+    }
+    pr.t_upsample = Since(t0);
+
+    if (!options.ground_truth_dir.empty()) {
+      const ImageF gt = ReadGroundTruth(options.ground_truth_dir, stem);
+      if (!gt.empty()) {
+        pr.evaluated = true;
+        if (options.debug) {
+          const std::string base = (fs::path(debug_dir) / stem).string();
+          const Image8 gt_rgb = Colorize(gt, v.range), err_rgb = ErrorMap(depth, gt);
+          io::WritePng(base + "_gt.png", gt_rgb.view());
+          io::WritePng(base + "_error.png", err_rgb.view());
         }
-      TrwsOptions trws;
-      trws.max_iterations = options.mrf.max_iterations;
-      const TrwsResult res = SolveTrws(mrf, trws);
-      mrf.unary.clear();
-      mrf.unary.shrink_to_fit();
-      pr.mrf_energy = res.energy;
-      pr.mrf_iterations = res.iterations;
-
-      // Edge-aware median (window fattening), sub-label refinement, depth and confidence.
-      const std::vector<int> labels = EdgeAwareMedian(std::vector<int>(res.labels.begin(), res.labels.end()),
-                                                      L, v.color, options.edge_median, inner);
-      std::vector<float> fl = FitSubLabel(vol, labels, options.sublabel, inner);
-      pr.t_mrf = Since(t0);
-      ImageF trws_depth;
-      if (options.debug) {
-        trws_depth = ImageF(w, h, 1);
-        for (size_t p = 0; p < np; ++p) trws_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(res.labels[p]));
-      }
-      t0 = Clock::now();
-      if (options.refine.enabled)
-        fl = RefineContinuous(v, swept[i], vol, labels, fl, options.sweep, options.refine, inner);
-      fl = SmoothSubLabel(vol, std::move(fl), v.color, options.sublabel, inner);
-      ImageF low_depth(w, h, 1), low_conf(w, h, 1);
-      for (size_t p = 0; p < np; ++p) {
-        const float* c = vol.cost.data() + p * L;
-        low_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(fl[p]));
-        low_conf.data()[p] = vol.photo_weight.data()[p] * std::max(0.0f, 1.0f - c[labels[p]]);
-      }
-      vol.cost.clear();
-      vol.cost.shrink_to_fit();
-      final_low[i] = low_depth;
-      pr.t_refine = Since(t0);
-
-      // Full resolution (Sec. 4.3.1: joint bilateral weighted median).
-      t0 = Clock::now();
-      const ImageF full_color = ReadPhotoFloat((fs::path(ws.images_dir) / v.name).string());
-      UpsampleOptions up = options.upsample;
-      up.num_threads = inner;
-      const ImageF depth = JointBilateralMedianUpsample(low_depth, v.color, full_color, up);
-      const ImageF conf = ResizeLinear(low_conf, v.full_width, v.full_height);
-      ImageF env_full;
-      if (!envelope.empty()) {
-        env_full = ResizeLinear(envelope, v.full_width, v.full_height);
-      } else {
-        env_full = ImageF(v.full_width, v.full_height, 1, static_cast<float>(v.range.near_m));
-      }
-      io::WriteExr((fs::path(out_dir) / "depth" / (stem + ".exr")).string(), depth.view(), {"Z"});
-      io::WriteExr((fs::path(out_dir) / "confidence" / (stem + ".exr")).string(), conf.view(), {"Y"});
-      io::WriteExr((fs::path(out_dir) / "envelope" / (stem + ".exr")).string(),
-                   static_cast<const ImageF&>(env_full).view(), {"Z"});
-      if (options.debug) {
-        auto png = [&](const char* what, const ImageF& img) {
-          const Image8 rgb = Colorize(img, v.range);
-          io::WritePng((fs::path(debug_dir) / (stem + "_" + what + ".png")).string(), rgb.view());
-        };
-        png("wta", wta[i]);
-        png("gc", gc);
-        png("median", med);
-        png("bilateral", bil);
-        if (!propagated.empty()) png("propagated", propagated);
-        if (!envelope.empty()) png("envelope", envelope);
-        png("trws", trws_depth);
-        png("mrf", low_depth);
-        Image8 texture(w, h, 1);
-        for (size_t p = 0; p < np; ++p)
-          texture.data()[p] = static_cast<uint8_t>(std::lround(255.0f * vol.photo_weight.data()[p]));
-        io::WritePng((fs::path(debug_dir) / (stem + "_texture.png")).string(), texture);
-        png("depth", depth);
-      }
-      pr.t_upsample = Since(t0);
-
-      if (!options.ground_truth_dir.empty()) {
-        const ImageF gt = ReadGroundTruth(options.ground_truth_dir, stem);
-        if (!gt.empty()) {
-          pr.evaluated = true;
-          if (options.debug) {
-            const std::string base = (fs::path(debug_dir) / stem).string();
-            const Image8 gt_rgb = Colorize(gt, v.range), err_rgb = ErrorMap(depth, gt);
-            io::WritePng(base + "_gt.png", gt_rgb.view());
-            io::WritePng(base + "_error.png", err_rgb.view());
-          }
-          const DepthAccuracy acc = EvaluateDepth(depth, gt, 0.5 * v.range.far_m, grid.InvStep());
-          pr.median_rel_error = acc.median_rel_error;
-          pr.within_3pct = acc.within_3pct;
-          pr.near_floaters = acc.near_floaters;
-          pr.sky_near = acc.sky_near;
-          pr.within_half_label = acc.within_half_label;
-          pr.within_two_labels = acc.within_two_labels;
-          const double tol = 2.0 * grid.InvStep();
-          const char* names[] = {"wta", "gc", "median", "bilateral"};
-          const ImageF* maps[] = {&wta[i], &gc, &med, &bil};
-          for (int s = 0; s < 4; ++s) {
-            const AnchorQuality q = EvaluateAnchors(*maps[s], gt, tol);
-            pr.stages.push_back({names[s], q.completeness, q.precision});
-          }
-          if (!envelope.empty()) {
-            const EnvelopeQuality eq = EvaluateEnvelope(envelope, gt);
-            pr.envelope_error = eq.error;
-            pr.envelope_tightness = eq.tightness;
-          }
+        const DepthAccuracy acc = EvaluateDepth(depth, gt, 0.5 * v.range.far_m, grid.InvStep());
+        pr.median_rel_error = acc.median_rel_error;
+        pr.within_3pct = acc.within_3pct;
+        pr.near_floaters = acc.near_floaters;
+        pr.sky_near = acc.sky_near;
+        pr.within_half_label = acc.within_half_label;
+        pr.within_two_labels = acc.within_two_labels;
+        const double tol = 2.0 * grid.InvStep();
+        const char* names[] = {"wta", "gc", "median", "bilateral"};
+        const ImageF* maps[] = {&wta[i], &gc, &med, &bil};
+        for (int s = 0; s < 4; ++s) {
+          const AnchorQuality q = EvaluateAnchors(*maps[s], gt, tol);
+          pr.stages.push_back({names[s], q.completeness, q.precision});
+        }
+        if (!envelope.empty()) {
+          const EnvelopeQuality eq = EvaluateEnvelope(envelope, gt);
+          pr.envelope_error = eq.error;
+          pr.envelope_tightness = eq.tightness;
         }
       }
-    } catch (const std::exception& e) {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (first_error.empty()) first_error = ws.views[i].name + ": " + e.what();
     }
     progress.Advance();
   });
   progress.Finish();
-  if (!first_error.empty()) throw std::runtime_error(first_error);
 
   // Cross-view consistency of the final depth maps (issue 5).
   {

@@ -272,17 +272,6 @@ DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r,
   return d;
 }
 
-double MaxFiniteDepth(const TwoLayerPanorama& pano) {
-  double m = 0.0;
-  for (int l = 0; l < kNumLayers; ++l) {
-    const LayerData& layer = pano.layer(l);
-    for (size_t i = 0; i < layer.depth_m.size(); ++i)
-      if (layer.present[i] && std::isfinite(layer.depth_m[i]))
-        m = std::max(m, static_cast<double>(layer.depth_m[i]));
-  }
-  return m;
-}
-
 }  // namespace
 
 PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
@@ -345,7 +334,9 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
   render_options.num_threads = options.num_threads;
   // The far plane beyond the farthest node, as the viewer sets it: the
   // model's units are arbitrary (COLMAP's), so a fixed far plane could clip.
-  render_options.far_m = std::max(render_options.far_m, 1.5 * MaxFiniteDepth(photo3d.pano));
+  double near_m = 0.0, far_m = 0.0;
+  if (photo3d.pano.NodeDepthRange(&near_m, &far_m))
+    render_options.far_m = std::max(render_options.far_m, 1.5 * far_m);
   util::Progress progress("rephotography", static_cast<int64_t>(selected.size()));
   eval.error_histogram.assign(options.metrics.histogram_bins, 0);
   for (const int index : selected) {

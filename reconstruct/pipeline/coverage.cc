@@ -33,8 +33,9 @@ Image8 FieldOfViewMask(const TwoLayerPanorama& pano, int layer,
   if (layer < 0 || layer >= kNumLayers) throw std::invalid_argument("coverage: no such layer");
   const LayerData& data = pano.layer(layer);
   ImageF depth(pano.width(), pano.height(), 1, 0.0f);
+  // Depth > 0 marks a node; a valid panorama's nodes all have one.
   for (size_t i = 0; i < data.present.size(); ++i)
-    if (data.present[i]) depth.data()[i] = std::max(data.depth_m[i], 1e-30f);
+    if (data.present[i]) depth.data()[i] = data.depth_m[i];
   return FieldOfViewMask(depth, pano.frame(), views, reference_depth_m, num_threads,
                          used_reference_depth_m);
 }
@@ -157,85 +158,72 @@ int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<i
     throw std::invalid_argument("coverage: gap filling needs images of one size");
   const bool with_label = label && !label->empty();
   float* depth = depth_m->data();
-  const auto gap = [&](int x, int y) { return mask.at(x, y) != 0 && !(depth[static_cast<size_t>(y) * W + x] > 0); };
-  // The farthest filled 8-neighbour of (x, y), or -1.
-  const auto farthest_neighbour = [&](int x, int y) {
+  uint8_t* colour = rgb->data();
+  const auto gap = [&](int64_t i) { return mask.data()[i] != 0 && !(depth[i] > 0); };
+  // Calls visit(j) for the 8-neighbours j of pixel i (columns wrap, rows end).
+  const auto for_each_neighbour = [W, H](int64_t i, auto&& visit) {
+    const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
+    for (int yy = std::max(0, y - 1); yy <= std::min(H - 1, y + 1); ++yy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (dx != 0 || yy != y) visit(static_cast<int64_t>(yy) * W + WrapColumn(x + dx, W));
+  };
+  // The farthest filled 8-neighbour of i, or -1.
+  const auto farthest_neighbour = [&](int64_t i) {
     int64_t best = -1;
-    float best_depth = 0;
-    for (int dy = -1; dy <= 1; ++dy) {
-      const int yy = y + dy;
-      if (yy < 0 || yy >= H) continue;
-      for (int dx = -1; dx <= 1; ++dx) {
-        if (dx == 0 && dy == 0) continue;
-        const int64_t j = static_cast<int64_t>(yy) * W + WrapColumn(x + dx, W);
-        if (depth[j] > best_depth) {
-          best_depth = depth[j];
-          best = j;
-        }
-      }
-    }
+    for_each_neighbour(i, [&](int64_t j) {
+      if (depth[j] > 0 && (best < 0 || depth[j] > depth[best])) best = j;
+    });
     return best;
   };
-  std::vector<int64_t> ring;
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x)
-      if (gap(x, y) && farthest_neighbour(x, y) >= 0) ring.push_back(static_cast<int64_t>(y) * W + x);
+
+  // Ring 0: gap pixels next to a filled one, each with its source.
   std::vector<uint8_t> queued(static_cast<size_t>(W) * H, 0);
-  for (int64_t i : ring) queued[i] = 1;
-  std::vector<std::pair<int64_t, int64_t>> sources;  // (pixel, its source), for one ring.
+  std::vector<std::pair<int64_t, int64_t>> ring, next;  // (pixel, its source)
+  for (int64_t i = 0; i < static_cast<int64_t>(W) * H; ++i) {
+    if (!gap(i)) continue;
+    const int64_t source = farthest_neighbour(i);
+    if (source < 0) continue;
+    ring.emplace_back(i, source);
+    queued[i] = 1;
+  }
   std::vector<std::array<uint8_t, 3>> fills;
-  std::vector<int64_t> next;
   int64_t filled = 0;
   while (!ring.empty()) {
-    // Each pixel of the ring: depth of its farthest filled 8-neighbour,
-    // colour the mean of the filled neighbours within 5% of that depth (a
-    // smooth extension of the background, not streaks of one pixel's colour).
-    sources.clear();
+    // Colour: the mean of the filled neighbours within 5% of the source's
+    // depth (a smooth extension of the background, not streaks of one
+    // pixel's colour).
     fills.clear();
-    for (int64_t i : ring) {
-      const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
-      const int64_t far = farthest_neighbour(x, y);
-      sources.emplace_back(i, far);
-      const float limit = 0.95f * depth[far];
+    for (const auto& [i, source] : ring) {
+      const float limit = 0.95f * depth[source];
       float sum[3] = {0, 0, 0};
       int count = 0;
-      for (int dy = -1; dy <= 1; ++dy) {
-        const int yy = y + dy;
-        if (yy < 0 || yy >= H) continue;
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int64_t j = static_cast<int64_t>(yy) * W + WrapColumn(x + dx, W);
-          if (j == i || !(depth[j] >= limit)) continue;
-          for (int c = 0; c < 3; ++c) sum[c] += rgb->data()[3 * j + c];
-          ++count;
-        }
-      }
-      std::array<uint8_t, 3> colour;
-      for (int c = 0; c < 3; ++c) colour[c] = static_cast<uint8_t>(std::lround(sum[c] / count));
-      fills.push_back(colour);
+      for_each_neighbour(i, [&](int64_t j) {
+        if (!(depth[j] >= limit)) return;
+        for (int c = 0; c < 3; ++c) sum[c] += colour[3 * j + c];
+        ++count;
+      });
+      std::array<uint8_t, 3> mean;
+      for (int c = 0; c < 3; ++c) mean[c] = static_cast<uint8_t>(std::lround(sum[c] / count));
+      fills.push_back(mean);
     }
     // Written after the whole ring is chosen, so a ring only grows from the previous ones.
-    for (size_t k = 0; k < sources.size(); ++k) {
-      const auto [i, j] = sources[k];
-      depth[i] = depth[j];
-      for (int c = 0; c < 3; ++c) rgb->data()[3 * i + c] = fills[k][c];
-      if (with_label) label->data()[i] = label->data()[j];
+    for (size_t k = 0; k < ring.size(); ++k) {
+      const auto [i, source] = ring[k];
+      depth[i] = depth[source];
+      for (int c = 0; c < 3; ++c) colour[3 * i + c] = fills[k][c];
+      if (with_label) label->data()[i] = label->data()[source];
     }
-    filled += static_cast<int64_t>(sources.size());
+    filled += static_cast<int64_t>(ring.size());
+    // The next ring: unqueued gap pixels next to this one, with their sources.
     next.clear();
-    for (int64_t i : ring) {
-      const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
-      for (int dy = -1; dy <= 1; ++dy) {
-        const int yy = y + dy;
-        if (yy < 0 || yy >= H) continue;
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int xx = WrapColumn(x + dx, W);
-          const int64_t j = static_cast<int64_t>(yy) * W + xx;
-          if (queued[j] || !gap(xx, yy)) continue;
-          queued[j] = 1;
-          next.push_back(j);
-        }
-      }
+    for (const auto& [i, source] : ring) {
+      for_each_neighbour(i, [&](int64_t j) {
+        if (queued[j] || !gap(j)) return;
+        queued[j] = 1;
+        next.emplace_back(j, -1);
+      });
     }
+    for (auto& [j, source] : next) source = farthest_neighbour(j);
     ring.swap(next);
   }
   return filled;
@@ -317,17 +305,6 @@ CoverageStats MeasureHoles(const TwoLayerPanorama& pano, int layer, const Image8
   }
   stats.largest_hole_fraction = largest_sr / stats.fov_steradians;
   stats.largest_interior_hole_fraction = largest_interior_sr / stats.fov_steradians;
-  return stats;
-}
-
-CoverageStats MeasureCoverage(const TwoLayerPanorama& pano, int layer,
-                              const std::vector<CoverageView>& views, int num_threads,
-                              Image8* fov_out, Image8* holes) {
-  double reference = 0.0;
-  Image8 fov = FieldOfViewMask(pano, layer, views, 0.0, num_threads, &reference);
-  CoverageStats stats = MeasureHoles(pano, layer, fov, holes);
-  stats.reference_depth_m = reference;
-  if (fov_out) *fov_out = std::move(fov);
   return stats;
 }
 

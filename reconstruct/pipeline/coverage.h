@@ -89,9 +89,4 @@ int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<i
 CoverageStats MeasureHoles(const TwoLayerPanorama& pano, int layer, const Image8& fov,
                            Image8* holes = nullptr);
 
-// FieldOfViewMask then MeasureHoles; fills reference_depth_m.
-CoverageStats MeasureCoverage(const TwoLayerPanorama& pano, int layer,
-                              const std::vector<CoverageView>& views, int num_threads = 0,
-                              Image8* fov = nullptr, Image8* holes = nullptr);
-
 }  // namespace casual3d::pipeline

@@ -287,16 +287,14 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   Image8 holes;
   report.front_fov = MeasureHoles(pano, kFront, fov, &holes);
   report.front_fov.reference_depth_m = reference_depth;
-  util::LogInfo("panorama: front layer covers " +
-                std::to_string(100.0 * report.front_fov.covered_fraction) +
-                "% of the photos' field of view; " + std::to_string(report.front_fov.num_holes) +
-                " holes, the largest " +
-                std::to_string(100.0 * report.front_fov.largest_hole_fraction) + "% of it");
   report.front_footprint = MeasureHoles(pano, kFront, footprint);
-  util::LogInfo("panorama: front layer covers " +
-                std::to_string(100.0 * report.front_footprint.covered_fraction) +
-                "% of the photos' footprint; the largest hole " +
-                std::to_string(100.0 * report.front_footprint.largest_hole_fraction) + "% of it");
+  for (const auto& [what, c] : {std::pair{"field of view", &report.front_fov},
+                                std::pair{"footprint", &report.front_footprint}}) {
+    util::LogInfo("panorama: front layer covers " + std::to_string(100.0 * c->covered_fraction) +
+                  "% of the photos' " + what + "; " + std::to_string(c->num_holes) +
+                  " holes, the largest " + std::to_string(100.0 * c->largest_hole_fraction) +
+                  "% of it");
+  }
 
   // Write.
   t = Clock::now();

@@ -173,6 +173,11 @@ export class PackageReader {
     return this.format.m._c3d_reader_num_levels(this.ptr);
   }
 
+  /** Largest depth the package encodes (manifest depth_encoding.far_m), metres. */
+  get depthFarM() {
+    return this.format.m._c3d_reader_depth_far_m(this.ptr);
+  }
+
   /** {width, height, tiles: [{x, y, w, h, files: [{kind, path, bytes, sha256, width, height}]}]} */
   level(level) {
     const p = this.format.m._c3d_reader_level_json(this.ptr, level);

@@ -93,12 +93,7 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
   // The farthest depth of the panorama (the package's depth code range), so
   // that the camera's far plane never clips the scene: a model in COLMAP
   // units can lie thousands of units away.
-  let depthFarM = 0;
-  try {
-    depthFarM = Number(JSON.parse(new TextDecoder().decode(manifestBytes)).depth_encoding.far_m) || 0;
-  } catch (err) {
-    depthFarM = 0;  // openPackage has validated the manifest; this cannot fail in practice.
-  }
+  const depthFarM = reader.depthFarM;
   try {
     const numLevels = reader.numLevels;
     // Coarsest first; finer levels while they fit maxLevelWidth.

@@ -198,6 +198,10 @@ EMSCRIPTEN_KEEPALIVE Reader* c3d_reader_open(const char* bytes, size_t size) {
 
 EMSCRIPTEN_KEEPALIVE void c3d_reader_free(Reader* r) { delete r; }
 EMSCRIPTEN_KEEPALIVE int c3d_reader_num_levels(const Reader* r) { return r->reader->num_levels(); }
+// Largest encodable depth of the package (manifest depth_encoding.far_m), metres.
+EMSCRIPTEN_KEEPALIVE double c3d_reader_depth_far_m(const Reader* r) {
+  return r->reader->manifest().depth.far_m;
+}
 
 // What a level needs, as JSON: {"width", "height", "tiles": [{"x", "y", "w",
 // "h", "files": [{"kind", "path", "bytes", "sha256", "width", "height"}]}]},

@@ -29,6 +29,18 @@ for (const level of [1, 0]) {
   });
 }
 
+test('the reader gives the depth range of the manifest', () => {
+  const bytes = fs.readFileSync(path.join(pkg, 'manifest.json'));
+  const manifest = JSON.parse(new TextDecoder().decode(bytes));
+  const reader = format.openPackage(bytes);
+  try {
+    assert.ok(manifest.depth_encoding.far_m > 0);
+    assert.equal(reader.depthFarM, manifest.depth_encoding.far_m);
+  } finally {
+    reader.free();
+  }
+});
+
 test('a damaged tile is refused with a message naming it', async () => {
   const bad = path.join(dir, 'bad');
   fs.cpSync(pkg, bad, { recursive: true });
