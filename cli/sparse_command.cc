@@ -63,6 +63,8 @@ void AddSiftOptions(CLI::App* cmd, sfm::SparseStageOptions* options) {
   cmd->add_option("--sift-first-octave", options->sift_first_octave,
                   "First SIFT octave: 0 at the photo's size, -1 doubled (slower, finer features) [-1, 2]")
       ->capture_default_str();
+  cmd->add_flag_callback("--colmap-matching", [options] { options->native_matching = false; },
+                         "Match descriptors with COLMAP's own CPU matcher (same criteria, slower)");
 }
 
 void AddSparseCommand(CLI::App& app) {

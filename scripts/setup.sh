@@ -17,7 +17,7 @@ packages=(
   # format/ and encoder/
   libwebp-dev libopenexr-dev libdraco-dev libtinygltf-dev libmeshoptimizer-dev nlohmann-json3-dev
   # reconstruct/
-  colmap libopencv-dev libeigen3-dev libmaxflow-dev libjpeg-dev libpng-dev libexif-dev
+  colmap libsqlite3-dev libopencv-dev libeigen3-dev libmaxflow-dev libjpeg-dev libpng-dev libexif-dev
   # cli/, tests and benchmarks
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   # wasm-viewer/ and its browser test

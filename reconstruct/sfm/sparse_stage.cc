@@ -20,7 +20,9 @@
 
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/io/file_util.h"
+#include "reconstruct/sfm/colmap_database.h"
 #include "reconstruct/sfm/colmap_runner.h"
+#include "reconstruct/sfm/descriptor_matcher.h"
 #include "reconstruct/util/log.h"
 
 namespace casual3d::sfm {
@@ -239,6 +241,7 @@ Json OptionsJson(const SparseStageOptions& o) {
           {"sequential_overlap", o.sequential_overlap},
           {"max_features", o.max_features},
           {"sift_first_octave", o.sift_first_octave},
+          {"native_matching", o.native_matching},
           {"num_threads", o.num_threads},
           {"init_min_tri_angle_deg", o.init_min_tri_angle_deg},
           {"min_registered_fraction", o.min_registered_fraction},
@@ -413,6 +416,41 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
         options.matcher == MatcherType::kExhaustive ||
         (options.matcher == MatcherType::kAuto && n <= options.exhaustive_max_photos);
     result.matcher = exhaustive ? "exhaustive" : "sequential";
+    if (options.native_matching) {
+      // Descriptors matched here; COLMAP's matcher below skips the
+      // descriptor matching of every pair whose matches exist and only
+      // verifies them. Its pair list is the same.
+      const auto t0 = std::chrono::steady_clock::now();
+      std::vector<DatabaseImage> images = ReadDatabaseImages(db);
+      std::vector<SiftDescriptors> descriptors;
+      for (DatabaseImage& im : images) descriptors.push_back(std::move(im.descriptors));
+      const int num_images = static_cast<int>(images.size());
+      const std::vector<std::pair<int, int>> pairs =
+          exhaustive ? ExhaustivePairs(num_images)
+                     : SequentialPairs(num_images, options.sequential_overlap);
+      std::vector<FeatureMatches> matches;
+      {
+        util::Progress progress("matching", static_cast<int64_t>(pairs.size()));
+        matches = MatchPairs(descriptors, pairs, DescriptorMatchOptions(), options.num_threads,
+                             [&](int done, int) {
+                               progress.Set(done);
+                               return !InterruptRequested();
+                             });
+        if (InterruptRequested()) throw std::runtime_error("interrupted during matching");
+        progress.Finish();
+      }
+      std::vector<std::pair<int64_t, int64_t>> id_pairs;
+      size_t total = 0;
+      for (size_t k = 0; k < pairs.size(); ++k) {
+        id_pairs.emplace_back(images[pairs[k].first].image_id, images[pairs[k].second].image_id);
+        total += matches[k].size();
+      }
+      WriteDatabaseMatches(db, id_pairs, matches);
+      const double seconds = SecondsSince(t0);
+      AppendLog(log_path, "descriptor matching: " + std::to_string(pairs.size()) + " pairs, " +
+                              std::to_string(total) + " matches in " + FormatNumber(seconds) + " s");
+      steps.Add("descriptor_matching", seconds);
+    }
     std::vector<std::string> match_args = {"--database_path", db, "--SiftMatching.use_gpu", "0",
                                            "--SiftMatching.num_threads", threads};
     if (!exhaustive) {

@@ -5,8 +5,9 @@
 // Input: a folder of photos (JPEG, PNG, with EXIF), or an existing COLMAP
 // workspace (DIR/images plus a sparse model in DIR/sparse or DIR/sparse/N).
 // For photos it imports them at the working resolution (photo_import.h), runs
-// Debian's COLMAP on the CPU (feature_extractor, exhaustive or sequential
-// matcher, mapper) and keeps the largest model; for a workspace it takes the
+// Debian's COLMAP on the CPU (feature_extractor; descriptor matching by
+// descriptor_matcher.h, then COLMAP's exhaustive or sequential matcher for
+// the geometric verification; mapper) and keeps the largest model; for a workspace it takes the
 // largest model found. Both then run COLMAP's image_undistorter and set up the
 // scene (scene_setup.h).
 //
@@ -65,6 +66,10 @@ struct SparseStageOptions {
   // mapper hardly needs (docs/PERFORMANCE.md, "Sparse stage"). -1 for tiny
   // photos or weak texture.
   int sift_first_octave = 0;  // Range [-1, 2].
+  // Match descriptors with casual3d's CPU matcher (descriptor_matcher.h: the
+  // same criteria, about 9 times faster on 2 cores) and let COLMAP only verify
+  // the matches geometrically; false runs COLMAP's own CPU matcher.
+  bool native_matching = true;
   int num_threads = 0;             // Range [0, 1024]; 0 = all cores.
   // Smallest triangulation angle of the mapper's initial pair, degrees.
   // COLMAP's 16 suits walk-around captures; a casual capture's photos sit on a

@@ -29,6 +29,9 @@ class SparseStageTest : public ::testing::Test {
     fs::create_directories(root_ / "photos");
     out_ = (root_ / "out").string();
     options_.colmap_path = FakeColmap("exit 0");
+    // The stand-in writes no database; the descriptor matching that reads
+    // it has its own test below.
+    options_.native_matching = false;
   }
   void TearDown() override { fs::remove_all(root_); }
 
@@ -97,6 +100,12 @@ TEST_F(SparseStageTest, NothingRegistered) {
   // The stand-in colmap succeeds at every step but maps nothing.
   WritePhotos(3);
   ExpectFailure({"registered none of the 3 photos", "overlap"});
+}
+
+TEST_F(SparseStageTest, ExtractorThatLeftNoDatabaseIsReported) {
+  WritePhotos(3);
+  options_.native_matching = true;
+  ExpectFailure({"database.db", "cannot open the COLMAP database"});
 }
 
 TEST_F(SparseStageTest, SkipUnreadableGoesOnWithoutTheBrokenPhoto) {
