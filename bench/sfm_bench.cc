@@ -1,0 +1,59 @@
+// Descriptor matching of the sparse stage (reconstruct/sfm/descriptor_matcher.h):
+// one pair of photos with N SIFT-like descriptors each, half of them shared
+// with noise. docs/PERFORMANCE.md, "Sparse stage".
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "reconstruct/sfm/descriptor_matcher.h"
+
+namespace {
+
+using casual3d::sfm::SiftDescriptors;
+
+std::vector<uint8_t> Bytes(const std::vector<double>& v) {
+  double n = 0;
+  for (double x : v) n += x * x;
+  n = std::sqrt(n);
+  std::vector<uint8_t> out(v.size());
+  for (size_t k = 0; k < v.size(); ++k)
+    out[k] = static_cast<uint8_t>(std::min(255.0, std::round(512.0 * v[k] / n)));
+  return out;
+}
+
+void MakePair(int n, SiftDescriptors* a, SiftDescriptors* b) {
+  std::mt19937 rng(17);
+  std::exponential_distribution<double> e(1.0);
+  std::normal_distribution<double> noise(0.0, 5.0);
+  a->rows = b->rows = n;
+  for (int i = 0; i < n; ++i) {
+    std::vector<double> v(casual3d::sfm::kSiftDimensions), w(v.size());
+    for (double& x : v) x = e(rng);
+    for (size_t k = 0; k < v.size(); ++k) w[k] = i % 2 == 0 ? std::max(0.0, v[k] * 40 + noise(rng)) : e(rng);
+    const auto av = Bytes(v), bw = Bytes(w);
+    a->data.insert(a->data.end(), av.begin(), av.end());
+    b->data.insert(b->data.end(), bw.begin(), bw.end());
+  }
+}
+
+void BM_MatchDescriptors(benchmark::State& state) {
+  SiftDescriptors a, b;
+  MakePair(static_cast<int>(state.range(0)), &a, &b);
+  size_t matches = 0;
+  for (auto _ : state) {
+    matches = casual3d::sfm::MatchDescriptors(a, b).size();
+    benchmark::DoNotOptimize(matches);
+  }
+  state.counters["matches"] = static_cast<double>(matches);
+  const double n = static_cast<double>(state.range(0));
+  state.counters["GFLOP/s"] = benchmark::Counter(2.0 * n * n * casual3d::sfm::kSiftDimensions / 1e9,
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_MatchDescriptors)->Arg(1024)->Arg(2048)->Arg(4096)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
