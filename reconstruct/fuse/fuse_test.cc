@@ -81,10 +81,14 @@ TEST(FuseTest, GrowsTheBackLayerBehindTheForeground) {
   for (int x = 100; x < 140; ++x) {
     const bool expect_back = x < 113 || x >= 127;
     EXPECT_EQ(pano.present(kBack, x, 65), expect_back) << "column " << x;
-    if (expect_back) EXPECT_FLOAT_EQ(pano.layer(kBack).depth_m[pano.index(x, 65)], 4.0f);
+    if (expect_back) {
+      EXPECT_FLOAT_EQ(pano.layer(kBack).depth_m[pano.index(x, 65)], 4.0f);
+    }
   }
   for (int x = 0; x < Scene::W; ++x) {
-    if (x < 100 || x >= 140) EXPECT_FALSE(pano.present(kBack, x, 65));
+    if (x < 100 || x >= 140) {
+      EXPECT_FALSE(pano.present(kBack, x, 65));
+    }
   }
   // Rows above and below the square grow too (vertical edges of the square).
   EXPECT_TRUE(pano.present(kBack, 120, 50));

@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 // Bump when a stage's output format or algorithm changes, so old caches are stale.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-1", "dense-2", "panorama-2",
+constexpr const char* kStageVersions[kNumStages] = {"sparse-2", "dense-3", "panorama-3",
                                                     "encode-1"};
 
 std::string HashHex(const std::string& text) {
@@ -57,7 +57,7 @@ std::string SparseOptionsText(const sfm::SparseStageOptions& o) {
     << " allow_mixed_devices=" << o.import.allow_mixed_devices << " focal_px=" << o.import.focal_px
     << " camera_model=" << o.camera_model << " shared_camera=" << o.shared_camera
     << " matcher=" << static_cast<int>(o.matcher) << " max_features=" << o.max_features
-    << " sift_first_octave=" << o.sift_first_octave
+    << " sift_first_octave=" << o.sift_first_octave << " native_matching=" << o.native_matching
     << " min_registered_fraction=" << o.min_registered_fraction;
   return s.str();
 }
