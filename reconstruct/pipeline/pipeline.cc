@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -231,6 +232,7 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
 
   PipelineReport report;
   nlohmann::json stage_json = nlohmann::json::object();
+  std::optional<TwoLayerPanorama> fresh_panorama;  // Made by this run's panorama stage.
   for (int s = 0; s < kNumStages; ++s) {
     const Stage stage = static_cast<Stage>(s);
     StageRun run;
@@ -279,8 +281,8 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
       case Stage::kPanorama: {
         RunIntoFolder(dirs[s], key_paths[s], keys[s], [&](const fs::path& tmp) {
           PanoramaStageReport r;
-          RunPanoramaStage(input_workspace().string(), dirs[1].string(), tmp.string(),
-                           options.panorama, &r);
+          fresh_panorama = RunPanoramaStage(input_workspace().string(), dirs[1].string(),
+                                            tmp.string(), options.panorama, &r);
           stage_json["panorama"] = {
               {"width", r.width},
               {"front_coverage", r.front_coverage},
@@ -296,7 +298,12 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
       }
       case Stage::kEncode: {
         const fs::path master = dirs[2] / "master.exr";
-        auto pano = encoder::ReadMasterFile(master.string());
+        // The panorama this run made is the master file's content (its round
+        // trip is exact); only a cached one is read back.
+        StatusOr<TwoLayerPanorama> pano = fresh_panorama
+                                              ? StatusOr<TwoLayerPanorama>(std::move(*fresh_panorama))
+                                              : encoder::ReadMasterFile(master.string());
+        fresh_panorama.reset();
         if (!pano.ok()) throw std::runtime_error(pano.status().ToString());
         encoder::PackageOptions package;
         package.color_quality = options.color_quality;
