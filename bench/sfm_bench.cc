@@ -9,31 +9,24 @@
 #include <random>
 
 #include "reconstruct/sfm/descriptor_matcher.h"
+#include "reconstruct/sfm/testing/sift_like.h"
 
 namespace {
 
 using casual3d::sfm::SiftDescriptors;
 
-std::vector<uint8_t> Bytes(const std::vector<double>& v) {
-  double n = 0;
-  for (double x : v) n += x * x;
-  n = std::sqrt(n);
-  std::vector<uint8_t> out(v.size());
-  for (size_t k = 0; k < v.size(); ++k)
-    out[k] = static_cast<uint8_t>(std::min(255.0, std::round(512.0 * v[k] / n)));
-  return out;
-}
-
 void MakePair(int n, SiftDescriptors* a, SiftDescriptors* b) {
+  using casual3d::sfm::testing::RandomSiftValues;
+  using casual3d::sfm::testing::SiftLikeBytes;
   std::mt19937 rng(17);
-  std::exponential_distribution<double> e(1.0);
   std::normal_distribution<double> noise(0.0, 5.0);
   a->rows = b->rows = n;
   for (int i = 0; i < n; ++i) {
-    std::vector<double> v(casual3d::sfm::kSiftDimensions), w(v.size());
-    for (double& x : v) x = e(rng);
-    for (size_t k = 0; k < v.size(); ++k) w[k] = i % 2 == 0 ? std::max(0.0, v[k] * 40 + noise(rng)) : e(rng);
-    const auto av = Bytes(v), bw = Bytes(w);
+    const std::vector<double> v = RandomSiftValues(&rng);
+    std::vector<double> w = RandomSiftValues(&rng);
+    if (i % 2 == 0)  // Every other descriptor of b is a's with noise.
+      for (size_t k = 0; k < v.size(); ++k) w[k] = std::max(0.0, v[k] * 40 + noise(rng));
+    const auto av = SiftLikeBytes(v), bw = SiftLikeBytes(w);
     a->data.insert(a->data.end(), av.begin(), av.end());
     b->data.insert(b->data.end(), bw.begin(), bw.end());
   }

@@ -26,8 +26,8 @@ void AddViewCommand(CLI::App& app);
 // `casual3d sparse <photos-or-workspace> -o <out>` (cli/sparse_command.cc).
 void AddSparseCommand(CLI::App& app);
 
-// --max-features and --sift-first-octave, shared by `sparse` and
-// `reconstruct` (cli/sparse_command.cc).
+// --max-features, --sift-first-octave and --colmap-matching, shared by
+// `sparse` and `reconstruct` (cli/sparse_command.cc).
 void AddSiftOptions(CLI::App* cmd, sfm::SparseStageOptions* options);
 
 // `casual3d dense <workspace> -o <out>` (cli/dense_command.cc).

@@ -29,9 +29,10 @@ class Db {
   Db(const Db&) = delete;
   Db& operator=(const Db&) = delete;
 
-  [[noreturn]] void Fail(const std::string& what) const {
-    throw std::runtime_error(path_ + ": " + what + ": " + sqlite3_errmsg(db_) +
-                             " (not a COLMAP database, or damaged)");
+  // Throws "<path>: <what>: <SQLite's reason> (<hint>)".
+  [[noreturn]] void Fail(const std::string& what,
+                         const char* hint = "not a COLMAP database, or damaged") const {
+    throw std::runtime_error(path_ + ": " + what + ": " + sqlite3_errmsg(db_) + " (" + hint + ")");
   }
   sqlite3_stmt* Prepare(const char* sql) {
     sqlite3_stmt* s = nullptr;
@@ -39,10 +40,9 @@ class Db {
     statements_.push_back(s);
     return s;
   }
-  void Exec(const char* sql) {
-    if (sqlite3_exec(db_, sql, nullptr, nullptr, nullptr) != SQLITE_OK) Fail(sql);
+  void Exec(const char* sql, const char* what, const char* hint) {
+    if (sqlite3_exec(db_, sql, nullptr, nullptr, nullptr) != SQLITE_OK) Fail(what, hint);
   }
-  const std::string& path() const { return path_; }
 
  private:
   std::string path_;
@@ -95,8 +95,10 @@ void WriteDatabaseMatches(const std::string& db_path,
                           const std::vector<FeatureMatches>& matches) {
   if (image_pairs.size() != matches.size())
     throw std::invalid_argument("WriteDatabaseMatches: one match list per pair");
+  // Closing the connection with the transaction open (any throw below)
+  // rolls it back: nothing is written.
   Db db(db_path, true);
-  db.Exec("BEGIN IMMEDIATE");
+  db.Exec("BEGIN IMMEDIATE", "cannot write", "is another program using it?");
   sqlite3_stmt* s =
       db.Prepare("INSERT OR REPLACE INTO matches (pair_id, rows, cols, data) VALUES (?, ?, 2, ?)");
   std::vector<uint32_t> blob;
@@ -117,14 +119,10 @@ void WriteDatabaseMatches(const std::string& db_path,
       sqlite3_bind_blob(s, 3, blob.data(), static_cast<int>(blob.size() * sizeof(uint32_t)),
                         SQLITE_TRANSIENT);
     }
-    if (sqlite3_step(s) != SQLITE_DONE) {
-      const std::string path = db.path();
-      db.Exec("ROLLBACK");
-      throw std::runtime_error(path + ": cannot store matches (disk full?)");
-    }
+    if (sqlite3_step(s) != SQLITE_DONE) db.Fail("cannot store matches", "disk full?");
     sqlite3_reset(s);
   }
-  db.Exec("COMMIT");
+  db.Exec("COMMIT", "cannot store matches", "disk full?");
 }
 
 }  // namespace casual3d::sfm

@@ -7,32 +7,13 @@
 
 #include <gtest/gtest.h>
 
+#include "reconstruct/sfm/testing/sift_like.h"
+
 namespace casual3d::sfm {
 namespace {
 
-// SIFT-like bytes: non-negative, length about 512.
-std::vector<uint8_t> Normalize(const std::vector<double>& v) {
-  double n = 0;
-  for (double x : v) n += x * x;
-  n = std::sqrt(n);
-  std::vector<uint8_t> out(v.size());
-  for (size_t k = 0; k < v.size(); ++k)
-    out[k] = static_cast<uint8_t>(std::min(255.0, std::round(512.0 * v[k] / n)));
-  return out;
-}
-
-SiftDescriptors Random(int rows, std::mt19937* rng) {
-  std::exponential_distribution<double> e(1.0);
-  SiftDescriptors d;
-  d.rows = rows;
-  for (int i = 0; i < rows; ++i) {
-    std::vector<double> v(kSiftDimensions);
-    for (double& x : v) x = e(*rng);
-    const std::vector<uint8_t> b = Normalize(v);
-    d.data.insert(d.data.end(), b.begin(), b.end());
-  }
-  return d;
-}
+using testing::RandomSiftDescriptors;
+using testing::SiftLikeBytes;
 
 // b: a's rows in a shuffled order with noise, plus unrelated rows.
 SiftDescriptors Perturbed(const SiftDescriptors& a, int extra, double noise, std::mt19937* rng) {
@@ -45,10 +26,10 @@ SiftDescriptors Perturbed(const SiftDescriptors& a, int extra, double noise, std
     std::vector<double> v(kSiftDimensions);
     for (int k = 0; k < kSiftDimensions; ++k)
       v[k] = std::max(0.0, a.data[static_cast<size_t>(i) * kSiftDimensions + k] + n(*rng));
-    const std::vector<uint8_t> bytes = Normalize(v);
+    const std::vector<uint8_t> bytes = SiftLikeBytes(v);
     b.data.insert(b.data.end(), bytes.begin(), bytes.end());
   }
-  const SiftDescriptors more = Random(extra, rng);
+  const SiftDescriptors more = RandomSiftDescriptors(extra, rng);
   b.data.insert(b.data.end(), more.data.begin(), more.data.end());
   b.rows = a.rows + extra;
   return b;
@@ -102,7 +83,7 @@ TEST(DescriptorMatcherTest, EqualsTheStraightforwardRulesOnManySizes) {
   std::mt19937 rng(7);
   // Sizes that are and are not multiples of the 4 x 16 tiles.
   for (auto [na, extra] : {std::pair{1, 0}, {3, 2}, {4, 12}, {17, 30}, {63, 1}, {200, 57}}) {
-    const SiftDescriptors a = Random(na, &rng);
+    const SiftDescriptors a = RandomSiftDescriptors(na, &rng);
     const SiftDescriptors b = Perturbed(a, extra, 6.0, &rng);
     for (bool cross : {true, false}) {
       DescriptorMatchOptions o;
@@ -117,7 +98,7 @@ TEST(DescriptorMatcherTest, EqualsTheStraightforwardRulesOnManySizes) {
 
 TEST(DescriptorMatcherTest, FindsPlantedCorrespondences) {
   std::mt19937 rng(11);
-  const SiftDescriptors a = Random(500, &rng);
+  const SiftDescriptors a = RandomSiftDescriptors(500, &rng);
   const SiftDescriptors b = Perturbed(a, 300, 4.0, &rng);
   const FeatureMatches m = MatchDescriptors(a, b);
   EXPECT_GT(m.size(), 450u);
@@ -135,7 +116,7 @@ TEST(DescriptorMatcherTest, FindsPlantedCorrespondences) {
 
 TEST(DescriptorMatcherTest, RatioDistanceAndTies) {
   std::mt19937 rng(3);
-  const SiftDescriptors a = Random(1, &rng);
+  const SiftDescriptors a = RandomSiftDescriptors(1, &rng);
   // Two identical candidates: a tie for the best fails the ratio test.
   SiftDescriptors twice;
   twice.rows = 2;
@@ -151,7 +132,7 @@ TEST(DescriptorMatcherTest, RatioDistanceAndTies) {
   once.data = a.data;
   EXPECT_EQ(MatchDescriptors(a, once), (FeatureMatches{{0, 0}}));
   // One unrelated candidate: its angle exceeds max_distance.
-  const SiftDescriptors other = Random(1, &rng);
+  const SiftDescriptors other = RandomSiftDescriptors(1, &rng);
   DescriptorMatchOptions tight;
   tight.max_distance = 0.05;
   EXPECT_TRUE(MatchDescriptors(a, other, tight).empty());
@@ -164,7 +145,7 @@ TEST(DescriptorMatcherTest, RejectsMalformedInput) {
   bad.rows = 2;
   bad.data.resize(100);
   std::mt19937 rng(1);
-  const SiftDescriptors good = Random(3, &rng);
+  const SiftDescriptors good = RandomSiftDescriptors(3, &rng);
   EXPECT_THROW(MatchDescriptors(bad, good), std::invalid_argument);
   DescriptorMatchOptions o;
   o.max_ratio = 0;
@@ -191,7 +172,7 @@ TEST(DescriptorMatcherTest, PairLists) {
 TEST(DescriptorMatcherTest, MatchPairsOnThreadsEqualsOnePairAtATime) {
   std::mt19937 rng(5);
   std::vector<SiftDescriptors> photos;
-  photos.push_back(Random(120, &rng));
+  photos.push_back(RandomSiftDescriptors(120, &rng));
   for (int i = 0; i < 4; ++i) photos.push_back(Perturbed(photos[0], 20 * i, 5.0, &rng));
   const auto pairs = ExhaustivePairs(5);
   int calls = 0, last = 0;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -225,6 +226,39 @@ double SecondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+// Matches the descriptors of the database's photos over the pairs that
+// COLMAP's exhaustive (or sequential) matcher considers and stores them;
+// that matcher, run next, skips the descriptor matching of every pair whose
+// matches exist and only verifies them. Returns "N pairs, M matches".
+std::string MatchIntoDatabase(const std::string& db, bool exhaustive, int sequential_overlap,
+                              int num_threads) {
+  std::vector<DatabaseImage> images = ReadDatabaseImages(db);
+  std::vector<SiftDescriptors> descriptors;
+  for (DatabaseImage& im : images) descriptors.push_back(std::move(im.descriptors));
+  const int n = static_cast<int>(images.size());
+  const std::vector<std::pair<int, int>> pairs =
+      exhaustive ? ExhaustivePairs(n) : SequentialPairs(n, sequential_overlap);
+  std::vector<FeatureMatches> matches;
+  {
+    util::Progress progress("matching", static_cast<int64_t>(pairs.size()));
+    matches = MatchPairs(descriptors, pairs, DescriptorMatchOptions(), num_threads,
+                         [&](int done, int) {
+                           progress.Set(done);
+                           return !InterruptRequested();
+                         });
+    if (InterruptRequested()) throw std::runtime_error("interrupted during matching");
+    progress.Finish();
+  }
+  std::vector<std::pair<int64_t, int64_t>> id_pairs;
+  size_t total = 0;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    id_pairs.emplace_back(images[pairs[k].first].image_id, images[pairs[k].second].image_id);
+    total += matches[k].size();
+  }
+  WriteDatabaseMatches(db, id_pairs, matches);
+  return std::to_string(pairs.size()) + " pairs, " + std::to_string(total) + " matches";
+}
+
 Json OptionsJson(const SparseStageOptions& o) {
   const char* matcher = o.matcher == MatcherType::kAuto         ? "auto"
                         : o.matcher == MatcherType::kExhaustive ? "exhaustive"
@@ -417,38 +451,13 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
         (options.matcher == MatcherType::kAuto && n <= options.exhaustive_max_photos);
     result.matcher = exhaustive ? "exhaustive" : "sequential";
     if (options.native_matching) {
-      // Descriptors matched here; COLMAP's matcher below skips the
-      // descriptor matching of every pair whose matches exist and only
-      // verifies them. Its pair list is the same.
       const auto t0 = std::chrono::steady_clock::now();
-      std::vector<DatabaseImage> images = ReadDatabaseImages(db);
-      std::vector<SiftDescriptors> descriptors;
-      for (DatabaseImage& im : images) descriptors.push_back(std::move(im.descriptors));
-      const int num_images = static_cast<int>(images.size());
-      const std::vector<std::pair<int, int>> pairs =
-          exhaustive ? ExhaustivePairs(num_images)
-                     : SequentialPairs(num_images, options.sequential_overlap);
-      std::vector<FeatureMatches> matches;
-      {
-        util::Progress progress("matching", static_cast<int64_t>(pairs.size()));
-        matches = MatchPairs(descriptors, pairs, DescriptorMatchOptions(), options.num_threads,
-                             [&](int done, int) {
-                               progress.Set(done);
-                               return !InterruptRequested();
-                             });
-        if (InterruptRequested()) throw std::runtime_error("interrupted during matching");
-        progress.Finish();
-      }
-      std::vector<std::pair<int64_t, int64_t>> id_pairs;
-      size_t total = 0;
-      for (size_t k = 0; k < pairs.size(); ++k) {
-        id_pairs.emplace_back(images[pairs[k].first].image_id, images[pairs[k].second].image_id);
-        total += matches[k].size();
-      }
-      WriteDatabaseMatches(db, id_pairs, matches);
+      const std::string summary =
+          MatchIntoDatabase(db, exhaustive, options.sequential_overlap, options.num_threads);
       const double seconds = SecondsSince(t0);
-      AppendLog(log_path, "descriptor matching: " + std::to_string(pairs.size()) + " pairs, " +
-                              std::to_string(total) + " matches in " + FormatNumber(seconds) + " s");
+      char took[32];
+      std::snprintf(took, sizeof(took), " in %.1f s", seconds);
+      AppendLog(log_path, "descriptor matching: " + summary + took);
       steps.Add("descriptor_matching", seconds);
     }
     std::vector<std::string> match_args = {"--database_path", db, "--SiftMatching.use_gpu", "0",
