@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "format/f64x2.h"
+
 namespace casual3d {
 namespace {
 
@@ -48,7 +50,8 @@ class LayerPyramid {
                double max_error)
       : p_(p), dirs_(dirs), layer_(layer), max_error_(max_error) {
     const int qw = p.width(), qh = p.height() - 1;
-    FullQuads();
+    const int tile = 1 << levels;
+    FullQuads(tile);
     nx_.push_back(qw);
     ny_.push_back(qh);
     error_.emplace_back();  // Level 0 uses full_.
@@ -59,9 +62,11 @@ class LayerPyramid {
       error_.emplace_back(static_cast<size_t>(nx_[k]) * ny_[k], kInf);
     }
     // Blocks nest inside tiles, so a block's children are evaluated before it.
-    const int tile = 1 << levels;
+    // A tile without a full quad has no mergeable block.
+    const int tiles_x = (qw + tile - 1) / tile;
     for (int y0 = 0; y0 < qh; y0 += tile) {
       for (int x0 = 0; x0 < qw; x0 += tile) {
+        if (!tile_has_full_[static_cast<size_t>(y0 / tile) * tiles_x + x0 / tile]) continue;
         tile_x0_ = x0;
         tile_y0_ = y0;
         tile_ready_ = false;
@@ -77,7 +82,10 @@ class LayerPyramid {
         }
       }
     }
-    std::vector<double>().swap(positions_);
+    std::vector<double>().swap(px_);
+    std::vector<double>().swap(py_);
+    std::vector<double>().swap(pz_);
+    std::vector<uint8_t>().swap(tile_has_full_);
   }
 
   int levels() const { return static_cast<int>(error_.size()) - 1; }
@@ -97,40 +105,49 @@ class LayerPyramid {
 
  private:
   // full_: whether all four corners of a quad are nodes of this layer, linked
-  // to each other around the quad. Per node, bit 0: present; bits 1 + d: the
-  // link in direction d leads to this layer.
-  void FullQuads() {
+  // to each other around the quad. Per node, bit 7: present; bit 2d: the link
+  // in direction d leads to this layer. Byte-wise arithmetic without tables,
+  // so that compilers vectorize the loops. Also notes which tiles of the
+  // largest block size hold a full quad at all (tile_has_full_).
+  void FullQuads(int tile) {
     const int w = p_.width(), qh = p_.height() - 1;
     const LayerData& d = p_.layer(layer_);
-    const unsigned same = static_cast<unsigned>(layer_ == kFront ? Link::kFront : Link::kBack);
-    uint8_t link_bits[256];  // Bits 1 + d of a packed links byte.
-    for (unsigned links = 0; links < 256; ++links) {
-      unsigned bits = 0;
-      for (int dir = 0; dir < kNumDirections; ++dir) {
-        bits |= (((links >> (2 * dir)) & 3u) == same ? 1u : 0u) << (1 + dir);
-      }
-      link_bits[links] = static_cast<uint8_t>(bits);
-    }
+    const bool front = layer_ == kFront;
     std::vector<uint8_t> upper(w), lower(w);
     auto row_bits = [&](int y, std::vector<uint8_t>* out) {
-      const size_t i0 = p_.index(0, y);
+      const uint8_t* links = &d.links[p_.index(0, y)];
+      const uint8_t* present = &d.present[p_.index(0, y)];
+      uint8_t* o = out->data();
       for (int x = 0; x < w; ++x) {
-        (*out)[x] = link_bits[d.links[i0 + x]] | (d.present[i0 + x] ? 1u : 0u);
+        const unsigned lo = links[x] & 0x55u, hi = (links[x] >> 1) & 0x55u;
+        const unsigned same = front ? lo & ~hi : hi & ~lo;  // Link::kFront is 1, kBack 2.
+        o[x] = static_cast<uint8_t>(same | (present[x] != 0 ? 0x80u : 0u));
       }
     };
-    constexpr unsigned kP = 1, kR = 1 << (1 + kRight), kD = 1 << (1 + kDown), kL = 1 << (1 + kLeft),
-                       kU = 1 << (1 + kUp);
+    constexpr unsigned kP = 0x80, kR = 1u << (2 * kRight), kD = 1u << (2 * kDown),
+                       kL = 1u << (2 * kLeft), kU = 1u << (2 * kUp);
+    constexpr unsigned kA = kP | kR | kD, kB = kP | kD | kL, kC = kP | kR | kU, kDD = kP | kU | kL;
     full_.assign(static_cast<size_t>(w) * qh, 0);
+    const int tiles_x = (w + tile - 1) / tile;
+    tile_has_full_.assign(static_cast<size_t>(tiles_x) * ((qh + tile - 1) / tile), 0);
     if (qh > 0) row_bits(0, &upper);
     for (int y = 0; y < qh; ++y) {
       row_bits(y + 1, &lower);
       uint8_t* full = &full_[static_cast<size_t>(y) * w];
-      for (int x = 0; x < w; ++x) {
-        const int xb = x + 1 == w ? 0 : x + 1;
-        full[x] = (upper[x] & (kP | kR | kD)) == (kP | kR | kD) &&
-                  (upper[xb] & (kP | kD | kL)) == (kP | kD | kL) &&
-                  (lower[x] & (kP | kR | kU)) == (kP | kR | kU) &&
-                  (lower[xb] & (kP | kU | kL)) == (kP | kU | kL);
+      const uint8_t* u = upper.data();
+      const uint8_t* l = lower.data();
+      for (int x = 0; x + 1 < w; ++x) {
+        full[x] = static_cast<uint8_t>(((u[x] & kA) == kA) & ((u[x + 1] & kB) == kB) &
+                                       ((l[x] & kC) == kC) & ((l[x + 1] & kDD) == kDD));
+      }
+      full[w - 1] = static_cast<uint8_t>(((u[w - 1] & kA) == kA) & ((u[0] & kB) == kB) &
+                                         ((l[w - 1] & kC) == kC) & ((l[0] & kDD) == kDD));
+      uint8_t* has = &tile_has_full_[static_cast<size_t>(y / tile) * tiles_x];
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        const int end = std::min(w, (tx + 1) * tile);
+        unsigned any = 0;
+        for (int x = tx * tile; x < end; ++x) any |= full[x];
+        has[tx] |= static_cast<uint8_t>(any);
       }
       upper.swap(lower);
     }
@@ -138,7 +155,8 @@ class LayerPyramid {
 
   // Positions (x, y, z) of the nodes of the current tile: rows tile_y0_ ..
   // tile_y0_ + tile size and columns tile_x0_ .. tile_x0_ + tile size, clipped
-  // to the grid (column `width` repeats column 0), computed on first use.
+  // to the grid (column `width` repeats column 0), computed on first use and
+  // stored as three planes (px_, py_, pz_) of (tile + 1)^2 doubles.
   void PrepareTile() {
     if (tile_ready_) return;
     tile_ready_ = true;
@@ -147,20 +165,33 @@ class LayerPyramid {
     const int rows = std::min(tile, last_row - tile_y0_) + 1;
     const int cols = std::min(tile, w - tile_x0_) + 1;
     const size_t stride = static_cast<size_t>(tile) + 1;
-    positions_.resize(3 * stride * stride);
+    px_.resize(stride * stride);
+    py_.resize(stride * stride);
+    pz_.resize(stride * stride);
     const LayerData& d = p_.layer(layer_);
+    // Columns tile_x0_ .. tile_x0_ + inner - 1 need no wrap.
+    const int inner = std::min(cols, w - tile_x0_);
+    const double* sin_lon = &dirs_.sin_lon[tile_x0_];
+    const double* cos_lon = &dirs_.cos_lon[tile_x0_];
     for (int r = 0; r < rows; ++r) {
       const int y = tile_y0_ + r;
       const float* depth_row = &d.depth_m[p_.index(0, y)];
+      const float* depth = depth_row + tile_x0_;
       const double cos_lat = dirs_.cos_lat[y], sin_lat = dirs_.sin_lat[y];
-      double* out = &positions_[3 * r * stride];
-      for (int i = 0; i < cols; ++i, out += 3) {
-        const int c = tile_x0_ + i == w ? 0 : tile_x0_ + i;
-        const double depth = depth_row[c];
-        const double horizontal = cos_lat * depth;
-        out[0] = horizontal * dirs_.sin_lon[c];
-        out[1] = sin_lat * depth;
-        out[2] = -(horizontal * dirs_.cos_lon[c]);
+      double* ox = &px_[r * stride];
+      double* oy = &py_[r * stride];
+      double* oz = &pz_[r * stride];
+      for (int i = 0; i < inner; ++i) {
+        const double horizontal = cos_lat * static_cast<double>(depth[i]);
+        ox[i] = horizontal * sin_lon[i];
+        oy[i] = sin_lat * static_cast<double>(depth[i]);
+        oz[i] = -(horizontal * cos_lon[i]);
+      }
+      if (inner < cols) {  // Column `width`: column 0.
+        const double horizontal = cos_lat * static_cast<double>(depth_row[0]);
+        ox[inner] = horizontal * dirs_.sin_lon[0];
+        oy[inner] = sin_lat * static_cast<double>(depth_row[0]);
+        oz[inner] = -(horizontal * dirs_.cos_lon[0]);
       }
     }
   }
@@ -188,7 +219,9 @@ class LayerPyramid {
     const size_t top = static_cast<size_t>(y0 - tile_y0_) * stride + (x0 - tile_x0_);
     const size_t bottom = top + static_cast<size_t>(s) * stride;
     auto position = [&](size_t node, double out[3]) {
-      for (int i = 0; i < 3; ++i) out[i] = positions_[3 * node + i];
+      out[0] = px_[node];
+      out[1] = py_[node];
+      out[2] = pz_[node];
     };
     double a[3], b[3], c[3], d[3];
     position(top, a);
@@ -201,24 +234,44 @@ class LayerPyramid {
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 0.0)) return kInf;
     for (double& e : n) e /= len;
-    // Separate running minima and maxima for even and odd columns shorten the
-    // dependency chains; the range does not depend on the order of the nodes.
-    double lo0 = kInf, hi0 = -kInf, lo1 = kInf, hi1 = -kInf;
+    // n . p of every node, two nodes per vector (the same products and sums
+    // as n[0] * x + n[1] * y + n[2] * z per node), with running minima and
+    // maxima; the range does not depend on the order of the nodes.
+    using internal::F64x2;
+    const F64x2 n0 = internal::SplatF64x2(n[0]), n1 = internal::SplatF64x2(n[1]),
+                n2 = internal::SplatF64x2(n[2]);
+    F64x2 lo2 = internal::SplatF64x2(kInf), hi2 = internal::SplatF64x2(-kInf);
+    F64x2 lo2b = lo2, hi2b = hi2;
+    double lo0 = kInf, hi0 = -kInf;
     for (size_t row = top; row <= bottom; row += stride) {
-      const double* q = &positions_[3 * row];
+      const double* qx = &px_[row];
+      const double* qy = &py_[row];
+      const double* qz = &pz_[row];
       int x = 0;
-      for (; x < s; x += 2, q += 6) {
-        const double t0 = n[0] * q[0] + n[1] * q[1] + n[2] * q[2];
-        const double t1 = n[0] * q[3] + n[1] * q[4] + n[2] * q[5];
-        lo0 = std::min(lo0, t0);
-        hi0 = std::max(hi0, t0);
-        lo1 = std::min(lo1, t1);
-        hi1 = std::max(hi1, t1);
+      for (; x + 4 <= s; x += 4) {
+        const F64x2 t = n0 * internal::LoadF64x2(qx + x) + n1 * internal::LoadF64x2(qy + x) +
+                        n2 * internal::LoadF64x2(qz + x);
+        const F64x2 tb = n0 * internal::LoadF64x2(qx + x + 2) +
+                         n1 * internal::LoadF64x2(qy + x + 2) + n2 * internal::LoadF64x2(qz + x + 2);
+        lo2 = internal::MinF64x2(lo2, t);
+        hi2 = internal::MaxF64x2(hi2, t);
+        lo2b = internal::MinF64x2(lo2b, tb);
+        hi2b = internal::MaxF64x2(hi2b, tb);
       }
-      const double t = n[0] * q[0] + n[1] * q[1] + n[2] * q[2];  // x == s (s is even).
+      for (; x + 2 <= s; x += 2) {
+        const F64x2 t = n0 * internal::LoadF64x2(qx + x) + n1 * internal::LoadF64x2(qy + x) +
+                        n2 * internal::LoadF64x2(qz + x);
+        lo2 = internal::MinF64x2(lo2, t);
+        hi2 = internal::MaxF64x2(hi2, t);
+      }
+      const double t = n[0] * qx[s] + n[1] * qy[s] + n[2] * qz[s];  // x == s (s is even).
       lo0 = std::min(lo0, t);
       hi0 = std::max(hi0, t);
     }
+    lo2 = internal::MinF64x2(lo2, lo2b);
+    hi2 = internal::MaxF64x2(hi2, hi2b);
+    const double lo1 = std::min(internal::Lane0(lo2), internal::Lane1(lo2));
+    const double hi1 = std::max(internal::Lane0(hi2), internal::Lane1(hi2));
     const double lo = std::min(lo0, lo1), hi = std::max(hi0, hi1);
     const double delta = 0.5 * (hi - lo);
     const double offset = std::fabs(0.5 * (hi + lo));
@@ -232,12 +285,13 @@ class LayerPyramid {
   int layer_;
   double max_error_;
   std::vector<uint8_t> full_;
+  std::vector<uint8_t> tile_has_full_;  // Per tile of the largest block size, row-major.
   std::vector<int> nx_, ny_;
   std::vector<std::vector<double>> error_;
   // The tile being evaluated (its top-left quad) and its node positions.
   int tile_x0_ = 0, tile_y0_ = 0;
   bool tile_ready_ = false;
-  std::vector<double> positions_;
+  std::vector<double> px_, py_, pz_;
 };
 
 // The triangles of BuildMesh(). A quad whose four front nodes are linked

@@ -1,0 +1,64 @@
+#pragma once
+
+// Two doubles in one vector register: SSE2 natively, SIMD128 in WebAssembly,
+// plain code elsewhere. Only operations whose result is fully specified by
+// IEEE 754 (add, multiply, compare-and-select min and max), so every build
+// gives the same bits as the scalar expressions named below. Internal to
+// format/; used by the simplifier's block errors.
+
+#if defined(__wasm_simd128__)
+#include <wasm_simd128.h>
+#elif defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace casual3d {
+namespace internal {
+
+#if defined(__wasm_simd128__)
+struct F64x2 {
+  v128_t v;
+};
+inline F64x2 LoadF64x2(const double* p) { return {wasm_v128_load(p)}; }
+inline F64x2 SplatF64x2(double x) { return {wasm_f64x2_splat(x)}; }
+inline F64x2 operator+(F64x2 a, F64x2 b) { return {wasm_f64x2_add(a.v, b.v)}; }
+inline F64x2 operator*(F64x2 a, F64x2 b) { return {wasm_f64x2_mul(a.v, b.v)}; }
+// Per lane t < lo ? t : lo, which is std::min(lo, t).
+inline F64x2 MinF64x2(F64x2 lo, F64x2 t) { return {wasm_f64x2_pmin(lo.v, t.v)}; }
+// Per lane hi < t ? t : hi, which is std::max(hi, t).
+inline F64x2 MaxF64x2(F64x2 hi, F64x2 t) { return {wasm_f64x2_pmax(hi.v, t.v)}; }
+inline double Lane0(F64x2 a) { return wasm_f64x2_extract_lane(a.v, 0); }
+inline double Lane1(F64x2 a) { return wasm_f64x2_extract_lane(a.v, 1); }
+#elif defined(__SSE2__)
+struct F64x2 {
+  __m128d v;
+};
+inline F64x2 LoadF64x2(const double* p) { return {_mm_loadu_pd(p)}; }
+inline F64x2 SplatF64x2(double x) { return {_mm_set1_pd(x)}; }
+inline F64x2 operator+(F64x2 a, F64x2 b) { return {_mm_add_pd(a.v, b.v)}; }
+inline F64x2 operator*(F64x2 a, F64x2 b) { return {_mm_mul_pd(a.v, b.v)}; }
+// minpd(a, b) is a < b ? a : b, maxpd(a, b) is a > b ? a : b.
+inline F64x2 MinF64x2(F64x2 lo, F64x2 t) { return {_mm_min_pd(t.v, lo.v)}; }
+inline F64x2 MaxF64x2(F64x2 hi, F64x2 t) { return {_mm_max_pd(t.v, hi.v)}; }
+inline double Lane0(F64x2 a) { return _mm_cvtsd_f64(a.v); }
+inline double Lane1(F64x2 a) { return _mm_cvtsd_f64(_mm_unpackhi_pd(a.v, a.v)); }
+#else
+struct F64x2 {
+  double v[2];
+};
+inline F64x2 LoadF64x2(const double* p) { return {{p[0], p[1]}}; }
+inline F64x2 SplatF64x2(double x) { return {{x, x}}; }
+inline F64x2 operator+(F64x2 a, F64x2 b) { return {{a.v[0] + b.v[0], a.v[1] + b.v[1]}}; }
+inline F64x2 operator*(F64x2 a, F64x2 b) { return {{a.v[0] * b.v[0], a.v[1] * b.v[1]}}; }
+inline F64x2 MinF64x2(F64x2 lo, F64x2 t) {
+  return {{t.v[0] < lo.v[0] ? t.v[0] : lo.v[0], t.v[1] < lo.v[1] ? t.v[1] : lo.v[1]}};
+}
+inline F64x2 MaxF64x2(F64x2 hi, F64x2 t) {
+  return {{hi.v[0] < t.v[0] ? t.v[0] : hi.v[0], hi.v[1] < t.v[1] ? t.v[1] : hi.v[1]}};
+}
+inline double Lane0(F64x2 a) { return a.v[0]; }
+inline double Lane1(F64x2 a) { return a.v[1]; }
+#endif
+
+}  // namespace internal
+}  // namespace casual3d
