@@ -2,7 +2,8 @@
 
 // Two doubles in one vector register: SSE2 natively, SIMD128 in WebAssembly,
 // plain code elsewhere. Only operations whose result is fully specified by
-// IEEE 754 (add, multiply, compare-and-select min and max), so every build
+// IEEE 754 (add, subtract, multiply, divide, square root, compare-and-select
+// min and max, lane moves), so every build
 // gives the same bits as the scalar expressions named below. Internal to
 // format/; used by the simplifier's block errors.
 
@@ -27,6 +28,12 @@ inline F64x2 operator*(F64x2 a, F64x2 b) { return {wasm_f64x2_mul(a.v, b.v)}; }
 inline F64x2 MinF64x2(F64x2 lo, F64x2 t) { return {wasm_f64x2_pmin(lo.v, t.v)}; }
 // Per lane hi < t ? t : hi, which is std::max(hi, t).
 inline F64x2 MaxF64x2(F64x2 hi, F64x2 t) { return {wasm_f64x2_pmax(hi.v, t.v)}; }
+inline F64x2 operator-(F64x2 a, F64x2 b) { return {wasm_f64x2_sub(a.v, b.v)}; }
+inline F64x2 operator/(F64x2 a, F64x2 b) { return {wasm_f64x2_div(a.v, b.v)}; }
+inline F64x2 SqrtF64x2(F64x2 a) { return {wasm_f64x2_sqrt(a.v)}; }
+// (a0, b0) and (a1, b1).
+inline F64x2 UnpackLo(F64x2 a, F64x2 b) { return {wasm_i64x2_shuffle(a.v, b.v, 0, 2)}; }
+inline F64x2 UnpackHi(F64x2 a, F64x2 b) { return {wasm_i64x2_shuffle(a.v, b.v, 1, 3)}; }
 inline double Lane0(F64x2 a) { return wasm_f64x2_extract_lane(a.v, 0); }
 inline double Lane1(F64x2 a) { return wasm_f64x2_extract_lane(a.v, 1); }
 #elif defined(__SSE2__)
@@ -40,9 +47,19 @@ inline F64x2 operator*(F64x2 a, F64x2 b) { return {_mm_mul_pd(a.v, b.v)}; }
 // minpd(a, b) is a < b ? a : b, maxpd(a, b) is a > b ? a : b.
 inline F64x2 MinF64x2(F64x2 lo, F64x2 t) { return {_mm_min_pd(t.v, lo.v)}; }
 inline F64x2 MaxF64x2(F64x2 hi, F64x2 t) { return {_mm_max_pd(t.v, hi.v)}; }
+inline F64x2 operator-(F64x2 a, F64x2 b) { return {_mm_sub_pd(a.v, b.v)}; }
+inline F64x2 operator/(F64x2 a, F64x2 b) { return {_mm_div_pd(a.v, b.v)}; }
+inline F64x2 SqrtF64x2(F64x2 a) { return {_mm_sqrt_pd(a.v)}; }
+inline F64x2 UnpackLo(F64x2 a, F64x2 b) { return {_mm_unpacklo_pd(a.v, b.v)}; }
+inline F64x2 UnpackHi(F64x2 a, F64x2 b) { return {_mm_unpackhi_pd(a.v, b.v)}; }
 inline double Lane0(F64x2 a) { return _mm_cvtsd_f64(a.v); }
 inline double Lane1(F64x2 a) { return _mm_cvtsd_f64(_mm_unpackhi_pd(a.v, a.v)); }
 #else
+}  // namespace internal
+}  // namespace casual3d
+#include <cmath>
+namespace casual3d {
+namespace internal {
 struct F64x2 {
   double v[2];
 };
@@ -56,6 +73,11 @@ inline F64x2 MinF64x2(F64x2 lo, F64x2 t) {
 inline F64x2 MaxF64x2(F64x2 hi, F64x2 t) {
   return {{hi.v[0] < t.v[0] ? t.v[0] : hi.v[0], hi.v[1] < t.v[1] ? t.v[1] : hi.v[1]}};
 }
+inline F64x2 operator-(F64x2 a, F64x2 b) { return {{a.v[0] - b.v[0], a.v[1] - b.v[1]}}; }
+inline F64x2 operator/(F64x2 a, F64x2 b) { return {{a.v[0] / b.v[0], a.v[1] / b.v[1]}}; }
+inline F64x2 SqrtF64x2(F64x2 a) { return {{std::sqrt(a.v[0]), std::sqrt(a.v[1])}}; }
+inline F64x2 UnpackLo(F64x2 a, F64x2 b) { return {{a.v[0], b.v[0]}}; }
+inline F64x2 UnpackHi(F64x2 a, F64x2 b) { return {{a.v[1], b.v[1]}}; }
 inline double Lane0(F64x2 a) { return a.v[0]; }
 inline double Lane1(F64x2 a) { return a.v[1]; }
 #endif

@@ -276,25 +276,33 @@ Mesh MeshAssembler::Finish() {
   }
 
   Mesh mesh;
-  mesh.positions.reserve(3 * static_cast<size_t>(count));
-  mesh.normals.reserve(3 * static_cast<size_t>(count));
-  mesh.uvs.reserve(2 * static_cast<size_t>(count));
-  mesh.colors.reserve(3 * static_cast<size_t>(count));
-  // Vertices are appended in index order: regular nodes, then seam copies.
+  mesh.positions.resize(3 * static_cast<size_t>(count));
+  mesh.normals.resize(3 * static_cast<size_t>(count));
+  mesh.uvs.resize(2 * static_cast<size_t>(count));
+  mesh.colors.resize(3 * static_cast<size_t>(count));
+  float* position = mesh.positions.data();
+  float* normal = mesh.normals.data();
+  float* uv = mesh.uvs.data();
+  uint8_t* colour = mesh.colors.data();
+  // Vertices are written in index order: regular nodes, then seam copies.
   auto emit = [&](int x, int y, int layer, int half, bool seam) {
     const LayerData& d = pano_.layer(layer);
     const size_t i = pano_.index(x, y);
     const double depth = d.depth_m[i];
     const double horizontal = cos_lat[y] * depth;
-    mesh.positions.push_back(static_cast<float>(horizontal * sin_lon[x]));
-    mesh.positions.push_back(static_cast<float>(sin_lat[y] * depth));
-    mesh.positions.push_back(static_cast<float>(-(horizontal * cos_lon[x])));
+    position[0] = static_cast<float>(horizontal * sin_lon[x]);
+    position[1] = static_cast<float>(sin_lat[y] * depth);
+    position[2] = static_cast<float>(-(horizontal * cos_lon[x]));
     for (int c = 0; c < 3; ++c) {
-      mesh.normals.push_back(d.normal[3 * i + c]);
-      mesh.colors.push_back(d.rgb[3 * i + c]);
+      normal[c] = d.normal[3 * i + c];
+      colour[c] = d.rgb[3 * i + c];
     }
-    mesh.uvs.push_back(u_of[seam ? w : x]);
-    mesh.uvs.push_back(v_of[2 * y + half]);
+    uv[0] = u_of[seam ? w : x];
+    uv[1] = v_of[2 * y + half];
+    position += 3;
+    normal += 3;
+    colour += 3;
+    uv += 2;
   };
   // Used keys in increasing order, i.e. (row, column, layer, half) order.
   for (size_t word = 0; word < words; ++word) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -75,7 +76,9 @@ class LayerPyramid {
           const int by_end = std::min(ny_[k], (y0 + tile) / s);
           const int bx_end = std::min(nx_[k], (x0 + tile) / s);
           for (int by = y0 / s; by < by_end; ++by) {
-            for (int bx = x0 / s; bx < bx_end; ++bx) {
+            int bx = x0 / s;
+            if (k == 1) bx = Level1Pairs(by, bx, bx_end);
+            for (; bx < bx_end; ++bx) {
               error_[k][Index(k, bx, by)] = BlockError(k, bx, by);
             }
           }
@@ -93,15 +96,12 @@ class LayerPyramid {
   int ny(int k) const { return ny_[k]; }
   size_t Index(int k, int bx, int by) const { return static_cast<size_t>(by) * nx_[k] + bx; }
   double Error(int k, int bx, int by) const { return error_[k][Index(k, bx, by)]; }
+  // Error(k, bx, by) for bx = 0 .. nx(k) - 1.
+  const double* ErrorRow(int k, int by) const { return &error_[k][Index(k, 0, by)]; }
   // Whether pixel quad (x, y) has four nodes of this layer linked around it.
   bool FullQuad(int x, int y) const { return full_[static_cast<size_t>(y) * nx_[0] + x] != 0; }
-  // The parent's error, or infinity if the parent block does not exist.
-  double ParentError(int k, int bx, int by) const {
-    if (k == levels()) return kInf;
-    const int px = bx / 2, py = by / 2;
-    if (px >= nx_[k + 1] || py >= ny_[k + 1]) return kInf;
-    return error_[k + 1][Index(k + 1, px, py)];
-  }
+  // FullQuad(x, y) for x = 0 .. width - 1 (1 or 0 per quad).
+  const uint8_t* FullRow(int y) const { return &full_[static_cast<size_t>(y) * nx_[0]]; }
 
  private:
   // full_: whether all four corners of a quad are nodes of this layer, linked
@@ -113,21 +113,42 @@ class LayerPyramid {
     const int w = p_.width(), qh = p_.height() - 1;
     const LayerData& d = p_.layer(layer_);
     const bool front = layer_ == kFront;
-    std::vector<uint8_t> upper(w), lower(w);
+    // Rows of node bits, padded to whole 8-byte words plus one byte (column
+    // w repeats column 0), processed 8 nodes at a time in 64-bit words.
+    const size_t words = (static_cast<size_t>(w) + 1 + 7) / 8;
+    std::vector<uint8_t> upper(8 * words + 8, 0), lower(8 * words + 8, 0);
+    constexpr uint64_t kOnes = 0x0101010101010101ull;
+    auto load = [](const uint8_t* p) {
+      uint64_t v;
+      std::memcpy(&v, p, sizeof(v));
+      return v;
+    };
     auto row_bits = [&](int y, std::vector<uint8_t>* out) {
       const uint8_t* links = &d.links[p_.index(0, y)];
       const uint8_t* present = &d.present[p_.index(0, y)];
       uint8_t* o = out->data();
-      for (int x = 0; x < w; ++x) {
+      int x = 0;
+      for (; x + 8 <= w; x += 8) {
+        const uint64_t L = load(links + x), P = load(present + x);
+        const uint64_t lo = L & (0x55 * kOnes), hi = (L >> 1) & (0x55 * kOnes);
+        const uint64_t same = front ? lo & ~hi : hi & ~lo;  // Link::kFront is 1, kBack 2.
+        // Bit 7 of each byte: the byte of P is not zero.
+        const uint64_t nonzero = ((P & (0x7f * kOnes)) + 0x7f * kOnes) | P;
+        const uint64_t bits = same | (nonzero & (0x80 * kOnes));
+        std::memcpy(o + x, &bits, sizeof(bits));
+      }
+      for (; x < w; ++x) {
         const unsigned lo = links[x] & 0x55u, hi = (links[x] >> 1) & 0x55u;
-        const unsigned same = front ? lo & ~hi : hi & ~lo;  // Link::kFront is 1, kBack 2.
+        const unsigned same = front ? lo & ~hi : hi & ~lo;
         o[x] = static_cast<uint8_t>(same | (present[x] != 0 ? 0x80u : 0u));
       }
+      o[w] = o[0];
     };
     constexpr unsigned kP = 0x80, kR = 1u << (2 * kRight), kD = 1u << (2 * kDown),
                        kL = 1u << (2 * kLeft), kU = 1u << (2 * kUp);
-    constexpr unsigned kA = kP | kR | kD, kB = kP | kD | kL, kC = kP | kR | kU, kDD = kP | kU | kL;
-    full_.assign(static_cast<size_t>(w) * qh, 0);
+    constexpr uint64_t kA = (kP | kR | kD) * kOnes, kB = (kP | kD | kL) * kOnes,
+                       kC = (kP | kR | kU) * kOnes, kDD = (kP | kU | kL) * kOnes;
+    full_.assign(static_cast<size_t>(w) * qh + 8, 0);  // 8 bytes of slack for word stores.
     const int tiles_x = (w + tile - 1) / tile;
     tile_has_full_.assign(static_cast<size_t>(tiles_x) * ((qh + tile - 1) / tile), 0);
     if (qh > 0) row_bits(0, &upper);
@@ -136,12 +157,14 @@ class LayerPyramid {
       uint8_t* full = &full_[static_cast<size_t>(y) * w];
       const uint8_t* u = upper.data();
       const uint8_t* l = lower.data();
-      for (int x = 0; x + 1 < w; ++x) {
-        full[x] = static_cast<uint8_t>(((u[x] & kA) == kA) & ((u[x + 1] & kB) == kB) &
-                                       ((l[x] & kC) == kC) & ((l[x + 1] & kDD) == kDD));
+      // A quad is full when no required bit is missing at any of its corners.
+      for (int x = 0; x < w; x += 8) {
+        const uint64_t missing = (~load(u + x) & kA) | (~load(u + x + 1) & kB) |
+                                 (~load(l + x) & kC) | (~load(l + x + 1) & kDD);
+        const uint64_t any_missing = ((missing & (0x7f * kOnes)) + 0x7f * kOnes) | missing;
+        const uint64_t bits = (~any_missing >> 7) & kOnes;
+        std::memcpy(full + x, &bits, sizeof(bits));  // Past w only into the next row or slack.
       }
-      full[w - 1] = static_cast<uint8_t>(((u[w - 1] & kA) == kA) & ((u[0] & kB) == kB) &
-                                         ((l[w - 1] & kC) == kC) & ((l[0] & kDD) == kDD));
       uint8_t* has = &tile_has_full_[static_cast<size_t>(y / tile) * tiles_x];
       for (int tx = 0; tx < tiles_x; ++tx) {
         const int end = std::min(w, (tx + 1) * tile);
@@ -165,9 +188,10 @@ class LayerPyramid {
     const int rows = std::min(tile, last_row - tile_y0_) + 1;
     const int cols = std::min(tile, w - tile_x0_) + 1;
     const size_t stride = static_cast<size_t>(tile) + 1;
-    px_.resize(stride * stride);
-    py_.resize(stride * stride);
-    pz_.resize(stride * stride);
+    // Two doubles of padding: Level1Pairs loads one past a row's last node.
+    px_.resize(stride * stride + 2);
+    py_.resize(stride * stride + 2);
+    pz_.resize(stride * stride + 2);
     const LayerData& d = p_.layer(layer_);
     // Columns tile_x0_ .. tile_x0_ + inner - 1 need no wrap.
     const int inner = std::min(cols, w - tile_x0_);
@@ -194,6 +218,86 @@ class LayerPyramid {
         oz[inner] = -(horizontal * dirs_.cos_lon[0]);
       }
     }
+  }
+
+  // The level-1 blocks bx_begin, bx_begin + 1, ... of block row `by` in the
+  // current tile, two blocks per vector (lane 0 block bx, lane 1 block bx + 1),
+  // with exactly the arithmetic of BlockError. Returns the first block not
+  // done (at most one is left for BlockError).
+  int Level1Pairs(int by, int bx_begin, int bx_end) {
+    using internal::F64x2;
+    using internal::LoadF64x2;
+    using internal::UnpackHi;
+    using internal::UnpackLo;
+    const size_t stride = (size_t{1} << levels()) + 1;
+    const size_t quads = static_cast<size_t>(nx_[0]);
+    int bx = bx_begin;
+    for (; bx + 2 <= bx_end; bx += 2) {
+      const int x0 = 2 * bx, y0 = 2 * by;
+      const uint8_t* f0 = &full_[static_cast<size_t>(y0) * quads + x0];
+      const uint8_t* f1 = f0 + quads;
+      const bool mergeable[2] = {(f0[0] & f0[1] & f1[0] & f1[1]) != 0,
+                                 (f0[2] & f0[3] & f1[2] & f1[3]) != 0};
+      if (!mergeable[0] && !mergeable[1]) continue;  // Both stay infinite.
+      PrepareTile();
+      // Node (x0 + i, y0 + r) of lane 0 and (x0 + 2 + i, y0 + r) of lane 1:
+      // row r of a plane gives nodes i = 0, 1, 2 of both lanes.
+      const size_t top = static_cast<size_t>(y0 - tile_y0_) * stride + (x0 - tile_x0_);
+      auto load_row = [](const double* q, F64x2 out[3]) {
+        const F64x2 a = LoadF64x2(q), b = LoadF64x2(q + 2), c = LoadF64x2(q + 4);
+        out[0] = UnpackLo(a, b);
+        out[1] = UnpackHi(a, b);
+        out[2] = UnpackLo(b, c);
+      };
+      // Corners A (0, 0), B (2, 0), C (0, 2), D (2, 2).
+      F64x2 n0, n1, n2, len;
+      {
+        const size_t bottom = top + 2 * stride;
+        auto corners = [&](const std::vector<double>& plane, F64x2* u, F64x2* v) {
+          F64x2 row0[3], row2[3];
+          load_row(&plane[top], row0);
+          load_row(&plane[bottom], row2);
+          *u = row2[2] - row0[0];  // D - A
+          *v = row2[0] - row0[2];  // C - B
+        };
+        F64x2 u0, u1, u2, v0, v1, v2;
+        corners(px_, &u0, &v0);
+        corners(py_, &u1, &v1);
+        corners(pz_, &u2, &v2);
+        n0 = u1 * v2 - u2 * v1;
+        n1 = u2 * v0 - u0 * v2;
+        n2 = u0 * v1 - u1 * v0;
+        len = internal::SqrtF64x2(n0 * n0 + n1 * n1 + n2 * n2);
+        n0 = n0 / len;
+        n1 = n1 / len;
+        n2 = n2 / len;
+      }
+      F64x2 lo = internal::SplatF64x2(kInf), hi = internal::SplatF64x2(-kInf);
+      for (int r = 0; r < 3; ++r) {
+        const size_t at = top + r * stride;
+        F64x2 X[3], Y[3], Z[3];
+        load_row(&px_[at], X);
+        load_row(&py_[at], Y);
+        load_row(&pz_[at], Z);
+        for (int i = 0; i < 3; ++i) {
+          const F64x2 t = n0 * X[i] + n1 * Y[i] + n2 * Z[i];
+          lo = internal::MinF64x2(lo, t);
+          hi = internal::MaxF64x2(hi, t);
+        }
+      }
+      const double lens[2] = {internal::Lane0(len), internal::Lane1(len)};
+      const double los[2] = {internal::Lane0(lo), internal::Lane1(lo)};
+      const double his[2] = {internal::Lane0(hi), internal::Lane1(hi)};
+      for (int lane = 0; lane < 2; ++lane) {
+        if (!mergeable[lane] || !(lens[lane] > 0.0)) continue;
+        const double delta = 0.5 * (his[lane] - los[lane]);
+        const double offset = std::fabs(0.5 * (his[lane] + los[lane]));
+        if (!(offset > delta)) continue;  // The slab contains the centre.
+        const double error = std::max(0.0, 2.0 * delta / (offset - delta));
+        if (error <= max_error_) error_[1][Index(1, bx + lane, by)] = error;
+      }
+    }
+    return bx;
   }
 
   // Spec/mesh.md Sec. 5.2: the children must be mergeable; the plane normal is
@@ -303,20 +407,27 @@ int64_t CountFullTriangles(const TwoLayerPanorama& p, const LayerPyramid& front,
   const bool use_back = back != nullptr;
   const int w = p.width(), qh = p.height() - 1;
   const std::vector<uint8_t>& back_present = p.layer(kBack).present;
-  std::vector<uint8_t> back_in_column(w, 0);  // A back node at (x, y) or (x, y + 1).
+  std::vector<uint8_t> back_in_column(w + 1, 0);  // A back node at (x, y) or (x, y + 1).
   int64_t triangles = 0;
   for (int y = 0; y < qh; ++y) {
     if (use_back) {
-      const size_t i0 = p.index(0, y);
-      for (int x = 0; x < w; ++x) {
-        back_in_column[x] = back_present[i0 + x] | back_present[i0 + w + x];
-      }
+      const uint8_t* upper = &back_present[p.index(0, y)];
+      const uint8_t* lower = upper + w;
+      for (int x = 0; x < w; ++x) back_in_column[x] = upper[x] | lower[x];
+      back_in_column[w] = back_in_column[0];
     }
+    const uint8_t* full = front.FullRow(y);
+    // Two triangles for each front-full quad without back nodes; the other
+    // quads one by one.
+    int64_t simple = 0;
     for (int x = 0; x < w; ++x) {
-      const int xb = x + 1 == w ? 0 : x + 1;
-      if (front.FullQuad(x, y) && !(back_in_column[x] | back_in_column[xb])) {
-        triangles += 2;
-      } else if (front.FullQuad(x, y) && use_back && back->FullQuad(x, y)) {
+      simple += full[x] & ((back_in_column[x] | back_in_column[x + 1]) == 0 ? 1 : 0);
+    }
+    triangles += 2 * simple;
+    for (int x = 0; x < w; ++x) {
+      const bool no_back = (back_in_column[x] | back_in_column[x + 1]) == 0;
+      if (full[x] && no_back) continue;
+      if (full[x] && use_back && back->FullQuad(x, y)) {
         triangles += 4;
       } else {
         triangles += CountQuadTriangles(p, x, y, use_back, 0);
@@ -338,14 +449,22 @@ void AddSavings(const LayerPyramid& py, const StepOf& step_of, std::vector<int64
   std::vector<int8_t> parent_steps, block_steps;
   for (int k = py.levels(); k >= 1; --k) {
     const int64_t s = (int64_t{2} << (2 * k)) - 2;
-    block_steps.assign(static_cast<size_t>(py.nx(k)) * py.ny(k), -1);
+    const int nx = py.nx(k);
+    block_steps.assign(static_cast<size_t>(nx) * py.ny(k), -1);
     for (int by = 0; by < py.ny(k); ++by) {
-      for (int bx = 0; bx < py.nx(k); ++bx) {
-        const int last = step_of(py.Error(k, bx, by));
+      const double* error = py.ErrorRow(k, by);
+      int8_t* steps = &block_steps[static_cast<size_t>(by) * nx];
+      // Blocks with a parent: columns below parent_nx in a row below the
+      // parent level's last row.
+      const bool parent_row = k < py.levels() && by / 2 < py.ny(k + 1);
+      const int parent_nx = parent_row ? py.nx(k + 1) : 0;
+      const int8_t* parents =
+          parent_row ? &parent_steps[static_cast<size_t>(by / 2) * parent_nx] : nullptr;
+      for (int bx = 0; bx < nx; ++bx) {
+        const int last = step_of(error[bx]);
         if (last < 0) continue;
-        block_steps[py.Index(k, bx, by)] = static_cast<int8_t>(last);
-        const bool has_parent = k < py.levels() && bx / 2 < py.nx(k + 1) && by / 2 < py.ny(k + 1);
-        const int parent = has_parent ? parent_steps[py.Index(k + 1, bx / 2, by / 2)] : -1;
+        steps[bx] = static_cast<int8_t>(last);
+        const int parent = bx / 2 < parent_nx ? parents[bx / 2] : -1;
         (*saving)[parent + 1] += s;  // i in (parent, last].
         (*saving)[last + 1] -= s;
       }
@@ -368,11 +487,15 @@ std::vector<Leaf> SelectLeaves(const std::vector<LayerPyramid>& pyramids, double
     const LayerPyramid& py = pyramids[l];
     for (int k = py.levels(); k >= 1; --k) {
       for (int by = 0; by < py.ny(k); ++by) {
+        const double* error = py.ErrorRow(k, by);
+        const bool parent_row = k < py.levels() && by / 2 < py.ny(k + 1);
+        const int parent_nx = parent_row ? py.nx(k + 1) : 0;
+        const double* parents = parent_row ? py.ErrorRow(k + 1, by / 2) : nullptr;
         for (int bx = 0; bx < py.nx(k); ++bx) {
-          const double e = py.Error(k, bx, by);
-          if (e <= tau && !(py.ParentError(k, bx, by) <= tau)) {
-            leaves.push_back({static_cast<int>(l), k, bx << k, by << k, e});
-          }
+          const double e = error[bx];
+          if (!(e <= tau)) continue;
+          if (bx / 2 < parent_nx && parents[bx / 2] <= tau) continue;  // The parent is merged.
+          leaves.push_back({static_cast<int>(l), k, bx << k, by << k, e});
         }
       }
     }
@@ -383,14 +506,15 @@ std::vector<Leaf> SelectLeaves(const std::vector<LayerPyramid>& pyramids, double
 // Builds the simplified mesh for a set of leaves (spec/mesh.md Sec. 5.4).
 Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>& leaves) {
   const int w = p.width(), qh = p.height() - 1;
-  std::vector<uint8_t> covered(static_cast<size_t>(w) * qh, 0);
+  // Per layer, whether a leaf of that layer covers the quad (1 or 0).
+  std::vector<uint8_t> covered[kNumLayers];
+  for (int l = 0; l < (use_back ? kNumLayers : 1); ++l) {
+    covered[l].assign(static_cast<size_t>(w) * qh, 0);
+  }
   for (const Leaf& leaf : leaves) {
     const int s = 1 << leaf.level;
-    for (int y = leaf.y0; y < leaf.y0 + s; ++y) {
-      for (int x = leaf.x0; x < leaf.x0 + s; ++x) {
-        covered[static_cast<size_t>(y) * w + x] |= static_cast<uint8_t>(1u << leaf.layer);
-      }
-    }
+    uint8_t* row = &covered[leaf.layer][static_cast<size_t>(leaf.y0) * w + leaf.x0];
+    for (int y = 0; y < s; ++y, row += w) std::memset(row, 1, static_cast<size_t>(s));
   }
   MeshAssembler out(p);
   out.Reserve(2 * static_cast<size_t>(w) * qh / 4 + 1024);
@@ -398,20 +522,26 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
   // has no triangle left (each triangle starts at a corner node of an
   // uncovered layer).
   const std::vector<uint8_t>& back_present = p.layer(kBack).present;
-  std::vector<uint8_t> back_in_column(w, 0);  // A back node at (x, y) or (x, y + 1).
+  std::vector<uint8_t> back_in_column(w + 1, 0);  // A back node at (x, y) or (x, y + 1).
   for (int y = 0; y < qh; ++y) {
-    const uint8_t* row_covered = &covered[static_cast<size_t>(y) * w];
+    const uint8_t* front_covered = &covered[kFront][static_cast<size_t>(y) * w];
+    const uint8_t* back_covered =
+        use_back ? &covered[kBack][static_cast<size_t>(y) * w] : nullptr;
     if (use_back) {
-      const size_t i0 = p.index(0, y);
-      for (int x = 0; x < w; ++x) {
-        back_in_column[x] = back_present[i0 + x] | back_present[i0 + w + x];
-      }
+      const uint8_t* upper = &back_present[p.index(0, y)];
+      const uint8_t* lower = upper + w;
+      for (int x = 0; x < w; ++x) back_in_column[x] = upper[x] | lower[x];
+      back_in_column[w] = back_in_column[0];
     }
     for (int x = 0; x < w; ++x) {
-      const int xb = x + 1 == w ? 0 : x + 1;
-      const unsigned back_needed = (back_in_column[x] | back_in_column[xb]) ? 2u : 0u;
-      if ((row_covered[x] & 1u) && !(back_needed & ~row_covered[x])) continue;
-      AddQuadTriangles(p, x, y, use_back, row_covered[x], &out);
+      if (!front_covered[x]) {
+        const unsigned skip = use_back ? static_cast<unsigned>(back_covered[x]) << 1 : 0u;
+        AddQuadTriangles(p, x, y, use_back, skip, &out);
+        continue;
+      }
+      // Covered in front: triangles remain only from back nodes not covered.
+      if (!(back_in_column[x] | back_in_column[x + 1]) || back_covered[x]) continue;
+      AddQuadTriangles(p, x, y, use_back, 1u, &out);
     }
   }
   // Nodes that geometry outside a leaf uses: every vertex of the remaining
@@ -536,7 +666,7 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
   for (int i = 1; i < kNumSteps; ++i) steps[i] = steps[i - 1] * kQuarterOctave;
   steps[kNumSteps] = 0.0;
   for (int i = kNumSteps + 1; i < kStepsPadded; ++i) steps[i] = -kInf;
-  auto step_of = [&](double e) {  // The last (finest) step i with e <= steps[i], or -1.
+  auto search_step = [&](double e) {  // The last (finest) step i with e <= steps[i], or -1.
     if (!(e <= steps[0])) return -1;
     // e <= steps[i] holds for a prefix of i (steps decrease): find its end
     // without data-dependent branches.
@@ -545,6 +675,29 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
       last = e <= steps[last + half] ? last + half : last;
     }
     return last;
+  };
+  // The same function through a table over the leading bits of e (exponent
+  // and 4 mantissa bits): a bucket spans a factor of at most 2^(1/16), less
+  // than the 2^(1/4) between steps, so the step of a bucket's smallest value
+  // is the answer or one more than it for every e in the bucket.
+  auto bucket_of = [](double e) {
+    uint64_t bits;
+    std::memcpy(&bits, &e, sizeof(bits));
+    return bits >> 48;
+  };
+  const uint64_t first_bucket = bucket_of(steps[kNumSteps - 1]);
+  std::vector<int8_t> bucket_step(bucket_of(steps[0]) - first_bucket + 1);
+  for (size_t b = 0; b < bucket_step.size(); ++b) {
+    const uint64_t low_bits = (first_bucket + b) << 48;
+    double low;
+    std::memcpy(&low, &low_bits, sizeof(low));
+    bucket_step[b] = static_cast<int8_t>(search_step(low));
+  }
+  auto step_of = [&](double e) {
+    if (!(e <= steps[0])) return -1;
+    if (e <= steps[kNumSteps - 1]) return e <= 0.0 ? kNumSteps : kNumSteps - 1;
+    const int g = bucket_step[bucket_of(e) - first_bucket];
+    return e <= steps[g] ? g : g - 1;
   };
   std::vector<int64_t> saving(kNumSteps + 2, 0);  // Difference array over step indices.
   for (const LayerPyramid& py : pyramids) AddSavings(py, step_of, &saving);
