@@ -352,21 +352,37 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano) {
   for (int l = 0; l < kNumLayers; ++l) {
     LayerData& L = pano->layer(l);
     const size_t n = L.present.size();
-    for (size_t i = 0; i < n; ++i) {
-      if (L.present[i]) {
-        if (!(L.depth_m[i] > 0))
+    const uint8_t* present = L.present.data();
+    // Present nodes must have a depth: one branch-free pass, then the first
+    // offender for the message.
+    bool missing = false;
+    for (size_t i = 0; i < n; ++i) missing |= (present[i] != 0) & !(L.depth_m[i] > 0);
+    if (missing) {
+      for (size_t i = 0; i < n; ++i) {
+        if (present[i] && !(L.depth_m[i] > 0))
           return InvalidData(std::string(l == kFront ? "front" : "back") + " node at pixel " +
                              PixelName(static_cast<int>(i % pano->width()),
                                        static_cast<int>(i / pano->width())) +
                              " has no depth (code 0)");
-        continue;
       }
-      L.depth_m[i] = 0.0f;
-      L.label[i] = 0;
-      L.links[i] = 0;
+    }
+    // Every field of an absent node becomes zero, array by array.
+    float* depth = L.depth_m.data();
+    uint8_t* label = L.label.data();
+    uint8_t* links = L.links.data();
+    for (size_t i = 0; i < n; ++i) {
+      const bool keep = present[i] != 0;
+      depth[i] = keep ? depth[i] : 0.0f;
+      label[i] = keep ? label[i] : 0;
+      links[i] = keep ? links[i] : 0;
+    }
+    uint8_t* rgb = L.rgb.data();
+    float* normal = L.normal.data();
+    for (size_t i = 0; i < n; ++i) {
+      const bool keep = present[i] != 0;
       for (int c = 0; c < 3; ++c) {
-        L.rgb[3 * i + c] = 0;
-        L.normal[3 * i + c] = 0.0f;
+        rgb[3 * i + c] = keep ? rgb[3 * i + c] : 0;
+        normal[3 * i + c] = keep ? normal[3 * i + c] : 0.0f;
       }
     }
   }

@@ -194,6 +194,60 @@ TEST(TileCodecTest, TableDecodingMatchesTheReferenceFunctions) {
   }
 }
 
+// PackageReader::FinishLevel checks only the links of a decoded level
+// (TwoLayerPanorama::ValidateLinks): every value the decoder tables can give
+// must be one Validate() accepts. Each valid normal code of every bit depth
+// and each depth code of extreme quantizations, as present front nodes of a
+// panorama without links.
+TEST(TileCodecTest, EveryDecodableValueIsValidForValidate) {
+  for (int normal_bits = 4; normal_bits <= 8; ++normal_bits) {
+    TileQuantization q;
+    q.normal.bits = normal_bits;
+    const TileDecoder decoder(q);
+    const int m = q.normal.MaxCode();
+    TwoLayerPanorama pano(m + 1, m + 1);
+    LayerData& F = pano.layer(kFront);
+    int valid = 0;
+    for (int c0 = 0; c0 <= m; ++c0) {
+      for (int c1 = 0; c1 <= m; ++c1) {
+        const uint8_t code[2] = {static_cast<uint8_t>(c0), static_cast<uint8_t>(c1)};
+        if (!decoder.NormalValid(code)) continue;
+        ++valid;
+        const size_t i = pano.index(c0, c1);
+        F.present[i] = 1;
+        F.depth_m[i] = 1.0f;
+        for (int c = 0; c < 3; ++c) F.normal[3 * i + c] = decoder.Normal(code)[c];
+      }
+    }
+    EXPECT_EQ(valid, m * m + 1) << normal_bits << " bits";  // (1..M)^2 and (0, 0).
+    const Status s = pano.Validate();
+    EXPECT_TRUE(s.ok()) << normal_bits << " bits: " << s.ToString();
+  }
+  struct Range {
+    double near_m, far_m;
+    int bits;
+  };
+  for (const Range& r : {Range{1e-3, 1e6, 16}, Range{0.5, 0.5, 8}, Range{1e-4, 1e5, 8},
+                         Range{2.0, 2e9, 16}}) {
+    TileQuantization q;
+    q.depth.near_m = r.near_m;
+    q.depth.far_m = r.far_m;
+    q.depth.bits = r.bits;
+    ASSERT_TRUE(q.Check().ok());
+    const TileDecoder decoder(q);
+    const int codes = q.depth.MaxCode();
+    TwoLayerPanorama pano(256, (codes + 255) / 256);
+    LayerData& F = pano.layer(kFront);
+    for (int code = 1; code <= codes; ++code) {
+      const size_t i = static_cast<size_t>(code - 1);
+      F.present[i] = 1;
+      F.depth_m[i] = decoder.Depth(static_cast<uint16_t>(code));
+    }
+    const Status s = pano.Validate();
+    EXPECT_TRUE(s.ok()) << r.near_m << ".." << r.far_m << " m: " << s.ToString();
+  }
+}
+
 // Errors name the first invalid pixel in row, column, layer order, whichever
 // layer it is in.
 TEST(TileCodecTest, ErrorsNameTheFirstInvalidPixel) {

@@ -190,7 +190,11 @@ bool TwoLayerPanorama::Neighbour(int x, int y, Direction d, int* nx, int* ny) co
   return false;
 }
 
-bool TwoLayerPanorama::NodesAndLinksAreValid() const {
+bool TwoLayerPanorama::NodesAndLinksAreValid() const { return ScanIsValid<true>(); }
+bool TwoLayerPanorama::LinksAreValid() const { return ScanIsValid<false>(); }
+
+template <bool kCheckNodes>
+bool TwoLayerPanorama::ScanIsValid() const {
   const LayerData& front = layers_[kFront];
   const LayerData& back = layers_[kBack];
   const uint8_t* front_links = front.links.data();
@@ -208,8 +212,10 @@ bool TwoLayerPanorama::NodesAndLinksAreValid() const {
     bool bad = false;
     for (size_t x = 0; x < w; ++x) {
       const size_t i = row + x;
-      bad |= NodeInvalid(front, i);
-      bad |= NodeInvalid(back, i);
+      if (kCheckNodes) {
+        bad |= NodeInvalid(front, i);
+        bad |= NodeInvalid(back, i);
+      }
       // The edge to the right neighbour (wrapping at the seam) and the one below.
       const size_t r = x + 1 == w ? row : i + 1;
       bad |= kLinkPairs.invalid[PairCode(front_links[i], back_links[i], kRightBits, front_links[r],
@@ -225,7 +231,10 @@ bool TwoLayerPanorama::NodesAndLinksAreValid() const {
   return true;
 }
 
-Status TwoLayerPanorama::Validate() const {
+Status TwoLayerPanorama::Validate() const { return Check(true); }
+Status TwoLayerPanorama::ValidateLinks() const { return Check(false); }
+
+Status TwoLayerPanorama::Check(bool nodes) const {
   if (width_ < 1 || height_ < 1) {
     return InvalidData("panorama size " + std::to_string(width_) + "x" + std::to_string(height_) +
                        " is empty");
@@ -249,7 +258,7 @@ Status TwoLayerPanorama::Validate() const {
   // Valid panoramas (the common case: every level the viewer shows) pass one
   // fast scan; only a rejected one is scanned again, node by node, to name its
   // first problem in the order documented below.
-  if (NodesAndLinksAreValid()) return Status::Ok();
+  if (nodes ? NodesAndLinksAreValid() : LinksAreValid()) return Status::Ok();
   return FirstNodeOrLinkProblem();
 }
 

@@ -76,14 +76,25 @@ class TwoLayerPanorama {
   // Checks sizes, value ranges, and that every link is mutual and points at an
   // existing node. Returns the first problem found, naming layer and pixel.
   Status Validate() const;
+  // Validate() for a panorama whose node values are valid by construction,
+  // such as the output of FinishDecodedPanorama (format/tile_codec.h): checks
+  // sizes, the frame and every link, but not each node's values. A panorama
+  // that fails is scanned node by node, naming its first problem exactly as
+  // Validate() would.
+  Status ValidateLinks() const;
 
   bool operator==(const TwoLayerPanorama& o) const;
 
  private:
-  // Validate's two halves after the size checks: a single branch-light scan
-  // that only says whether every node and link is valid, and the node-by-node
+  // The body of Validate (nodes true) and ValidateLinks (nodes false): the
+  // size and frame checks, then a single branch-light scan that only says
+  // whether every node (if `nodes`) and link is valid, and the node-by-node
   // scan that names the first problem (run only when the first one fails).
+  Status Check(bool nodes) const;
   bool NodesAndLinksAreValid() const;
+  bool LinksAreValid() const;  // NodesAndLinksAreValid() without the node values.
+  template <bool kCheckNodes>
+  bool ScanIsValid() const;
   Status FirstNodeOrLinkProblem() const;
   friend struct TwoLayerPanoramaTestAccess;  // two_layer_test.cc compares the two scans.
 

@@ -405,6 +405,37 @@ TEST(TwoLayerTest, FastScanAgreesWithNodeByNodeScan) {
   EXPECT_GT(rejected, 300);
 }
 
+// ValidateLinks() trusts the node values and checks the rest: with valid
+// nodes and random link edits it agrees with Validate(), message included;
+// a bad node value alone passes it.
+TEST(TwoLayerTest, ValidateLinksAgreesWithValidateOnLinkEdits) {
+  std::mt19937 rng(11);
+  const TwoLayerPanorama bases[] = {testing::MakeRoomPanorama(64, 32), FullyLinked(),
+                                    FullyLinked(1, 3), FullyLinked(5, 1)};
+  int rejected = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    TwoLayerPanorama p = bases[trial % 4];
+    const int edits = 1 + static_cast<int>(rng() % 3);
+    for (int e = 0; e < edits; ++e) {
+      LayerData& d = p.layer(static_cast<int>(rng() % 2));
+      const size_t i = rng() % d.present.size();
+      if (!d.present[i]) continue;  // Absent nodes keep zero links.
+      d.links[i] =
+          SetLink(d.links[i], static_cast<Direction>(rng() % 4), static_cast<Link>(rng() % 4));
+    }
+    const Status full = p.Validate(), links = p.ValidateLinks();
+    ASSERT_EQ(full.ToString(), links.ToString()) << "trial " << trial;
+    rejected += full.ok() ? 0 : 1;
+  }
+  EXPECT_GT(rejected, 300);
+  TwoLayerPanorama p = FullyLinked();
+  p.layer(kFront).depth_m[p.index(1, 1)] = -1.0f;
+  EXPECT_FALSE(p.Validate().ok());
+  EXPECT_TRUE(p.ValidateLinks().ok());
+  p.layer(kFront).links[p.index(1, 1)] = 0;  // Its neighbours' links are no longer mutual.
+  EXPECT_FALSE(p.ValidateLinks().ok());
+}
+
 TEST(TwoLayerTest, FrameMustBeARotation) {
   TwoLayerPanorama p = FullyLinked();
   p.frame().rotation[0] = -1.0;  // A reflection.
