@@ -214,6 +214,23 @@ void MeshAssembler::ChooseAtlasHalves() {
   }
 }
 
+namespace {
+
+// Set bits of v: one instruction in wasm and where the target has POPCNT,
+// else the parallel bit count (the compiler's fallback is a library call).
+inline uint32_t PopCount(uint64_t v) {
+#if defined(__wasm__) || defined(__POPCNT__)
+  return static_cast<uint32_t>(__builtin_popcountll(v));
+#else
+  v = v - ((v >> 1) & 0x5555555555555555ull);
+  v = (v & 0x3333333333333333ull) + ((v >> 2) & 0x3333333333333333ull);
+  v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<uint32_t>((v * 0x0101010101010101ull) >> 56);
+#endif
+}
+
+}  // namespace
+
 Mesh MeshAssembler::Finish() {
   ChooseAtlasHalves();
   const int w = pano_.width(), h = pano_.height();
@@ -246,14 +263,14 @@ Mesh MeshAssembler::Finish() {
   uint32_t count = 0;
   for (size_t i = 0; i < words; ++i) {
     used_before[i] = count;
-    count += static_cast<uint32_t>(__builtin_popcountll(used[i]));
+    count += PopCount(used[i]);
   }
   for (uint32_t& v : seam_vertex_of) {
     if (v) v = ++count;
   }
   auto vertex_of = [&](uint32_t key) {
     const uint64_t below = used[key >> 6] & ((uint64_t{1} << (key & 63)) - 1);
-    return used_before[key >> 6] + static_cast<uint32_t>(__builtin_popcountll(below));
+    return used_before[key >> 6] + PopCount(below);
   };
 
   // Direction tables (Sec. 3 of spec/mesh.md): longitude per column and
@@ -304,14 +321,26 @@ Mesh MeshAssembler::Finish() {
     colour += 3;
     uv += 2;
   };
-  // Used keys in increasing order, i.e. (row, column, layer, half) order.
+  // Used keys in increasing order, i.e. (row, column, layer, half) order. A
+  // word holds the keys of 16 pixels; its first pixel's row and column are
+  // carried from word to word instead of divided out per key.
+  int word_x = 0, word_y = 0;
   for (size_t word = 0; word < words; ++word) {
     for (uint64_t bits = used[word]; bits != 0; bits &= bits - 1) {
-      const size_t key = word * 64 + static_cast<size_t>(__builtin_ctzll(bits));
-      const size_t pixel = key >> 2;
-      const int l = static_cast<int>((key >> 1) & 1);
-      const int other = static_cast<int>(key & 1);
-      emit(static_cast<int>(pixel % w), static_cast<int>(pixel / w), l, l ^ other, false);
+      const int bit = __builtin_ctzll(bits);
+      int x = word_x + (bit >> 2), y = word_y;
+      if (x >= w) {  // 16 pixels may run into the next rows when w < 16.
+        y += x / w;
+        x %= w;
+      }
+      const int l = (bit >> 1) & 1;
+      const int other = bit & 1;
+      emit(x, y, l, l ^ other, false);
+    }
+    word_x += 16;
+    if (word_x >= w) {
+      word_y += word_x / w;
+      word_x %= w;
     }
   }
   for (int y = 0; y < h; ++y) {

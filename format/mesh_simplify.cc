@@ -18,6 +18,30 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kNumSteps = 80;
 constexpr double kQuarterOctave = 0.84089641525371454303;
 
+// Eight bytes from p as one word (any alignment).
+inline uint64_t Load64(const uint8_t* p) {
+  uint64_t v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+constexpr uint64_t kOnes = 0x0101010101010101ull;
+
+// back_in_column[x] = 1 if pixel (x, y) or (x, y + 1) has a back node, for
+// x = 0 .. w - 1, and back_in_column[w] = back_in_column[0]; the array holds
+// at least w + 1 bytes.
+inline void BackInColumns(const TwoLayerPanorama& p, int y, uint8_t* back_in_column) {
+  const int w = p.width();
+  const uint8_t* upper = &p.layer(kBack).present[p.index(0, y)];
+  const uint8_t* lower = upper + w;
+  int x = 0;
+  for (; x + 8 <= w; x += 8) {
+    const uint64_t v = Load64(upper + x) | Load64(lower + x);
+    std::memcpy(back_in_column + x, &v, sizeof(v));
+  }
+  for (; x < w; ++x) back_in_column[x] = upper[x] | lower[x];
+  back_in_column[w] = back_in_column[0];
+}
+
 // Pixel-centre direction tables, the same arithmetic as MeshAssembler::Finish.
 struct Directions {
   std::vector<double> sin_lon, cos_lon, sin_lat, cos_lat;
@@ -117,12 +141,7 @@ class LayerPyramid {
     // w repeats column 0), processed 8 nodes at a time in 64-bit words.
     const size_t words = (static_cast<size_t>(w) + 1 + 7) / 8;
     std::vector<uint8_t> upper(8 * words + 8, 0), lower(8 * words + 8, 0);
-    constexpr uint64_t kOnes = 0x0101010101010101ull;
-    auto load = [](const uint8_t* p) {
-      uint64_t v;
-      std::memcpy(&v, p, sizeof(v));
-      return v;
-    };
+    auto load = Load64;
     auto row_bits = [&](int y, std::vector<uint8_t>* out) {
       const uint8_t* links = &d.links[p_.index(0, y)];
       const uint8_t* present = &d.present[p_.index(0, y)];
@@ -168,9 +187,11 @@ class LayerPyramid {
       uint8_t* has = &tile_has_full_[static_cast<size_t>(y / tile) * tiles_x];
       for (int tx = 0; tx < tiles_x; ++tx) {
         const int end = std::min(w, (tx + 1) * tile);
-        unsigned any = 0;
-        for (int x = tx * tile; x < end; ++x) any |= full[x];
-        has[tx] |= static_cast<uint8_t>(any);
+        uint64_t any = 0;
+        int x = tx * tile;
+        for (; x + 8 <= end; x += 8) any |= load(full + x);
+        for (; x < end; ++x) any |= full[x];
+        has[tx] |= any != 0 ? 1 : 0;
       }
       upper.swap(lower);
     }
@@ -406,28 +427,35 @@ int64_t CountFullTriangles(const TwoLayerPanorama& p, const LayerPyramid& front,
                            const LayerPyramid* back) {
   const bool use_back = back != nullptr;
   const int w = p.width(), qh = p.height() - 1;
-  const std::vector<uint8_t>& back_present = p.layer(kBack).present;
-  std::vector<uint8_t> back_in_column(w + 1, 0);  // A back node at (x, y) or (x, y + 1).
+  std::vector<uint8_t> back_in_column(w + 8, 0);  // See BackInColumns; zero without the back layer.
   int64_t triangles = 0;
   for (int y = 0; y < qh; ++y) {
-    if (use_back) {
-      const uint8_t* upper = &back_present[p.index(0, y)];
-      const uint8_t* lower = upper + w;
-      for (int x = 0; x < w; ++x) back_in_column[x] = upper[x] | lower[x];
-      back_in_column[w] = back_in_column[0];
-    }
+    if (use_back) BackInColumns(p, y, back_in_column.data());
     const uint8_t* full = front.FullRow(y);
-    // Two triangles for each front-full quad without back nodes; the other
-    // quads one by one.
-    int64_t simple = 0;
-    for (int x = 0; x < w; ++x) {
-      simple += full[x] & ((back_in_column[x] | back_in_column[x + 1]) == 0 ? 1 : 0);
+    const uint8_t* bic = back_in_column.data();
+    int x = 0;
+    // Two triangles for each front-full quad without back nodes, eight quads
+    // at a time where all eight are such; the other quads one by one.
+    for (; x + 8 <= w; x += 8) {
+      const uint64_t simple = Load64(full + x) & ~(Load64(bic + x) | Load64(bic + x + 1));
+      if (simple == kOnes) {
+        triangles += 16;
+        continue;
+      }
+      for (int i = x; i < x + 8; ++i) {
+        if (full[i] && !(bic[i] | bic[i + 1])) {
+          triangles += 2;
+        } else if (full[i] && use_back && back->FullQuad(i, y)) {
+          triangles += 4;
+        } else {
+          triangles += CountQuadTriangles(p, i, y, use_back, 0);
+        }
+      }
     }
-    triangles += 2 * simple;
-    for (int x = 0; x < w; ++x) {
-      const bool no_back = (back_in_column[x] | back_in_column[x + 1]) == 0;
-      if (full[x] && no_back) continue;
-      if (full[x] && use_back && back->FullQuad(x, y)) {
+    for (; x < w; ++x) {
+      if (full[x] && !(bic[x] | bic[x + 1])) {
+        triangles += 2;
+      } else if (full[x] && use_back && back->FullQuad(x, y)) {
         triangles += 4;
       } else {
         triangles += CountQuadTriangles(p, x, y, use_back, 0);
@@ -521,26 +549,27 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
   // A quad covered by leaves of every layer that has a node at its corners
   // has no triangle left (each triangle starts at a corner node of an
   // uncovered layer).
-  const std::vector<uint8_t>& back_present = p.layer(kBack).present;
-  std::vector<uint8_t> back_in_column(w + 1, 0);  // A back node at (x, y) or (x, y + 1).
+  std::vector<uint8_t> back_in_column(w + 8, 0);  // See BackInColumns; zero without the back layer.
+  const uint8_t* bic = back_in_column.data();
   for (int y = 0; y < qh; ++y) {
     const uint8_t* front_covered = &covered[kFront][static_cast<size_t>(y) * w];
     const uint8_t* back_covered =
         use_back ? &covered[kBack][static_cast<size_t>(y) * w] : nullptr;
-    if (use_back) {
-      const uint8_t* upper = &back_present[p.index(0, y)];
-      const uint8_t* lower = upper + w;
-      for (int x = 0; x < w; ++x) back_in_column[x] = upper[x] | lower[x];
-      back_in_column[w] = back_in_column[0];
-    }
+    if (use_back) BackInColumns(p, y, back_in_column.data());
     for (int x = 0; x < w; ++x) {
+      // Eight quads covered in front without back nodes have no triangle.
+      if ((x & 7) == 0 && x + 8 <= w &&
+          (Load64(front_covered + x) & ~(Load64(bic + x) | Load64(bic + x + 1))) == kOnes) {
+        x += 7;
+        continue;
+      }
       if (!front_covered[x]) {
         const unsigned skip = use_back ? static_cast<unsigned>(back_covered[x]) << 1 : 0u;
         AddQuadTriangles(p, x, y, use_back, skip, &out);
         continue;
       }
       // Covered in front: triangles remain only from back nodes not covered.
-      if (!(back_in_column[x] | back_in_column[x + 1]) || back_covered[x]) continue;
+      if (!(bic[x] | bic[x + 1]) || back_covered[x]) continue;
       AddQuadTriangles(p, x, y, use_back, 1u, &out);
     }
   }
