@@ -30,7 +30,7 @@ const Scene& RoomScene(int width) {
   scene.mesh = *BuildMesh(pano);
   scene.atlas = Image8(width, width, 3);
   for (int l = 0; l < kNumLayers; ++l) {
-    const std::vector<uint8_t>& rgb = pano.layer(l).rgb;
+    const NodeArray<uint8_t>& rgb = pano.layer(l).rgb;
     std::copy(rgb.begin(), rgb.end(),
               scene.atlas.data() + static_cast<size_t>(l) * width * (width / 2) * 3);
   }

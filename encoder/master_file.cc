@@ -56,7 +56,7 @@ const FloatChannel kFloatChannels[] = {
     {"Z", 0, 1}, {"N.X", 0, 3}, {"N.Y", 1, 3}, {"N.Z", 2, 3}};
 constexpr int kNumFloatChannels = sizeof(kFloatChannels) / sizeof(kFloatChannels[0]);
 
-std::vector<uint8_t>& ByteArray(LayerData& layer, int channel) {
+NodeArray<uint8_t>& ByteArray(LayerData& layer, int channel) {
   switch (channel) {
     case 0: return layer.present;
     case 1: case 2: case 3: return layer.rgb;
@@ -64,10 +64,10 @@ std::vector<uint8_t>& ByteArray(LayerData& layer, int channel) {
     default: return layer.links;
   }
 }
-const std::vector<uint8_t>& ByteArray(const LayerData& layer, int channel) {
+const NodeArray<uint8_t>& ByteArray(const LayerData& layer, int channel) {
   return ByteArray(const_cast<LayerData&>(layer), channel);
 }
-std::vector<float>& FloatArray(LayerData& layer, int channel) {
+NodeArray<float>& FloatArray(LayerData& layer, int channel) {
   return channel == 0 ? layer.depth_m : layer.normal;
 }
 

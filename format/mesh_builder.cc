@@ -189,8 +189,8 @@ int CountQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back
 }
 
 void MeshAssembler::ChooseAtlasHalves() {
-  const std::vector<uint8_t>& front_present = pano_.layer(kFront).present;
-  const std::vector<uint8_t>& back_present = pano_.layer(kBack).present;
+  const NodeArray<uint8_t>& front_present = pano_.layer(kFront).present;
+  const NodeArray<uint8_t>& back_present = pano_.layer(kBack).present;
   for (size_t t = 0; t + 2 < refs_.size(); t += 3) {
     NodeRef* tri = &refs_[t];
     const unsigned layers = (tri[0] & 1u) + (tri[1] & 1u) + (tri[2] & 1u);

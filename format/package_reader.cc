@@ -48,7 +48,9 @@ Status PackageReader::BeginLevel(int level, int64_t max_pixels) {
                          "x" + std::to_string(L.height) + ", more than the limit of " +
                          std::to_string(max_pixels) + " pixels");
   level_ = level;
-  pano_ = TwoLayerPanorama(L.width, L.height);
+  // The level's tiles cover it and FinishLevel requires every image of every
+  // tile, whose decoding writes every field of every node.
+  pano_ = TwoLayerPanorama::Unfilled(L.width, L.height);
   pano_.frame() = manifest_.frame;
   received_.assign(L.tiles.size() * kNumTileImageKinds, 0);
   return Status::Ok();

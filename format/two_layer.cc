@@ -151,6 +151,22 @@ TwoLayerPanorama::TwoLayerPanorama(int width, int height) : width_(width), heigh
   }
 }
 
+TwoLayerPanorama TwoLayerPanorama::Unfilled(int width, int height) {
+  TwoLayerPanorama p;
+  p.width_ = width;
+  p.height_ = height;
+  const size_t n = static_cast<size_t>(width > 0 ? width : 0) * (height > 0 ? height : 0);
+  for (LayerData& layer : p.layers_) {
+    layer.present.resize(n);
+    layer.rgb.resize(3 * n);
+    layer.depth_m.resize(n);
+    layer.normal.resize(3 * n);
+    layer.label.resize(n);
+    layer.links.resize(n);
+  }
+  return p;
+}
+
 bool TwoLayerPanorama::NodeDepthRange(double* near_m, double* far_m) const {
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
   for (const LayerData& L : layers_) {

@@ -6,6 +6,9 @@
 // B) and links to nodes of its 4 neighbours. spec/ is the normative text.
 
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <utility>
 #include <vector>
 
 #include "format/equirect.h"
@@ -36,16 +39,42 @@ inline uint8_t SetLink(uint8_t links, Direction d, Link l) {
   return static_cast<uint8_t>((links & ~(3u << (2 * d))) | (static_cast<unsigned>(l) << (2 * d)));
 }
 
+// The allocator of the node arrays: std::allocator, except that resize()
+// without a value leaves new elements (bytes and floats) uninitialised, so
+// that a decoder which writes every element does not pay for zeroing them
+// first. assign(n, v), resize(n, v) and copies initialise as usual.
+template <typename T>
+struct NodeArrayAllocator : std::allocator<T> {
+  using value_type = T;
+  template <typename U>
+  struct rebind {
+    using other = NodeArrayAllocator<U>;
+  };
+  NodeArrayAllocator() = default;
+  template <typename U>
+  NodeArrayAllocator(const NodeArrayAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+template <typename T>
+using NodeArray = std::vector<T, NodeArrayAllocator<T>>;
+
 // Arrays of one layer, each width*height long (times 3 for rgb and normal),
 // row-major. A pixel without a node of this layer has present 0 and all its
 // other fields zero.
 struct LayerData {
-  std::vector<uint8_t> present;  // 1 if the node exists.
-  std::vector<uint8_t> rgb;      // sRGB colour, 8 bits per channel.
-  std::vector<float> depth_m;    // Distance from the frame centre along the ray, > 0, finite.
-  std::vector<float> normal;     // Unit normal in the panorama frame, or (0,0,0): unlit (sky).
-  std::vector<uint8_t> label;    // NodeLabel.
-  std::vector<uint8_t> links;    // 4 Links packed as above.
+  NodeArray<uint8_t> present;  // 1 if the node exists.
+  NodeArray<uint8_t> rgb;      // sRGB colour, 8 bits per channel.
+  NodeArray<float> depth_m;    // Distance from the frame centre along the ray, > 0, finite.
+  NodeArray<float> normal;     // Unit normal in the panorama frame, or (0,0,0): unlit (sky).
+  NodeArray<uint8_t> label;    // NodeLabel.
+  NodeArray<uint8_t> links;    // 4 Links packed as above.
 };
 
 class TwoLayerPanorama {
@@ -53,6 +82,10 @@ class TwoLayerPanorama {
   TwoLayerPanorama() = default;
   // All nodes absent. Precondition: width, height > 0 (see Validate for limits).
   TwoLayerPanorama(int width, int height);
+  // Arrays of the right sizes with unspecified contents, for a decoder that
+  // writes every element of every array before anything reads them (the
+  // package reader: a level's tiles cover it). Precondition as above.
+  static TwoLayerPanorama Unfilled(int width, int height);
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -20,8 +20,8 @@ class Writer {
     bytes_.resize(at + sizeof(T));
     std::memcpy(bytes_.data() + at, &v, sizeof(T));
   }
-  template <typename T>
-  void PutArray(const std::vector<T>& v) {
+  template <typename T, typename A>
+  void PutArray(const std::vector<T, A>& v) {
     const size_t at = bytes_.size();
     bytes_.resize(at + v.size() * sizeof(T));
     if (!v.empty()) std::memcpy(bytes_.data() + at, v.data(), v.size() * sizeof(T));
@@ -43,8 +43,8 @@ class Reader {
     at_ += sizeof(T);
     return true;
   }
-  template <typename T>
-  bool GetArray(size_t n, std::vector<T>* v) {
+  template <typename T, typename A>
+  bool GetArray(size_t n, std::vector<T, A>* v) {
     if (n > (size_ - at_) / sizeof(T)) return false;
     v->resize(n);
     if (n) std::memcpy(v->data(), data_ + at_, n * sizeof(T));
