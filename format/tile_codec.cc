@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace casual3d {
@@ -261,20 +262,32 @@ bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int 
   for (int y = 0; y < h; ++y) {
     const uint8_t* px = image.row(y);
     const size_t i0 = pano->index(x0, y0 + y);
-    for (int x = 0; x < w; ++x, px += kChannels) {
-      const uint8_t flags = px[2];
-      if (flags & kFlagReserved) {
-        *bad_x = x0 + x;
-        *bad_y = y0 + y;
-        return false;
+    uint8_t* __restrict front_present = &F.present[i0];
+    uint8_t* __restrict back_present = &B.present[i0];
+    uint8_t* __restrict front_label = &F.label[i0];
+    uint8_t* __restrict back_label = &B.label[i0];
+    uint8_t* __restrict front_links = &F.links[i0];
+    uint8_t* __restrict back_links = &B.links[i0];
+    unsigned reserved = 0;
+    for (int x = 0; x < w; ++x) {
+      const uint8_t* p = px + kChannels * x;
+      const unsigned flags = p[2];
+      reserved |= flags & kFlagReserved;
+      front_present[x] = static_cast<uint8_t>(flags & kFlagFrontPresent);
+      back_present[x] = static_cast<uint8_t>((flags & kFlagBackPresent) >> 1);
+      front_label[x] = static_cast<uint8_t>((flags & kFlagFrontLabel) >> 2);
+      back_label[x] = static_cast<uint8_t>((flags & kFlagBackLabel) >> 3);
+      front_links[x] = p[0];
+      back_links[x] = p[1];
+    }
+    if (reserved) {  // The first offending pixel of the row, for the message.
+      for (int x = 0; x < w; ++x) {
+        if (px[kChannels * x + 2] & kFlagReserved) {
+          *bad_x = x0 + x;
+          *bad_y = y0 + y;
+          return false;
+        }
       }
-      const size_t i = i0 + x;
-      F.present[i] = flags & kFlagFrontPresent;
-      B.present[i] = (flags & kFlagBackPresent) >> 1;
-      F.label[i] = (flags & kFlagFrontLabel) >> 2;
-      B.label[i] = (flags & kFlagBackLabel) >> 3;
-      F.links[i] = px[0];
-      B.links[i] = px[1];
     }
   }
   return true;
@@ -366,24 +379,37 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano) {
                              " has no depth (code 0)");
       }
     }
-    // Every field of an absent node becomes zero, array by array.
-    float* depth = L.depth_m.data();
-    uint8_t* label = L.label.data();
-    uint8_t* links = L.links.data();
-    for (size_t i = 0; i < n; ++i) {
-      const bool keep = present[i] != 0;
-      depth[i] = keep ? depth[i] : 0.0f;
-      label[i] = keep ? label[i] : 0;
-      links[i] = keep ? links[i] : 0;
-    }
-    uint8_t* rgb = L.rgb.data();
-    float* normal = L.normal.data();
-    for (size_t i = 0; i < n; ++i) {
-      const bool keep = present[i] != 0;
-      for (int c = 0; c < 3; ++c) {
-        rgb[3 * i + c] = keep ? rgb[3 * i + c] : 0;
-        normal[3 * i + c] = keep ? normal[3 * i + c] : 0.0f;
+    // Every field of an absent node becomes zero: runs of absent nodes are
+    // found eight flags at a time and cleared array by array.
+    auto clear = [&L](size_t begin, size_t end) {
+      const size_t k = end - begin;
+      std::memset(&L.depth_m[begin], 0, k * sizeof(float));
+      std::memset(&L.label[begin], 0, k);
+      std::memset(&L.links[begin], 0, k);
+      std::memset(&L.rgb[3 * begin], 0, 3 * k);
+      std::memset(&L.normal[3 * begin], 0, 3 * k * sizeof(float));
+    };
+    size_t i = 0;
+    while (i < n) {
+      // Skip present nodes.
+      while (i + 8 <= n) {
+        uint64_t word;
+        std::memcpy(&word, present + i, sizeof(word));
+        if (word != 0x0101010101010101ull) break;
+        i += 8;
       }
+      while (i < n && present[i]) ++i;
+      if (i == n) break;
+      size_t end = i + 1;
+      while (end + 8 <= n) {
+        uint64_t word;
+        std::memcpy(&word, present + end, sizeof(word));
+        if (word != 0) break;
+        end += 8;
+      }
+      while (end < n && !present[end]) ++end;
+      clear(i, end);
+      i = end;
     }
   }
   return Status::Ok();
