@@ -98,7 +98,7 @@ bool Linked(const TwoLayerPanorama& p, const NodeId& a, const NodeId& b) {
 // Every triangle: two of its edges are links, the third is the diagonal of a
 // pixel quad; it faces the centre (counter-clockwise seen from the origin).
 void CheckTriangles(const TwoLayerPanorama& p, const Mesh& m) {
-  const int w = p.width(), h = p.height();
+  const int w = p.width();
   for (size_t t = 0; t < m.num_triangles(); ++t) {
     NodeId n[3];
     for (int k = 0; k < 3; ++k) n[k] = NodeOfVertex(p, m, m.indices[3 * t + k]);

@@ -215,7 +215,9 @@ TEST(CoverageTest, GapsInsideTheMaskCloseRingByRingFromTheirRims) {
     // Columns 13..15 between the wall (column 12) and the object (column 0,
     // across the seam): 13 from the wall, 15 from the object, and 14, which
     // both rings reach at once, from the farther of the two.
-    if (y < 5) EXPECT_FLOAT_EQ(depth.at(13, y), 10.0f) << y;
+    if (y < 5) {
+      EXPECT_FLOAT_EQ(depth.at(13, y), 10.0f) << y;
+    }
     EXPECT_FLOAT_EQ(depth.at(14, y), 10.0f) << y;
     EXPECT_FLOAT_EQ(depth.at(15, y), 1.0f) << y;
   }
