@@ -131,8 +131,8 @@ class LayerPyramid {
   // full_: whether all four corners of a quad are nodes of this layer, linked
   // to each other around the quad. Per node, bit 7: present; bit 2d: the link
   // in direction d leads to this layer. Byte-wise arithmetic without tables,
-  // so that compilers vectorize the loops. Also notes which tiles of the
-  // largest block size hold a full quad at all (tile_has_full_).
+  // eight nodes per 64-bit word. Also notes which tiles of the largest block
+  // size hold a full quad at all (tile_has_full_).
   void FullQuads(int tile) {
     const int w = p_.width(), qh = p_.height() - 1;
     const LayerData& d = p_.layer(layer_);
