@@ -11,6 +11,16 @@
 
 import createCasual3dFormat from './casual3d-format.js';
 
+/**
+ * A module whose one function uses a SIMD instruction (i8x16.popcnt): it
+ * validates exactly where WebAssembly SIMD, which the format module is built
+ * with, is available.
+ */
+const SIMD_PROBE = new Uint8Array([
+  0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0, 10, 10, 1, 8, 0, 65, 0, 253, 15,
+  253, 98, 11,
+]);
+
 /** Copies `count` elements of a typed-array type out of the wasm heap. */
 function copyOut(module, Type, ptr, count) {
   if (count === 0) return new Type(0);
@@ -29,6 +39,10 @@ export class FormatModule {
 
   /** Instantiates the wasm module; `options` go to the Emscripten factory. */
   static async create(options = {}) {
+    if (!WebAssembly.validate(SIMD_PROBE)) {
+      throw new Error('this browser lacks WebAssembly SIMD, which the viewer needs ' +
+                      '(Chrome or Edge 91, Firefox 89, Safari 16.4 or later)');
+    }
     return new FormatModule(await createCasual3dFormat(options));
   }
 

@@ -62,3 +62,15 @@ test('wasm panorama blob parser refuses damaged input', () => {
   huge.writeUInt32LE(1 << 20, 8);
   assert.throws(() => format.parsePanoramaBlob(huge), /beyond the limit/);
 });
+
+test('a browser without WebAssembly SIMD gets a message naming it', async () => {
+  const validate = WebAssembly.validate;
+  // Such a browser refuses every module with a SIMD instruction.
+  WebAssembly.validate = (bytes) => !Array.from(bytes).includes(253) && validate(bytes);
+  try {
+    await assert.rejects(loadFormatModule(), /lacks WebAssembly SIMD.*Safari 16\.4/);
+  } finally {
+    WebAssembly.validate = validate;
+  }
+  assert.ok(await loadFormatModule(), 'loads again with SIMD');
+});
