@@ -5,6 +5,10 @@
 #include <cstring>
 #include <string>
 
+#if defined(__wasm_simd128__)
+#include <wasm_simd128.h>
+#endif
+
 namespace casual3d {
 namespace {
 
@@ -269,7 +273,38 @@ bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int 
     uint8_t* __restrict front_links = &F.links[i0];
     uint8_t* __restrict back_links = &B.links[i0];
     unsigned reserved = 0;
-    for (int x = 0; x < w; ++x) {
+    int x = 0;
+#if defined(__wasm_simd128__)
+    if (kChannels == 4) {
+      // 16 RGBA pixels at a time: R, G and B into their own vectors.
+      const v128_t one = wasm_i8x16_splat(1);
+      v128_t bad = wasm_i8x16_splat(0);
+      for (; x + 16 <= w; x += 16) {
+        const uint8_t* p = px + 4 * x;
+        v128_t t[4];
+        for (int j = 0; j < 4; ++j) {  // RRRR GGGG BBBB AAAA of 4 pixels.
+          t[j] = wasm_i8x16_shuffle(wasm_v128_load(p + 16 * j), wasm_v128_load(p + 16 * j), 0,
+                                    4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
+        }
+        const v128_t rg01 = wasm_i32x4_shuffle(t[0], t[1], 0, 4, 1, 5);
+        const v128_t rg23 = wasm_i32x4_shuffle(t[2], t[3], 0, 4, 1, 5);
+        const v128_t ba01 = wasm_i32x4_shuffle(t[0], t[1], 2, 6, 3, 7);
+        const v128_t ba23 = wasm_i32x4_shuffle(t[2], t[3], 2, 6, 3, 7);
+        const v128_t r = wasm_i64x2_shuffle(rg01, rg23, 0, 2);
+        const v128_t g = wasm_i64x2_shuffle(rg01, rg23, 1, 3);
+        const v128_t flags = wasm_i64x2_shuffle(ba01, ba23, 0, 2);
+        bad = wasm_v128_or(bad, wasm_v128_and(flags, wasm_i8x16_splat(kFlagReserved)));
+        wasm_v128_store(front_present + x, wasm_v128_and(flags, one));
+        wasm_v128_store(back_present + x, wasm_v128_and(wasm_u8x16_shr(flags, 1), one));
+        wasm_v128_store(front_label + x, wasm_v128_and(wasm_u8x16_shr(flags, 2), one));
+        wasm_v128_store(back_label + x, wasm_v128_and(wasm_u8x16_shr(flags, 3), one));
+        wasm_v128_store(front_links + x, r);
+        wasm_v128_store(back_links + x, g);
+      }
+      reserved |= wasm_v128_any_true(bad) ? 1u : 0u;
+    }
+#endif
+    for (; x < w; ++x) {
       const uint8_t* p = px + kChannels * x;
       const unsigned flags = p[2];
       reserved |= flags & kFlagReserved;
@@ -304,7 +339,19 @@ bool DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0,
       const size_t i0 = pano->index(x0, y0 + y);
       if (kind == TileImageKind::kColor) {
         uint8_t* rgb = &L.rgb[3 * i0];
-        for (int x = 0; x < w; ++x, px += kChannels, rgb += 3) {
+        int x = 0;
+#if defined(__wasm_simd128__)
+        if (kChannels == 4) {
+          // 4 RGBA pixels to 12 RGB bytes; each 16-byte store runs 4 bytes into
+          // the next pixel, so the loop stops one pixel before the row's end.
+          for (; x + 5 <= w; x += 4, px += 16, rgb += 12) {
+            const v128_t v = wasm_v128_load(px);
+            wasm_v128_store(rgb, wasm_i8x16_shuffle(v, v, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14,
+                                                    0, 0, 0, 0));
+          }
+        }
+#endif
+        for (; x < w; ++x, px += kChannels, rgb += 3) {
           rgb[0] = px[0];
           rgb[1] = px[1];
           rgb[2] = px[2];
