@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 
 #if defined(__wasm_simd128__)
@@ -413,17 +414,25 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano) {
     LayerData& L = pano->layer(l);
     const size_t n = L.present.size();
     const uint8_t* present = L.present.data();
-    // Present nodes must have a depth: one branch-free pass, then the first
-    // offender for the message.
-    bool missing = false;
-    for (size_t i = 0; i < n; ++i) missing |= (present[i] != 0) & !(L.depth_m[i] > 0);
-    if (missing) {
+    // Present nodes must have a finite depth (code 0 means none; a depth
+    // range beyond 32-bit floats decodes to infinity): one branch-free pass,
+    // then the first offender for the message.
+    constexpr float kMaxDepth = std::numeric_limits<float>::max();
+    bool bad = false;
+    for (size_t i = 0; i < n; ++i) {
+      const float d = L.depth_m[i];
+      bad |= (present[i] != 0) & !((d > 0) & (d <= kMaxDepth));
+    }
+    if (bad) {
       for (size_t i = 0; i < n; ++i) {
-        if (present[i] && !(L.depth_m[i] > 0))
+        const float d = L.depth_m[i];
+        if (present[i] && !(d > 0 && d <= kMaxDepth))
           return InvalidData(std::string(l == kFront ? "front" : "back") + " node at pixel " +
                              PixelName(static_cast<int>(i % pano->width()),
                                        static_cast<int>(i / pano->width())) +
-                             " has no depth (code 0)");
+                             (d > 0 ? " has a depth beyond the range of 32-bit floats (the "
+                                      "manifest's depth range is too large)"
+                                    : " has no depth (code 0)"));
       }
     }
     // Every field of an absent node becomes zero: runs of absent nodes are

@@ -135,7 +135,10 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
                        int h, const TileDecoder& decoder, TwoLayerPanorama* pano);
 
 // After all tiles are decoded: zeroes every field of absent nodes and checks
-// that every present node has a depth (code != 0). Returns the first problem.
+// that every present node has a finite depth (code != 0, and a depth range
+// within 32-bit floats). Returns the first problem. Afterwards every node value
+// is one that TwoLayerPanorama::Validate() accepts, so only the links remain
+// to check (TwoLayerPanorama::ValidateLinks()).
 Status FinishDecodedPanorama(TwoLayerPanorama* pano);
 
 }  // namespace casual3d

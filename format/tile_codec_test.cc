@@ -248,6 +248,30 @@ TEST(TileCodecTest, EveryDecodableValueIsValidForValidate) {
   }
 }
 
+// A depth range that the manifest allows (finite doubles) but 32-bit floats
+// cannot hold decodes to infinity, which FinishDecodedPanorama refuses.
+TEST(TileCodecTest, DepthsBeyondFloatRangeAreRefused) {
+  TileQuantization q;
+  q.depth.near_m = 1e36;
+  q.depth.far_m = 1e40;
+  ASSERT_TRUE(q.Check().ok());
+  const TileDecoder decoder(q);
+  TwoLayerPanorama p(4, 1);
+  for (int x = 0; x < 4; ++x) p.layer(kFront).present[p.index(x, 0)] = 1;
+  Image8 depth(4, 2, 3, 0);
+  for (int x = 0; x < 4; ++x) {
+    const int code = x < 3 ? 1 : q.depth.MaxCode();
+    depth.at(x, 0, 0) = static_cast<uint8_t>(code >> 8);
+    depth.at(x, 0, 1) = static_cast<uint8_t>(code & 255);
+  }
+  ASSERT_TRUE(DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 4, 1, decoder, &p).ok());
+  const Status s = FinishDecodedPanorama(&p);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidData);
+  EXPECT_NE(s.message().find("front node at pixel (3, 0) has a depth beyond the range of 32-bit"),
+            std::string::npos)
+      << s.ToString();
+}
+
 // Errors name the first invalid pixel in row, column, layer order, whichever
 // layer it is in.
 TEST(TileCodecTest, ErrorsNameTheFirstInvalidPixel) {
