@@ -279,6 +279,7 @@ bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int 
     if (kChannels == 4) {
       // 16 RGBA pixels at a time: R, G and B into their own vectors.
       const v128_t one = wasm_i8x16_splat(1);
+      const v128_t reserved_bits = wasm_i8x16_splat(static_cast<int8_t>(kFlagReserved));
       v128_t bad = wasm_i8x16_splat(0);
       for (; x + 16 <= w; x += 16) {
         const uint8_t* p = px + 4 * x;
@@ -294,7 +295,7 @@ bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int 
         const v128_t r = wasm_i64x2_shuffle(rg01, rg23, 0, 2);
         const v128_t g = wasm_i64x2_shuffle(rg01, rg23, 1, 3);
         const v128_t flags = wasm_i64x2_shuffle(ba01, ba23, 0, 2);
-        bad = wasm_v128_or(bad, wasm_v128_and(flags, wasm_i8x16_splat(static_cast<int8_t>(kFlagReserved))));
+        bad = wasm_v128_or(bad, wasm_v128_and(flags, reserved_bits));
         wasm_v128_store(front_present + x, wasm_v128_and(flags, one));
         wasm_v128_store(back_present + x, wasm_v128_and(wasm_u8x16_shr(flags, 1), one));
         wasm_v128_store(front_label + x, wasm_v128_and(wasm_u8x16_shr(flags, 2), one));
