@@ -377,7 +377,8 @@ class LayerPyramid {
         const F64x2 t = n0 * internal::LoadF64x2(qx + x) + n1 * internal::LoadF64x2(qy + x) +
                         n2 * internal::LoadF64x2(qz + x);
         const F64x2 tb = n0 * internal::LoadF64x2(qx + x + 2) +
-                         n1 * internal::LoadF64x2(qy + x + 2) + n2 * internal::LoadF64x2(qz + x + 2);
+                         n1 * internal::LoadF64x2(qy + x + 2) +
+                         n2 * internal::LoadF64x2(qz + x + 2);
         lo2 = internal::MinF64x2(lo2, t);
         hi2 = internal::MaxF64x2(hi2, t);
         lo2b = internal::MinF64x2(lo2b, tb);
