@@ -94,9 +94,9 @@ StatusOr<TwoLayerPanorama> PackageReader::FinishLevel() {
                              " was not added");
   }
   CASUAL3D_RETURN_IF_ERROR(FinishDecodedPanorama(&pano_));
-  // Decoding leaves only valid node values (FinishDecodedPanorama; the decoder
-  // tables hold finite positive depths and valid normals, tile_codec_test.cc),
-  // so the links are what remains to check.
+  // Decoding leaves only valid node values (FinishDecodedPanorama checks the
+  // depths and clears absent nodes; the decoder's normal table holds only
+  // valid normals, tile_codec_test.cc), so the links are what remains to check.
   Status valid = pano_.ValidateLinks();
   if (!valid.ok())
     return InvalidData("level " + std::to_string(level_) + ": the decoded panorama is invalid: " +
