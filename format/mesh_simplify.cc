@@ -141,14 +141,13 @@ class LayerPyramid {
     // w repeats column 0), processed 8 nodes at a time in 64-bit words.
     const size_t words = (static_cast<size_t>(w) + 1 + 7) / 8;
     std::vector<uint8_t> upper(8 * words + 8, 0), lower(8 * words + 8, 0);
-    auto load = Load64;
     auto row_bits = [&](int y, std::vector<uint8_t>* out) {
       const uint8_t* links = &d.links[p_.index(0, y)];
       const uint8_t* present = &d.present[p_.index(0, y)];
       uint8_t* o = out->data();
       int x = 0;
       for (; x + 8 <= w; x += 8) {
-        const uint64_t L = load(links + x), P = load(present + x);
+        const uint64_t L = Load64(links + x), P = Load64(present + x);
         const uint64_t lo = L & (0x55 * kOnes), hi = (L >> 1) & (0x55 * kOnes);
         const uint64_t same = front ? lo & ~hi : hi & ~lo;  // Link::kFront is 1, kBack 2.
         // Bit 7 of each byte: the byte of P is not zero.
@@ -178,8 +177,8 @@ class LayerPyramid {
       const uint8_t* l = lower.data();
       // A quad is full when no required bit is missing at any of its corners.
       for (int x = 0; x < w; x += 8) {
-        const uint64_t missing = (~load(u + x) & kA) | (~load(u + x + 1) & kB) |
-                                 (~load(l + x) & kC) | (~load(l + x + 1) & kDD);
+        const uint64_t missing = (~Load64(u + x) & kA) | (~Load64(u + x + 1) & kB) |
+                                 (~Load64(l + x) & kC) | (~Load64(l + x + 1) & kDD);
         const uint64_t any_missing = ((missing & (0x7f * kOnes)) + 0x7f * kOnes) | missing;
         const uint64_t bits = (~any_missing >> 7) & kOnes;
         std::memcpy(full + x, &bits, sizeof(bits));  // Past w only into the next row or slack.
@@ -189,7 +188,7 @@ class LayerPyramid {
         const int end = std::min(w, (tx + 1) * tile);
         uint64_t any = 0;
         int x = tx * tile;
-        for (; x + 8 <= end; x += 8) any |= load(full + x);
+        for (; x + 8 <= end; x += 8) any |= Load64(full + x);
         for (; x < end; ++x) any |= full[x];
         has[tx] |= any != 0 ? 1 : 0;
       }
@@ -311,11 +310,7 @@ class LayerPyramid {
       const double his[2] = {internal::Lane0(hi), internal::Lane1(hi)};
       for (int lane = 0; lane < 2; ++lane) {
         if (!mergeable[lane] || !(lens[lane] > 0.0)) continue;
-        const double delta = 0.5 * (his[lane] - los[lane]);
-        const double offset = std::fabs(0.5 * (his[lane] + los[lane]));
-        if (!(offset > delta)) continue;  // The slab contains the centre.
-        const double error = std::max(0.0, 2.0 * delta / (offset - delta));
-        if (error <= max_error_) error_[1][Index(1, bx + lane, by)] = error;
+        error_[1][Index(1, bx + lane, by)] = SlabError(los[lane], his[lane], 0.0);
       }
     }
     return bx;
@@ -398,7 +393,13 @@ class LayerPyramid {
     hi2 = internal::MaxF64x2(hi2, hi2b);
     const double lo1 = std::min(internal::Lane0(lo2), internal::Lane1(lo2));
     const double hi1 = std::max(internal::Lane0(hi2), internal::Lane1(hi2));
-    const double lo = std::min(lo0, lo1), hi = std::max(hi0, hi1);
+    return SlabError(std::min(lo0, lo1), std::max(hi0, hi1), children);
+  }
+
+  // The error of a block whose n.p range is [lo, hi] and whose children's
+  // largest error is `children` (spec/mesh.md Sec. 5.2 steps 2-3), infinity
+  // if it cannot be merged or exceeds max_error_.
+  double SlabError(double lo, double hi, double children) const {
     const double delta = 0.5 * (hi - lo);
     const double offset = std::fabs(0.5 * (hi + lo));
     if (!(offset > delta)) return kInf;  // The slab contains the centre.
@@ -434,26 +435,14 @@ int64_t CountFullTriangles(const TwoLayerPanorama& p, const LayerPyramid& front,
     if (use_back) BackInColumns(p, y, back_in_column.data());
     const uint8_t* full = front.FullRow(y);
     const uint8_t* bic = back_in_column.data();
-    int x = 0;
-    // Two triangles for each front-full quad without back nodes, eight quads
-    // at a time where all eight are such; the other quads one by one.
-    for (; x + 8 <= w; x += 8) {
-      const uint64_t simple = Load64(full + x) & ~(Load64(bic + x) | Load64(bic + x + 1));
-      if (simple == kOnes) {
+    for (int x = 0; x < w; ++x) {
+      // Eight front-full quads without back nodes: two triangles each.
+      if ((x & 7) == 0 && x + 8 <= w &&
+          (Load64(full + x) & ~(Load64(bic + x) | Load64(bic + x + 1))) == kOnes) {
         triangles += 16;
+        x += 7;
         continue;
       }
-      for (int i = x; i < x + 8; ++i) {
-        if (full[i] && !(bic[i] | bic[i + 1])) {
-          triangles += 2;
-        } else if (full[i] && use_back && back->FullQuad(i, y)) {
-          triangles += 4;
-        } else {
-          triangles += CountQuadTriangles(p, i, y, use_back, 0);
-        }
-      }
-    }
-    for (; x < w; ++x) {
       if (full[x] && !(bic[x] | bic[x + 1])) {
         triangles += 2;
       } else if (full[x] && use_back && back->FullQuad(x, y)) {

@@ -446,24 +446,21 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano) {
       std::memset(&L.rgb[3 * begin], 0, 3 * k);
       std::memset(&L.normal[3 * begin], 0, 3 * k * sizeof(float));
     };
+    // The 8 present flags from i, which are 0 or 1 (graph decoding).
+    auto flags_at = [present](size_t i) {
+      uint64_t word;
+      std::memcpy(&word, present + i, sizeof(word));
+      return word;
+    };
+    constexpr uint64_t kAllPresent = 0x0101010101010101ull;
     size_t i = 0;
     while (i < n) {
       // Skip present nodes.
-      while (i + 8 <= n) {
-        uint64_t word;
-        std::memcpy(&word, present + i, sizeof(word));
-        if (word != 0x0101010101010101ull) break;
-        i += 8;
-      }
+      while (i + 8 <= n && flags_at(i) == kAllPresent) i += 8;
       while (i < n && present[i]) ++i;
       if (i == n) break;
       size_t end = i + 1;
-      while (end + 8 <= n) {
-        uint64_t word;
-        std::memcpy(&word, present + end, sizeof(word));
-        if (word != 0) break;
-        end += 8;
-      }
+      while (end + 8 <= n && flags_at(end) == 0) end += 8;
       while (end < n && !present[end]) ++end;
       clear(i, end);
       i = end;

@@ -206,9 +206,6 @@ bool TwoLayerPanorama::Neighbour(int x, int y, Direction d, int* nx, int* ny) co
   return false;
 }
 
-bool TwoLayerPanorama::NodesAndLinksAreValid() const { return ScanIsValid<true>(); }
-bool TwoLayerPanorama::LinksAreValid() const { return ScanIsValid<false>(); }
-
 template <bool kCheckNodes>
 bool TwoLayerPanorama::ScanIsValid() const {
   const LayerData& front = layers_[kFront];
@@ -274,7 +271,7 @@ Status TwoLayerPanorama::Check(bool nodes) const {
   // Valid panoramas (the common case: every level the viewer shows) pass one
   // fast scan; only a rejected one is scanned again, node by node, to name its
   // first problem in the order documented below.
-  if (nodes ? NodesAndLinksAreValid() : LinksAreValid()) return Status::Ok();
+  if (nodes ? ScanIsValid<true>() : ScanIsValid<false>()) return Status::Ok();
   return FirstNodeOrLinkProblem();
 }
 

@@ -124,8 +124,7 @@ class TwoLayerPanorama {
   // whether every node (if `nodes`) and link is valid, and the node-by-node
   // scan that names the first problem (run only when the first one fails).
   Status Check(bool nodes) const;
-  bool NodesAndLinksAreValid() const;
-  bool LinksAreValid() const;  // NodesAndLinksAreValid() without the node values.
+  // The single scan; kCheckNodes false checks the links only.
   template <bool kCheckNodes>
   bool ScanIsValid() const;
   Status FirstNodeOrLinkProblem() const;

@@ -16,7 +16,7 @@ namespace casual3d {
 
 // Runs Validate's two scans separately.
 struct TwoLayerPanoramaTestAccess {
-  static bool FastScanAccepts(const TwoLayerPanorama& p) { return p.NodesAndLinksAreValid(); }
+  static bool FastScanAccepts(const TwoLayerPanorama& p) { return p.ScanIsValid<true>(); }
   static Status NodeByNodeScan(const TwoLayerPanorama& p) { return p.FirstNodeOrLinkProblem(); }
 };
 
