@@ -38,6 +38,11 @@ void RunDense(const DenseCommandOptions& o) {
         "dense: against ground truth: median relative error %.2f%%, within 3%%: %.1f%%, near "
         "floaters: %.2f%%\n",
         100 * report.median_rel_error, 100 * report.within_3pct, 100 * report.near_floaters);
+    std::printf(
+        "dense: on the %.1f%% of pixels whose surface >= 2 swept neighbours see: median %.2f%%, "
+        "within 3%%: %.1f%%, near floaters: %.2f%%\n",
+        100 * report.observed_fraction, 100 * report.median_rel_error_observed,
+        100 * report.within_3pct_observed, 100 * report.near_floaters_observed);
   }
 }
 
@@ -82,6 +87,10 @@ void AddDenseCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--far-bias", opts->dense.mrf.far_bias,
                   "Cost leaning textureless pixels away from the camera (MRF data term)")
+      ->capture_default_str();
+  cmd->add_option("--neighbor-coverage", opts->dense.neighbors.coverage_k,
+                  "Neighbours are picked so that each part of the photo has this many partners "
+                  "(0: by score alone)")
       ->capture_default_str();
   cmd->add_option("--ground-truth", opts->dense.ground_truth_dir,
                   "Folder of ground-truth depth <stem>.exr (e.g. a synthetic capture's depth/) "

@@ -441,7 +441,30 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
           io::WritePng(base + "_gt.png", gt_rgb.view());
           io::WritePng(base + "_error.png", err_rgb.view());
         }
-        const DepthAccuracy acc = EvaluateDepth(depth, gt, 0.5 * v.range.far_m, grid.InvStep());
+        // Which swept neighbours see each pixel's true surface.
+        std::vector<ImageF> nb_gt;
+        std::vector<PinholeCamera> nb_cam;
+        for (const DenseView* nb : swept[i]) {
+          ImageF g = ReadGroundTruth(options.ground_truth_dir, OutputStem(nb->name));
+          if (g.empty()) continue;
+          nb_cam.push_back(nb->camera.Resized(g.width(), g.height()));
+          nb_gt.push_back(std::move(g));
+        }
+        std::vector<const PinholeCamera*> cam_ptrs;
+        std::vector<const ImageF*> gt_ptrs;
+        for (size_t k = 0; k < nb_gt.size(); ++k) {
+          cam_ptrs.push_back(&nb_cam[k]);
+          gt_ptrs.push_back(&nb_gt[k]);
+        }
+        const std::vector<uint8_t> observers =
+            AgreeingViews(v.camera.Resized(gt.width(), gt.height()), gt, cam_ptrs, gt_ptrs, 0.02);
+        const DepthAccuracy acc =
+            EvaluateDepth(depth, gt, 0.5 * v.range.far_m, grid.InvStep(), &observers, 2);
+        pr.pixels = acc.pixels;
+        pr.observed_pixels = acc.observed_pixels;
+        pr.median_rel_error_observed = acc.median_rel_error_observed;
+        pr.within_3pct_observed = acc.within_3pct_observed;
+        pr.near_floaters_observed = acc.near_floaters_observed;
         pr.median_rel_error = acc.median_rel_error;
         pr.within_3pct = acc.within_3pct;
         pr.near_floaters = acc.near_floaters;
@@ -466,7 +489,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   });
   progress.Finish();
 
-  // Cross-view consistency of the final depth maps (issue 5).
+  // Cross-view consistency of the final depth maps.
   {
     std::vector<const ImageF*> final_ptrs;
     for (const ImageF& d : final_low) final_ptrs.push_back(&d);
@@ -478,9 +501,14 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   }
 
   // Summary.
-  long long weight = 0;
+  long long weight = 0, pixels = 0, observed = 0;
   for (const PhotoReport& pr : report.photos) {
     if (!pr.evaluated) continue;
+    pixels += pr.pixels;
+    observed += pr.observed_pixels;
+    report.median_rel_error_observed += pr.median_rel_error_observed * pr.observed_pixels;
+    report.within_3pct_observed += pr.within_3pct_observed * pr.observed_pixels;
+    report.near_floaters_observed += pr.near_floaters_observed * pr.observed_pixels;
     const long long px = static_cast<long long>(pr.width) * pr.height;
     report.evaluated = true;
     report.median_rel_error += pr.median_rel_error * px;
@@ -496,6 +524,12 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     report.near_floaters /= weight;
     report.within_half_label /= weight;
     report.within_two_labels /= weight;
+  }
+  if (observed > 0) {
+    report.observed_fraction = static_cast<double>(observed) / pixels;
+    report.median_rel_error_observed /= observed;
+    report.within_3pct_observed /= observed;
+    report.near_floaters_observed /= observed;
   }
   report.seconds_total = Since(t_start);
   report.peak_rss_bytes = PeakRssBytes();
@@ -517,7 +551,11 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
                      {"within_3pct", report.within_3pct},
                      {"near_floaters", report.near_floaters},
                      {"within_half_label", report.within_half_label},
-                     {"within_two_labels", report.within_two_labels}};
+                     {"within_two_labels", report.within_two_labels},
+                     {"observed_fraction", report.observed_fraction},
+                     {"median_rel_error_observed", report.median_rel_error_observed},
+                     {"within_3pct_observed", report.within_3pct_observed},
+                     {"near_floaters_observed", report.near_floaters_observed}};
   }
   for (const PhotoReport& pr : report.photos) {
     nlohmann::json p;
@@ -539,7 +577,11 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     if (pr.evaluated) {
       p["accuracy"] = {{"median_rel_error", pr.median_rel_error}, {"within_3pct", pr.within_3pct},
                        {"near_floaters", pr.near_floaters}, {"sky_near", pr.sky_near},
-                       {"within_half_label", pr.within_half_label}, {"within_two_labels", pr.within_two_labels}};
+                       {"within_half_label", pr.within_half_label}, {"within_two_labels", pr.within_two_labels},
+                       {"observed_fraction", pr.pixels > 0 ? static_cast<double>(pr.observed_pixels) / pr.pixels : 0.0},
+                       {"median_rel_error_observed", pr.median_rel_error_observed},
+                       {"within_3pct_observed", pr.within_3pct_observed},
+                       {"near_floaters_observed", pr.near_floaters_observed}};
       for (const StageQuality& s : pr.stages)
         p["anchor_quality"][s.stage] = {{"completeness", s.completeness}, {"precision", s.precision}};
       p["envelope_quality"] = {{"error", pr.envelope_error}, {"tightness", pr.envelope_tightness}};

@@ -128,6 +128,10 @@ struct PhotoReport {
   bool evaluated = false;
   double median_rel_error = 0, within_3pct = 0, near_floaters = 0, sky_near = 0;
   double within_half_label = 0, within_two_labels = 0;  // Label-step error (depth_metrics.h).
+  // The same over the pixels whose true surface >= 2 swept neighbours see
+  // (depth_metrics.h, AgreeingViews of the ground truth).
+  long long pixels = 0, observed_pixels = 0;
+  double median_rel_error_observed = 0, within_3pct_observed = 0, near_floaters_observed = 0;
   std::vector<StageQuality> stages;
   double envelope_error = 0, envelope_tightness = 0;
 };
@@ -141,6 +145,8 @@ struct DenseReport {
   bool evaluated = false;
   double median_rel_error = 0, within_3pct = 0, near_floaters = 0;
   double within_half_label = 0, within_two_labels = 0;
+  double observed_fraction = 0;  // Of the evaluated pixels: seen by >= 2 swept neighbours.
+  double median_rel_error_observed = 0, within_3pct_observed = 0, near_floaters_observed = 0;
   double cross_view_consistency = 0.0;  // Mean over photos.
 };
 

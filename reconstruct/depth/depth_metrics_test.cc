@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <vector>
 
 namespace casual3d::depth {
 namespace {
@@ -69,6 +71,39 @@ TEST(EvaluateDepth, CountsFloatersAndSkySeparately) {
   EXPECT_NEAR(a.near_floaters, 1.0 / 3, 1e-9);
   EXPECT_NEAR(a.within_3pct, 2.0 / 3, 1e-9);
   EXPECT_NEAR(a.sky_near, 1.0, 1e-9);
+}
+
+TEST(AgreeingViews, CountsTheViewsThatSeeTheSurface) {
+  Rig rig;
+  // A pole 2 m away in front of columns 20-23 of camera 1 hides the wall
+  // behind them from it.
+  for (int y = 0; y < 48; ++y)
+    for (int x = 20; x < 24; ++x) rig.depth[1].at(x, y) = 2.0f;
+  const std::vector<const PinholeCamera*> cams = {&rig.views[1].camera, &rig.views[2].camera};
+  const std::vector<const ImageF*> maps = {&rig.depth[1], &rig.depth[2]};
+  const std::vector<uint8_t> n = AgreeingViews(rig.views[0].camera, rig.depth[0], cams, maps, 0.02);
+  ASSERT_EQ(n.size(), 64u * 48u);
+  // Camera 1 (0.1 m) sees pixel x at x - 1.2, camera 2 at x - 2.4.
+  EXPECT_EQ(n[10 * 64 + 0], 0);   // Outside both.
+  EXPECT_EQ(n[10 * 64 + 1], 1);   // Inside camera 1 only (x - 1.2 >= 0 > x - 2.4).
+  EXPECT_EQ(n[10 * 64 + 10], 2);
+  EXPECT_EQ(n[10 * 64 + 22], 1);  // Hidden from camera 1 by the pole (camera 1 column 20).
+  rig.depth[0].at(5, 10) = 0.0f;
+  EXPECT_EQ(AgreeingViews(rig.views[0].camera, rig.depth[0], cams, maps, 0.02)[10 * 64 + 5], kNoDepth);
+}
+
+TEST(EvaluateDepth, ReportsThePixelsOthersSeeSeparately) {
+  ImageF gt(4, 1, 1, 10.0f), d(4, 1, 1, 10.0f);
+  d.at(0, 0) = 5.0f;  // A floater where no neighbour sees the surface.
+  d.at(1, 0) = 8.0f;  // A floater where two do.
+  const std::vector<uint8_t> observers = {0, 2, 3, kNoDepth};
+  const DepthAccuracy a = EvaluateDepth(d, gt, 10.0, 0.0, &observers, 2);
+  EXPECT_NEAR(a.near_floaters, 0.5, 1e-9);
+  EXPECT_EQ(a.observed_pixels, 2);
+  EXPECT_NEAR(a.near_floaters_observed, 0.5, 1e-9);
+  EXPECT_NEAR(a.within_3pct_observed, 0.5, 1e-9);
+  const std::vector<uint8_t> wrong_size = {0, 2};
+  EXPECT_THROW(EvaluateDepth(d, gt, 10.0, 0.0, &wrong_size, 2), std::invalid_argument);
 }
 
 }  // namespace

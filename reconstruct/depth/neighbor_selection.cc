@@ -16,8 +16,74 @@ Status NeighborOptions::Check() const {
     return InvalidArgument("max_angle_deg must lie in (min_angle_deg, 180]");
   if (min_shared_points < 1 || min_shared_points > 1000000)
     return InvalidArgument("min_shared_points outside [1, 1e6]");
+  if (coverage_k < 0 || coverage_k > 16) return InvalidArgument("coverage_k outside [0, 16]");
+  if (coverage_picks < 1 || coverage_picks > 64) return InvalidArgument("coverage_picks outside [1, 64]");
   return Status::Ok();
 }
+
+namespace {
+
+// Reorders the primary views at the front of `order` (ranked by score;
+// `cand` holds each one's (primary, score)) by greedy coverage of view i's
+// points (neighbor_selection.h). Ties in gain keep the score order.
+void CoverageOrder(int i, const std::vector<NeighborInput>& views,
+                   const std::vector<std::pair<long long, Eigen::Vector3d>>& point_positions,
+                   const std::vector<std::vector<int>>& seen, const NeighborOptions& options,
+                   std::vector<int>* order,
+                   const std::vector<std::pair<std::pair<int, double>, int>>& cand) {
+  size_t num_primary = 0;
+  while (num_primary < cand.size() && cand[num_primary].first.first == 1) ++num_primary;
+  if (num_primary < 2) return;
+  // Reference point index -> slot, and per candidate its (slot, g) pairs.
+  const std::vector<int>& mine = seen[i];
+  std::unordered_map<int, int> slot;
+  slot.reserve(mine.size());
+  for (size_t s = 0; s < mine.size(); ++s) slot[mine[s]] = static_cast<int>(s);
+  const double rad2deg = 180.0 / M_PI;
+  std::vector<std::vector<std::pair<int, float>>> gains(num_primary);
+  for (size_t c = 0; c < num_primary; ++c) {
+    const int j = (*order)[c];
+    for (int p : seen[j]) {
+      auto it = slot.find(p);
+      if (it == slot.end()) continue;
+      const Eigen::Vector3d& x = point_positions[p].second;
+      const Eigen::Vector3d ra = (views[i].center - x).normalized();
+      const Eigen::Vector3d rb = (views[j].center - x).normalized();
+      const double t = std::acos(std::min(1.0, std::max(-1.0, ra.dot(rb)))) * rad2deg;
+      if (t > options.max_angle_deg) continue;
+      const double g = std::min(1.0, t / options.theta_good_deg);
+      gains[c].push_back({it->second, static_cast<float>(g * g)});
+    }
+  }
+  const float k = static_cast<float>(options.coverage_k);
+  std::vector<float> coverage(mine.size(), 0.0f);
+  std::vector<char> taken(num_primary, 0);
+  std::vector<int> picked;
+  const size_t picks = std::min(num_primary, static_cast<size_t>(options.coverage_picks));
+  while (picked.size() < picks) {
+    int best = -1;
+    double best_gain = 0.0;
+    for (size_t c = 0; c < num_primary; ++c) {
+      if (taken[c]) continue;
+      double gain = 0.0;
+      for (const auto& [s, g] : gains[c]) gain += coverage[s] < k ? g : 0.0f;
+      if (gain > best_gain) {  // Strict: ties keep the score order.
+        best_gain = gain;
+        best = static_cast<int>(c);
+      }
+    }
+    if (best < 0) break;  // Everything covered coverage_k times: the rest by score.
+    taken[best] = 1;
+    picked.push_back((*order)[best]);
+    for (const auto& [s, g] : gains[best]) coverage[s] += 1.0f;
+  }
+  std::vector<int> result = picked;
+  for (size_t c = 0; c < order->size(); ++c)
+    if (c >= num_primary || !taken[c]) result.push_back((*order)[c]);
+  *order = std::move(result);
+}
+
+}  // namespace
 
 std::vector<std::vector<int>> RankNeighbors(
     const std::vector<NeighborInput>& views,
@@ -39,6 +105,10 @@ std::vector<std::vector<int>> RankNeighbors(
     std::sort(o.begin(), o.end());
     o.erase(std::unique(o.begin(), o.end()), o.end());
   }
+  // The points each view observes, by index.
+  std::vector<std::vector<int>> seen(n);
+  for (size_t p = 0; p < observers.size(); ++p)
+    for (int v : observers[p]) seen[v].push_back(static_cast<int>(p));
 
   // Pairwise angle lists, accumulated per point.
   std::vector<std::vector<std::vector<float>>> angles(n, std::vector<std::vector<float>>(n));
@@ -100,6 +170,7 @@ std::vector<std::vector<int>> RankNeighbors(
       return x.second < y.second;
     });
     for (const auto& c : cand) ranked[i].push_back(c.second);
+    if (options.coverage_k > 0) CoverageOrder(i, views, point_positions, seen, options, &ranked[i], cand);
   }
   return ranked;
 }

@@ -2,7 +2,7 @@
 
 // How well a layer of the 3D photo covers what the photos saw: the photos'
 // field of view in the central panorama, and the holes of the front layer
-// inside it (issue 6: "no hole larger than 1% of the field of view").
+// inside it (the requirement: no hole larger than 1% of the field of view).
 //
 // Field of view: panorama pixel p is inside when the 3D point along p's ray
 // at distance r(p) from the panorama centre projects inside at least one

@@ -37,7 +37,7 @@ struct PanoramaStageOptions {
   stitch::StitchOptions stitch;
   fuse::FuseOptions fuse;
   normals::NormalOptions normals;
-  // false: front layer only (the ablation of the paper's Fig. 15 / issue 8).
+  // false: front layer only (the ablation of the paper's Fig. 15).
   bool back_layer = true;
   // Fill the front layer's gaps inside the photos' field of view
   // (coverage.h, FillGapsInside) before fusion: the ragged edges of the

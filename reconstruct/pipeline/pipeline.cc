@@ -71,7 +71,8 @@ std::string DenseOptionsText(const depth::DenseOptions& o) {
     << " use_near_envelope=" << o.use_near_envelope << " use_gc_filter=" << o.use_gc_filter
     << " envelope_scale=" << o.envelope.scale << " continuous_refine=" << o.refine.enabled
     << " min_far_over_near=" << o.min_far_over_near
-    << " texture_color_sigma=" << o.sweep.texture_color_sigma << " far_bias=" << o.mrf.far_bias;
+    << " texture_color_sigma=" << o.sweep.texture_color_sigma << " far_bias=" << o.mrf.far_bias
+    << " neighbor_coverage=" << o.neighbors.coverage_k;
   return s.str();
 }
 
