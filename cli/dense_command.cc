@@ -88,6 +88,10 @@ void AddDenseCommand(CLI::App& app) {
   cmd->add_option("--far-bias", opts->dense.mrf.far_bias,
                   "Cost leaning textureless pixels away from the camera (MRF data term)")
       ->capture_default_str();
+  cmd->add_option("--occlusion-truncation", opts->dense.sweep.occlusion_truncation,
+                  "Each of the best neighbours' matching costs is capped at the best one's plus "
+                  "this (1: plain mean)")
+      ->capture_default_str();
   cmd->add_option("--neighbor-coverage", opts->dense.neighbors.coverage_k,
                   "Neighbours are picked so that each part of the photo has this many partners "
                   "(0: by score alone)")

@@ -104,6 +104,8 @@ Status SweepOptions::Check() const {
     return InvalidArgument("texture_sigma " + std::to_string(texture_sigma) + " outside (0, 1]");
   if (!(texture_color_sigma >= 0.0 && texture_color_sigma <= 10.0))
     return InvalidArgument("texture_color_sigma outside [0, 10]");
+  if (!(occlusion_truncation >= 0.0 && occlusion_truncation <= 1.0))
+    return InvalidArgument("occlusion_truncation outside [0, 1]");
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   return Status::Ok();
 }
@@ -208,6 +210,7 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
   constexpr int kGroup = 16;
   const int num_nb = static_cast<int>(neighbors.size());
   const int best_k = std::min(options.best_k, num_nb);
+  const float truncation = static_cast<float>(options.occlusion_truncation);
   const int num_groups = (num_labels + kGroup - 1) / kGroup;
   vol.cost.resize(n * num_labels);
   std::atomic<int> next_group(0);
@@ -271,11 +274,12 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
             in.inv_std_i = inv_std_i.data() + o;
             in.invalid = nr.ring_invalid.data() + static_cast<size_t>(yo % nr.ring_rows) * w;
             sweep::ZnccCostRow(in, eps, w, cost_row.data());
-            // Occlusion-robust aggregation: mean of the best_k valid neighbours.
+            // Occlusion-robust aggregation: mean of the best_k valid neighbours,
+            // each capped at the best one's cost plus the truncation.
             sweep::InsertSmallest(cost_row.data(), w, best_k, slots.data());
           }
           if (yo >= 0)
-            sweep::MeanOfSlots(slots.data(), w, best_k, plane + static_cast<size_t>(yo) * w);
+            sweep::MeanOfSlots(slots.data(), w, best_k, truncation, plane + static_cast<size_t>(yo) * w);
         }
       }
       // Plane-major group to pixel-major volume.

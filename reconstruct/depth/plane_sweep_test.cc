@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "reconstruct/depth/sweep_kernels.h"
 #include "reconstruct/depth/testing/toy_scene.h"
 
 namespace casual3d::depth {
@@ -115,7 +116,7 @@ ReferenceVolume ReferenceSweep(const DenseView& ref, const std::vector<const Den
           std::sort(costs.begin(), costs.end());
           const int kk = std::min<int>(opt.best_k, static_cast<int>(costs.size()));
           c = 0;
-          for (int q = 0; q < kk; ++q) c += costs[q] / kk;
+          for (int q = 0; q < kk; ++q) c += std::min(costs[q], costs[0] + opt.occlusion_truncation) / kk;
         }
         out.cost[p * L + k] = c;
       }
@@ -259,6 +260,23 @@ TEST(PlaneSweep, BestKAveragingSurvivesAnOccludingNeighbour) {
   opt.best_k = 2;
   const CostVolume vol = ComputeCostVolume(ref, {&a, &b, &occ}, opt);
   EXPECT_GE(FractionWithinLabels(vol, WinnerTakesAll(vol), gt, 1.0, 14), 0.95);
+}
+
+TEST(PlaneSweep, SlotMeanCapsCostsAboveTheBestPlusTheTruncation) {
+  // Six pixels (four in SIMD, two in the scalar tail), two slots each, best first.
+  const float inv = sweep::kInvalidCost;
+  const std::vector<float> slots = {0.1f, 0.1f, 0.5f, inv, 0.2f, 0.3f,   // Slot 0.
+                                    0.9f, 0.2f, 0.6f, inv, 1.0f, inv};   // Slot 1.
+  std::vector<float> out(6);
+  sweep::MeanOfSlots(slots.data(), 6, 2, 0.2f, out.data());
+  const std::vector<float> capped = {0.2f, 0.15f, 0.55f, 1.0f, 0.3f, 0.3f};
+  for (int x = 0; x < 6; ++x) EXPECT_FLOAT_EQ(out[x], capped[x]) << x;
+  sweep::MeanOfSlots(slots.data(), 6, 2, 1.0f, out.data());  // The plain mean.
+  const std::vector<float> plain = {0.5f, 0.15f, 0.55f, 1.0f, 0.6f, 0.3f};
+  for (int x = 0; x < 6; ++x) EXPECT_FLOAT_EQ(out[x], plain[x]) << x;
+  SweepOptions opt;
+  opt.occlusion_truncation = 1.5;
+  EXPECT_FALSE(opt.Check().ok());
 }
 
 TEST(PlaneSweep, RejectsInvalidOptionsAndInputs) {

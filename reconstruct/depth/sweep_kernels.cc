@@ -237,17 +237,19 @@ void InsertSmallest(const float* cost, int width, int k, float* slots) {
   }
 }
 
-void MeanOfSlots(const float* slots, int width, int k, float* out) {
+void MeanOfSlots(const float* slots, int width, int k, float truncation, float* out) {
   int x = 0;
 #if defined(__SSE2__)
   const __m128 invalid = _mm_set1_ps(kInvalidCost), one = _mm_set1_ps(1.0f);
+  const __m128 trunc = _mm_set1_ps(truncation);
   for (; x + 4 <= width; x += 4) {
     // Ascending slot order: the same summation order as sorting the costs.
+    const __m128 cap = _mm_add_ps(_mm_loadu_ps(slots + x), trunc);
     __m128 sum = _mm_setzero_ps(), count = _mm_setzero_ps();
     for (int q = 0; q < k; ++q) {
       const __m128 v = _mm_loadu_ps(slots + static_cast<size_t>(q) * width + x);
       const __m128 valid = _mm_cmplt_ps(v, invalid);
-      sum = _mm_add_ps(sum, _mm_and_ps(valid, v));
+      sum = _mm_add_ps(sum, _mm_and_ps(valid, _mm_min_ps(v, cap)));
       count = _mm_add_ps(count, _mm_and_ps(valid, one));
     }
     const __m128 mean = _mm_div_ps(sum, _mm_max_ps(count, one));
@@ -256,11 +258,12 @@ void MeanOfSlots(const float* slots, int width, int k, float* out) {
   }
 #endif
   for (; x < width; ++x) {
+    const float cap = slots[x] + truncation;
     float sum = 0.0f, count = 0.0f;
     for (int q = 0; q < k; ++q) {
       const float v = slots[static_cast<size_t>(q) * width + x];
       if (v < kInvalidCost) {
-        sum += v;
+        sum += std::min(v, cap);
         count += 1.0f;
       }
     }

@@ -63,8 +63,9 @@ void ZnccCostRow(const ZnccRowInputs& in, float epsilon, int width, float* cost)
 // initialised to kInvalidCost; this inserts cost[x] into pixel x's list.
 void InsertSmallest(const float* cost, int width, int k, float* slots);
 
-// out[x] = mean of pixel x's valid (< kInvalidCost) slots, or 1 if none.
-void MeanOfSlots(const float* slots, int width, int k, float* out);
+// out[x] = mean of pixel x's valid (< kInvalidCost) slots, each capped at the
+// best slot's cost plus `truncation`, or 1 if none is valid.
+void MeanOfSlots(const float* slots, int width, int k, float truncation, float* out);
 
 // Writes `num_planes` plane-major rows of `n` values (planes[g * n + p]) into a
 // pixel-major array: out[p * stride + g] = planes[g * n + p].

@@ -72,7 +72,8 @@ std::string DenseOptionsText(const depth::DenseOptions& o) {
     << " envelope_scale=" << o.envelope.scale << " continuous_refine=" << o.refine.enabled
     << " min_far_over_near=" << o.min_far_over_near
     << " texture_color_sigma=" << o.sweep.texture_color_sigma << " far_bias=" << o.mrf.far_bias
-    << " neighbor_coverage=" << o.neighbors.coverage_k;
+    << " neighbor_coverage=" << o.neighbors.coverage_k
+    << " occlusion_truncation=" << o.sweep.occlusion_truncation;
   return s.str();
 }
 
