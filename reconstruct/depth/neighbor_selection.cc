@@ -23,6 +23,20 @@ Status NeighborOptions::Check() const {
 
 namespace {
 
+// Angle at x between the rays to the two camera centres, degrees.
+double TriangulationAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d ra = (a - x).normalized();
+  const Eigen::Vector3d rb = (b - x).normalized();
+  return std::acos(std::min(1.0, std::max(-1.0, ra.dot(rb)))) * (180.0 / M_PI);
+}
+
+// A shared point's contribution g(theta) to a pair's score (neighbor_selection.h).
+double AngleScore(double t_deg, const NeighborOptions& options) {
+  if (!(t_deg <= options.max_angle_deg)) return 0.0;
+  const double g = std::min(1.0, t_deg / options.theta_good_deg);
+  return g * g;
+}
+
 // Reorders the primary views at the front of `order` (ranked by score;
 // `cand` holds each one's (primary, score)) by greedy coverage of view i's
 // points (neighbor_selection.h). Ties in gain keep the score order.
@@ -39,24 +53,18 @@ void CoverageOrder(int i, const std::vector<NeighborInput>& views,
   std::unordered_map<int, int> slot;
   slot.reserve(mine.size());
   for (size_t s = 0; s < mine.size(); ++s) slot[mine[s]] = static_cast<int>(s);
-  const double rad2deg = 180.0 / M_PI;
   std::vector<std::vector<std::pair<int, float>>> gains(num_primary);
   for (size_t c = 0; c < num_primary; ++c) {
     const int j = (*order)[c];
     for (int p : seen[j]) {
       auto it = slot.find(p);
       if (it == slot.end()) continue;
-      const Eigen::Vector3d& x = point_positions[p].second;
-      const Eigen::Vector3d ra = (views[i].center - x).normalized();
-      const Eigen::Vector3d rb = (views[j].center - x).normalized();
-      const double t = std::acos(std::min(1.0, std::max(-1.0, ra.dot(rb)))) * rad2deg;
+      const double t = TriangulationAngleDeg(views[i].center, views[j].center, point_positions[p].second);
       if (t > options.max_angle_deg) continue;
-      const double g = std::min(1.0, t / options.theta_good_deg);
-      gains[c].push_back({it->second, static_cast<float>(g * g)});
+      gains[c].push_back({it->second, static_cast<float>(AngleScore(t, options))});
     }
   }
-  const float k = static_cast<float>(options.coverage_k);
-  std::vector<float> coverage(mine.size(), 0.0f);
+  std::vector<int> coverage(mine.size(), 0);  // Picked views that observe each point.
   std::vector<char> taken(num_primary, 0);
   std::vector<int> picked;
   const size_t picks = std::min(num_primary, static_cast<size_t>(options.coverage_picks));
@@ -66,7 +74,7 @@ void CoverageOrder(int i, const std::vector<NeighborInput>& views,
     for (size_t c = 0; c < num_primary; ++c) {
       if (taken[c]) continue;
       double gain = 0.0;
-      for (const auto& [s, g] : gains[c]) gain += coverage[s] < k ? g : 0.0f;
+      for (const auto& [s, g] : gains[c]) gain += coverage[s] < options.coverage_k ? g : 0.0f;
       if (gain > best_gain) {  // Strict: ties keep the score order.
         best_gain = gain;
         best = static_cast<int>(c);
@@ -75,7 +83,7 @@ void CoverageOrder(int i, const std::vector<NeighborInput>& views,
     if (best < 0) break;  // Everything covered coverage_k times: the rest by score.
     taken[best] = 1;
     picked.push_back((*order)[best]);
-    for (const auto& [s, g] : gains[best]) coverage[s] += 1.0f;
+    for (const auto& sg : gains[best]) ++coverage[sg.first];
   }
   std::vector<int> result = picked;
   for (size_t c = 0; c < order->size(); ++c)
@@ -112,18 +120,13 @@ std::vector<std::vector<int>> RankNeighbors(
 
   // Pairwise angle lists, accumulated per point.
   std::vector<std::vector<std::vector<float>>> angles(n, std::vector<std::vector<float>>(n));
-  const double rad2deg = 180.0 / M_PI;
   for (size_t p = 0; p < observers.size(); ++p) {
     const auto& obs = observers[p];
     const Eigen::Vector3d& x = point_positions[p].second;
     for (size_t a = 0; a < obs.size(); ++a)
-      for (size_t b = a + 1; b < obs.size(); ++b) {
-        const Eigen::Vector3d ra = (views[obs[a]].center - x).normalized();
-        const Eigen::Vector3d rb = (views[obs[b]].center - x).normalized();
-        const float ang = static_cast<float>(
-            std::acos(std::min(1.0, std::max(-1.0, ra.dot(rb)))) * rad2deg);
-        angles[obs[a]][obs[b]].push_back(ang);
-      }
+      for (size_t b = a + 1; b < obs.size(); ++b)
+        angles[obs[a]][obs[b]].push_back(
+            static_cast<float>(TriangulationAngleDeg(views[obs[a]].center, views[obs[b]].center, x)));
   }
 
   // Fallback score from geometry alone.
@@ -156,10 +159,7 @@ std::vector<std::vector<int>> RankNeighbors(
         if (med >= options.min_angle_deg && med <= options.max_angle_deg) {
           primary = 1;
           score = 0.0;
-          for (float t : a) {
-            const double g = std::min(1.0, t / options.theta_good_deg);
-            score += t <= options.max_angle_deg ? g * g : 0.0;
-          }
+          for (float t : a) score += AngleScore(t, options);
         }
       }
       cand.push_back({{primary, score}, j});
