@@ -38,11 +38,13 @@ void RunDense(const DenseCommandOptions& o) {
         "dense: against ground truth: median relative error %.2f%%, within 3%%: %.1f%%, near "
         "floaters: %.2f%%\n",
         100 * report.median_rel_error, 100 * report.within_3pct, 100 * report.near_floaters);
-    std::printf(
-        "dense: on the %.1f%% of pixels whose surface >= 2 swept neighbours see: median %.2f%%, "
-        "within 3%%: %.1f%%, near floaters: %.2f%%\n",
-        100 * report.observed_fraction, 100 * report.median_rel_error_observed,
-        100 * report.within_3pct_observed, 100 * report.near_floaters_observed);
+    if (report.observed_fraction > 0) {
+      std::printf(
+          "dense: on the %.1f%% of pixels whose surface >= 2 swept neighbours see: median %.2f%%, "
+          "within 3%%: %.1f%%, near floaters: %.2f%%\n",
+          100 * report.observed_fraction, 100 * report.median_rel_error_observed,
+          100 * report.within_3pct_observed, 100 * report.near_floaters_observed);
+    }
   }
 }
 

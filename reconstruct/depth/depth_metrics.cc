@@ -41,8 +41,9 @@ DepthAccuracy EvaluateDepth(const ImageF& depth, const ImageF& gt, double sky_ne
       ++a.pixels;
       const float e = d > 0 ? std::abs(d - g) / g : 1.0f;
       rel.push_back(e);
-      if (e <= 0.03f) ++within;
-      if (!(d >= 0.85f * g)) ++floaters;
+      const bool close = e <= 0.03f, floater = !(d >= 0.85f * g);
+      within += close;
+      floaters += floater;
       if (inv_step > 0 && d > 0) {
         const double e_inv = std::abs(1.0 / d - 1.0 / g);
         half_label += e_inv <= 0.5 * inv_step;
@@ -52,8 +53,8 @@ DepthAccuracy EvaluateDepth(const ImageF& depth, const ImageF& gt, double sky_ne
         const uint8_t c = (*observers)[GtIndex(gt, x, y, w, h)];
         if (c != kNoDepth && c >= min_observers) {
           rel_observed.push_back(e);
-          within_observed += e <= 0.03f;
-          floaters_observed += !(d >= 0.85f * g);
+          within_observed += close;
+          floaters_observed += floater;
         }
       }
     }

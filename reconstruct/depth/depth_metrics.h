@@ -57,6 +57,18 @@ struct EnvelopeQuality {
 };
 EnvelopeQuality EvaluateEnvelope(const ImageF& envelope, const ImageF& ground_truth);
 
+// Per pixel of `ref_depth` (a depth map of `ref_camera`, at its size), how many
+// of the other maps agree with it within `rel_tolerance`: the pixel's 3D point
+// lies in front of camera k, projects inside depths[k] (a map of cameras[k],
+// at its size), and |z_k - d_k| <= rel_tolerance d_k there. kNoDepth where
+// the pixel has no valid depth. With ground-truth maps it counts the views
+// that see the pixel's surface (inside the frame, not occluded). Only the
+// first 254 cameras are used, so that a count never reaches kNoDepth.
+constexpr uint8_t kNoDepth = 255;
+std::vector<uint8_t> AgreeingViews(const PinholeCamera& ref_camera, const ImageF& ref_depth,
+                                   const std::vector<const PinholeCamera*>& cameras,
+                                   const std::vector<const ImageF*>& depths, double rel_tolerance);
+
 // Cross-view consistency, which needs no ground truth: the
 // fraction of view `ref`'s pixels with a valid depth whose 3D point, projected
 // into the other views listed in `others` (indices into `views`, at most
@@ -65,17 +77,6 @@ EnvelopeQuality EvaluateEnvelope(const ImageF& envelope, const ImageF& ground_tr
 // `min_views` of them. `depths[i]` is view i's depth map (metres, <= 0 or
 // non-finite = none) at the size of views[i]->camera. Returns 0 when view
 // `ref` has no valid depth.
-// Per pixel of `ref_depth` (a depth map of `ref_camera`, at its size), how many
-// of the other maps agree with it within `rel_tolerance`: the pixel's 3D point
-// lies in front of camera k, projects inside depths[k] (a map of cameras[k],
-// at its size), and |z_k - d_k| <= rel_tolerance d_k there. kNoDepth where
-// the pixel has no valid depth. With ground-truth maps it counts the views
-// that see the pixel's surface (inside the frame, not occluded).
-constexpr uint8_t kNoDepth = 255;
-std::vector<uint8_t> AgreeingViews(const PinholeCamera& ref_camera, const ImageF& ref_depth,
-                                   const std::vector<const PinholeCamera*>& cameras,
-                                   const std::vector<const ImageF*>& depths, double rel_tolerance);
-
 double CrossViewConsistency(int ref, const std::vector<const DenseView*>& views,
                             const std::vector<const ImageF*>& depths, const std::vector<int>& others,
                             double rel_tolerance = 0.02, int min_views = 2, int max_views = 8);

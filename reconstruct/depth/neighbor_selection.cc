@@ -37,16 +37,13 @@ double AngleScore(double t_deg, const NeighborOptions& options) {
   return g * g;
 }
 
-// Reorders the primary views at the front of `order` (ranked by score;
-// `cand` holds each one's (primary, score)) by greedy coverage of view i's
-// points (neighbor_selection.h). Ties in gain keep the score order.
+// Reorders the first `num_primary` views of `order` (the primary pairs, ranked
+// by score) by greedy coverage of view i's points (neighbor_selection.h).
+// Ties in gain keep the score order.
 void CoverageOrder(int i, const std::vector<NeighborInput>& views,
                    const std::vector<std::pair<long long, Eigen::Vector3d>>& point_positions,
                    const std::vector<std::vector<int>>& seen, const NeighborOptions& options,
-                   std::vector<int>* order,
-                   const std::vector<std::pair<std::pair<int, double>, int>>& cand) {
-  size_t num_primary = 0;
-  while (num_primary < cand.size() && cand[num_primary].first.first == 1) ++num_primary;
+                   size_t num_primary, std::vector<int>* order) {
   if (num_primary < 2) return;
   // Reference point index -> slot, and per candidate its (slot, g) pairs.
   const std::vector<int>& mine = seen[i];
@@ -59,9 +56,9 @@ void CoverageOrder(int i, const std::vector<NeighborInput>& views,
     for (int p : seen[j]) {
       auto it = slot.find(p);
       if (it == slot.end()) continue;
-      const double t = TriangulationAngleDeg(views[i].center, views[j].center, point_positions[p].second);
-      if (t > options.max_angle_deg) continue;
-      gains[c].push_back({it->second, static_cast<float>(AngleScore(t, options))});
+      const double g =
+          AngleScore(TriangulationAngleDeg(views[i].center, views[j].center, point_positions[p].second), options);
+      if (g > 0.0) gains[c].push_back({it->second, static_cast<float>(g)});
     }
   }
   std::vector<int> coverage(mine.size(), 0);  // Picked views that observe each point.
@@ -169,8 +166,13 @@ std::vector<std::vector<int>> RankNeighbors(
       if (x.first.second != y.first.second) return x.first.second > y.first.second;
       return x.second < y.second;
     });
-    for (const auto& c : cand) ranked[i].push_back(c.second);
-    if (options.coverage_k > 0) CoverageOrder(i, views, point_positions, seen, options, &ranked[i], cand);
+    size_t num_primary = 0;
+    for (const auto& c : cand) {
+      ranked[i].push_back(c.second);
+      num_primary += c.first.first == 1;
+    }
+    if (options.coverage_k > 0)
+      CoverageOrder(i, views, point_positions, seen, options, num_primary, &ranked[i]);
   }
   return ranked;
 }

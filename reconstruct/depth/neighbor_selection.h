@@ -19,10 +19,10 @@
 // Each pick maximises the score restricted to the reference's points that
 // fewer than coverage_k picked views observe (the coverage the sweep's best-k
 // aggregation needs); once every point is covered coverage_k times, the rest
-// follow by score. The first coverage_k picks are the best-scoring views. At the ends of a partial rig the
-// highest-scoring views all lie on one side, and the plain score leaves the
-// other side of the frame with one partner or none (docs/PERFORMANCE.md,
-// "Neighbours").
+// follow by score. The first coverage_k picks are the best-scoring views. At
+// the ends of a partial rig the highest-scoring views all lie on one side,
+// and the plain score leaves the other side of the frame with one partner or
+// none (docs/PERFORMANCE.md, "Neighbour coverage and observable pixels").
 
 #include <vector>
 
@@ -42,7 +42,7 @@ struct NeighborOptions {
   // the sweep's best_k of 2: with 6 swept neighbours on the default synthetic
   // capture, 0 / 2 / 3 gave within 3% 69.8 / 71.5 / 70.9% and near floaters
   // 5.08 / 5.27 / 4.91%; fern's held-out views 20.80 / 20.94 / 20.95 dB
-  // (docs/PERFORMANCE.md, "Neighbour coverage"). [0, 16].
+  // (docs/PERFORMANCE.md, "Neighbour coverage and observable pixels"). [0, 16].
   int coverage_k = 3;
   // Picks made greedily for coverage; later ranks go by score. [1, 64].
   int coverage_picks = 16;
