@@ -286,6 +286,12 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   }
   const double diag_ratio =
       std::hypot(ws.views[0].camera.width, ws.views[0].camera.height) / options.reference_diagonal;
+  // Ground truth (evaluation only), read once: each photo's is also needed by
+  // the photos that sweep it (which of them see its surface). Empty where missing.
+  std::vector<ImageF> ground_truth(n);
+  if (!options.ground_truth_dir.empty())
+    for (int i = 0; i < n; ++i)
+      ground_truth[i] = ReadGroundTruth(options.ground_truth_dir, OutputStem(ws.views[i].name));
   util::Progress progress("dense: envelope + MRF", n);
   ForEachPhoto(ws.views, outer, [&](int i) {
     const DenseView& v = ws.views[i];
@@ -432,7 +438,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     pr.t_upsample = Since(t0);
 
     if (!options.ground_truth_dir.empty()) {
-      const ImageF gt = ReadGroundTruth(options.ground_truth_dir, stem);
+      const ImageF& gt = ground_truth[i];
       if (!gt.empty()) {
         pr.evaluated = true;
         if (options.debug) {
@@ -442,20 +448,16 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
           io::WritePng(base + "_error.png", err_rgb.view());
         }
         // Which swept neighbours see each pixel's true surface.
-        std::vector<ImageF> nb_gt;
         std::vector<PinholeCamera> nb_cam;
+        std::vector<const ImageF*> gt_ptrs;
         for (const DenseView* nb : swept[i]) {
-          ImageF g = ReadGroundTruth(options.ground_truth_dir, OutputStem(nb->name));
+          const ImageF& g = ground_truth[nb - ws.views.data()];
           if (g.empty()) continue;
           nb_cam.push_back(nb->camera.Resized(g.width(), g.height()));
-          nb_gt.push_back(std::move(g));
+          gt_ptrs.push_back(&g);
         }
         std::vector<const PinholeCamera*> cam_ptrs;
-        std::vector<const ImageF*> gt_ptrs;
-        for (size_t k = 0; k < nb_gt.size(); ++k) {
-          cam_ptrs.push_back(&nb_cam[k]);
-          gt_ptrs.push_back(&nb_gt[k]);
-        }
+        for (const PinholeCamera& c : nb_cam) cam_ptrs.push_back(&c);
         const std::vector<uint8_t> observers =
             AgreeingViews(v.camera.Resized(gt.width(), gt.height()), gt, cam_ptrs, gt_ptrs, 0.02);
         const DepthAccuracy acc =

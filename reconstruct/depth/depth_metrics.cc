@@ -129,7 +129,7 @@ std::vector<uint8_t> AgreeingViews(const PinholeCamera& ref_camera, const ImageF
     const ImageF* depth;
   };
   std::vector<Other> list;
-  for (size_t k = 0; k < cameras.size() && list.size() < 254; ++k) {
+  for (size_t k = 0; k < cameras.size() && list.size() < kNoDepth - 1; ++k) {
     Other o;
     o.cam = cameras[k];
     o.r = o.cam->R * cr.R.transpose();

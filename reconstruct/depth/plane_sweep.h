@@ -11,8 +11,9 @@
 // (exposure changes). Per neighbour the cost is min(1, 1 - ZNCC) in [0, 1];
 // the costs of the `best_k` best neighbours are averaged, each capped at the
 // best one's plus `occlusion_truncation`, which tolerates partial occlusion
-// (a surface hidden in some neighbours still matches in the others). w_photo = var / (var + texture_sigma^2) with var the reference
-// window's intensity variance, weighted by colour similarity to the centre
+// (a surface hidden in some neighbours still matches in the others).
+// w_photo = var / (var + texture_sigma^2) with var the reference window's
+// intensity variance, weighted by colour similarity to the centre
 // pixel: low in textureless regions, where ZNCC is noise, and on flat pixels
 // whose window borrows its texture from a differently coloured neighbour.
 // Window pixels that a neighbour does not see count as black.
