@@ -4,6 +4,8 @@
 #include <string>
 #include <utility>
 
+#include "format/parallel.h"
+
 namespace casual3d {
 namespace {
 
@@ -18,6 +20,9 @@ Status MeshBuildOptions::Check() const {
   if (max_pixels < 1 || max_pixels > kMeshPixelLimit) {
     return InvalidArgument("max_pixels " + std::to_string(max_pixels) + " is outside [1, " +
                            std::to_string(kMeshPixelLimit) + "]");
+  }
+  if (num_threads < 0 || num_threads > 256) {
+    return InvalidArgument("num_threads " + std::to_string(num_threads) + " is outside [0, 256]");
   }
   return Status::Ok();
 }
@@ -188,13 +193,14 @@ int CountQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back
   return counter.count;
 }
 
-void MeshAssembler::ChooseAtlasHalves() {
+void MeshAssembler::ChooseAtlasHalves(int num_threads) {
   const NodeArray<uint8_t>& front_present = pano_.layer(kFront).present;
   const NodeArray<uint8_t>& back_present = pano_.layer(kBack).present;
-  for (size_t t = 0; t + 2 < refs_.size(); t += 3) {
-    NodeRef* tri = &refs_[t];
+  const int64_t triangles = static_cast<int64_t>(refs_.size() / 3);
+  ParallelFor(0, triangles, num_threads, [&](int64_t t) {
+    NodeRef* tri = &refs_[3 * t];
     const unsigned layers = (tri[0] & 1u) + (tri[1] & 1u) + (tri[2] & 1u);
-    if (layers == 0 || layers == 3) continue;  // One layer: its own half.
+    if (layers == 0 || layers == 3) return;  // One layer: its own half.
     // Vertices whose colour the other half would not show at their pixel:
     // a front node where a back node exists (sampled in the back half), a
     // back node where a front node exists (sampled in the front half).
@@ -211,7 +217,7 @@ void MeshAssembler::ChooseAtlasHalves() {
     for (int k = 0; k < 3; ++k) {
       if ((tri[k] & 1u) != half) tri[k] |= kOtherHalfBit;
     }
-  }
+  }, 65536);
 }
 
 namespace {
@@ -231,8 +237,9 @@ inline uint32_t PopCount(uint64_t v) {
 
 }  // namespace
 
-Mesh MeshAssembler::Finish() {
-  ChooseAtlasHalves();
+Mesh MeshAssembler::Finish(int num_threads) {
+  const int threads = ResolveThreads(num_threads);
+  ChooseAtlasHalves(threads);
   const int w = pano_.width(), h = pano_.height();
   // Vertex keys: node * 2 + (1 if its uv is in the other layer's half).
   const size_t keys = static_cast<size_t>(w) * h * 2 * 2;
@@ -251,13 +258,41 @@ Mesh MeshAssembler::Finish() {
     return 4 * static_cast<size_t>((node >> 1) / w) + 2 * (node & 1) +
            ((r & kOtherHalfBit) ? 1 : 0);
   };
-  for (NodeRef r : refs_) {
-    if (r & kSeamBit) {
-      seam_vertex_of[seam_slot(r)] = 1;
-    } else {
-      const uint32_t key = key_of(r);
-      used[key >> 6] |= uint64_t{1} << (key & 63);
+  // Each chunk of references marks its own bitmap (the first chunk `used`
+  // itself); the bitmaps are then OR-ed word range by word range.
+  const int64_t num_refs = static_cast<int64_t>(refs_.size());
+  const int mark_chunks = num_refs >= (int64_t{1} << 20) ? threads : 1;
+  std::vector<std::vector<uint64_t>> more_used(static_cast<size_t>(mark_chunks - 1));
+  std::vector<std::vector<uint32_t>> more_seams(static_cast<size_t>(mark_chunks - 1));
+  ParallelFor(0, mark_chunks, threads, [&](int64_t c) {
+    uint64_t* bits = used.data();
+    uint32_t* seams = seam_vertex_of.data();
+    if (c > 0) {
+      more_used[c - 1].assign(words, 0);
+      more_seams[c - 1].assign(seam_vertex_of.size(), 0);
+      bits = more_used[c - 1].data();
+      seams = more_seams[c - 1].data();
     }
+    int64_t first, last;
+    ChunkRange(num_refs, mark_chunks, c, &first, &last);
+    for (int64_t i = first; i < last; ++i) {
+      const NodeRef r = refs_[i];
+      if (r & kSeamBit) {
+        seams[seam_slot(r)] = 1;
+      } else {
+        const uint32_t key = key_of(r);
+        bits[key >> 6] |= uint64_t{1} << (key & 63);
+      }
+    }
+  });
+  if (mark_chunks > 1) {
+    ParallelFor(0, static_cast<int64_t>(words), threads, [&](int64_t i) {
+      for (const auto& more : more_used) used[i] |= more[i];
+    }, 1 << 14);
+    for (const auto& more : more_seams) {
+      for (size_t i = 0; i < seam_vertex_of.size(); ++i) seam_vertex_of[i] |= more[i];
+    }
+    std::vector<std::vector<uint64_t>>().swap(more_used);
   }
   std::vector<uint32_t> used_before(words);
   uint32_t count = 0;
@@ -265,6 +300,7 @@ Mesh MeshAssembler::Finish() {
     used_before[i] = count;
     count += PopCount(used[i]);
   }
+  const uint32_t regular = count;
   for (uint32_t& v : seam_vertex_of) {
     if (v) v = ++count;
   }
@@ -297,16 +333,16 @@ Mesh MeshAssembler::Finish() {
   mesh.normals.resize(3 * static_cast<size_t>(count));
   mesh.uvs.resize(2 * static_cast<size_t>(count));
   mesh.colors.resize(3 * static_cast<size_t>(count));
-  float* position = mesh.positions.data();
-  float* normal = mesh.normals.data();
-  float* uv = mesh.uvs.data();
-  uint8_t* colour = mesh.colors.data();
-  // Vertices are written in index order: regular nodes, then seam copies.
-  auto emit = [&](int x, int y, int layer, int half, bool seam) {
+  // Writes vertex `index`.
+  auto emit = [&](uint32_t index, int x, int y, int layer, int half, bool seam) {
     const LayerData& d = pano_.layer(layer);
     const size_t i = pano_.index(x, y);
     const double depth = d.depth_m[i];
     const double horizontal = cos_lat[y] * depth;
+    float* position = &mesh.positions[3 * static_cast<size_t>(index)];
+    float* normal = &mesh.normals[3 * static_cast<size_t>(index)];
+    uint8_t* colour = &mesh.colors[3 * static_cast<size_t>(index)];
+    float* uv = &mesh.uvs[2 * static_cast<size_t>(index)];
     position[0] = static_cast<float>(horizontal * sin_lon[x]);
     position[1] = static_cast<float>(sin_lat[y] * depth);
     position[2] = static_cast<float>(-(horizontal * cos_lon[x]));
@@ -316,44 +352,52 @@ Mesh MeshAssembler::Finish() {
     }
     uv[0] = u_of[seam ? w : x];
     uv[1] = v_of[2 * y + half];
-    position += 3;
-    normal += 3;
-    colour += 3;
-    uv += 2;
   };
-  // Used keys in increasing order, i.e. (row, column, layer, half) order. A
+  // Used keys in increasing order, i.e. (row, column, layer, half) order, in
+  // ranges of words whose first vertex index is known from used_before. A
   // word holds the keys of 16 pixels; its first pixel's row and column are
   // carried from word to word instead of divided out per key.
-  int word_x = 0, word_y = 0;
-  for (size_t word = 0; word < words; ++word) {
-    for (uint64_t bits = used[word]; bits != 0; bits &= bits - 1) {
-      const int bit = __builtin_ctzll(bits);
-      int x = word_x + (bit >> 2), y = word_y;
-      if (x >= w) {  // 16 pixels may run into the next rows when w < 16.
-        y += x / w;
-        x %= w;
+  const int64_t word_chunks = regular >= (1u << 16) ? 8 * static_cast<int64_t>(threads) : 1;
+  ParallelFor(0, word_chunks, threads, [&](int64_t c) {
+    int64_t first, last;
+    ChunkRange(static_cast<int64_t>(words), word_chunks, c, &first, &last);
+    if (first >= last) return;
+    const uint64_t first_pixel = static_cast<uint64_t>(first) * 16;
+    int word_x = static_cast<int>(first_pixel % static_cast<uint64_t>(w));
+    int word_y = static_cast<int>(first_pixel / static_cast<uint64_t>(w));
+    uint32_t index = used_before[first];
+    for (int64_t word = first; word < last; ++word) {
+      for (uint64_t bits = used[word]; bits != 0; bits &= bits - 1) {
+        const int bit = __builtin_ctzll(bits);
+        int x = word_x + (bit >> 2), y = word_y;
+        if (x >= w) {  // 16 pixels may run into the next rows when w < 16.
+          y += x / w;
+          x %= w;
+        }
+        const int l = (bit >> 1) & 1;
+        const int other = bit & 1;
+        emit(index++, x, y, l, l ^ other, false);
       }
-      const int l = (bit >> 1) & 1;
-      const int other = bit & 1;
-      emit(x, y, l, l ^ other, false);
+      word_x += 16;
+      if (word_x >= w) {
+        word_y += word_x / w;
+        word_x %= w;
+      }
     }
-    word_x += 16;
-    if (word_x >= w) {
-      word_y += word_x / w;
-      word_x %= w;
-    }
-  }
+  });
+  uint32_t index = regular;
   for (int y = 0; y < h; ++y) {
     for (int l = 0; l < kNumLayers; ++l) {
       for (int other = 0; other < 2; ++other) {
-        if (seam_vertex_of[4 * y + 2 * l + other]) emit(0, y, l, l ^ other, true);
+        if (seam_vertex_of[4 * y + 2 * l + other]) emit(index++, 0, y, l, l ^ other, true);
       }
     }
   }
   // References become indices in place (both are 32-bit).
-  for (NodeRef& r : refs_) {
+  ParallelFor(0, num_refs, threads, [&](int64_t i) {
+    NodeRef& r = refs_[i];
     r = (r & kSeamBit) ? seam_vertex_of[seam_slot(r)] - 1 : vertex_of(key_of(r));
-  }
+  }, 1 << 16);
   mesh.indices = std::move(refs_);
   refs_ = std::vector<NodeRef>();
   return mesh;
@@ -408,7 +452,7 @@ StatusOr<Mesh> BuildMesh(const TwoLayerPanorama& pano, const MeshBuildOptions& o
       AddQuadTriangles(pano, x, y, options.include_back_layer, 0u, &assembler);
     }
   }
-  return assembler.Finish();
+  return assembler.Finish(options.num_threads);
 }
 
 }  // namespace casual3d

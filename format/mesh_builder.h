@@ -34,6 +34,9 @@ struct MeshBuildOptions {
   // just validated the panorama. The builder never reads out of bounds either
   // way, but on an invalid panorama the mesh is unspecified.
   bool validate_input = true;
+  // Threads for the per-pixel passes (format/parallel.h); 0: all hardware
+  // threads. The mesh does not depend on it. Range [0, 256].
+  int num_threads = 0;
 
   // InvalidArgument naming the field when a value is out of range.
   Status Check() const;
@@ -89,13 +92,21 @@ class MeshAssembler {
   // the vertices: every referenced (node, atlas half) in (row, column, layer,
   // own half before other half) order, then every referenced seam copy in
   // (row, layer, half) order. Triangles keep the order in which they were
-  // added. Leaves the assembler empty.
-  Mesh Finish();
+  // added. Leaves the assembler empty. Up to `num_threads` threads (resolved
+  // as in format/parallel.h) share the work; the mesh does not depend on it.
+  Mesh Finish(int num_threads = 1);
+
+  // Appends the triangles of `other` after those added so far and leaves
+  // `other` empty. Both must be of the same panorama.
+  void Append(MeshAssembler* other) {
+    refs_.insert(refs_.end(), other->refs_.begin(), other->refs_.end());
+    other->refs_ = std::vector<NodeRef>();
+  }
 
  private:
   // Marks with kOtherHalfBit the references of every triangle that joins
   // front and back nodes whose layer is not the triangle's atlas half.
-  void ChooseAtlasHalves();
+  void ChooseAtlasHalves(int num_threads);
 
   const TwoLayerPanorama& pano_;
   std::vector<NodeRef> refs_;

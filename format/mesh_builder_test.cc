@@ -414,5 +414,25 @@ TEST(MeshBuilderTest, GoldenChecksum) {
   EXPECT_EQ(testing::MeshChecksum(*mesh), 0x826f4abbec0b7206ull);
 }
 
+// MeshAssembler::Finish marks, numbers and writes vertices on several
+// threads: the mesh must be the same for any number of them.
+TEST(MeshBuilderTest, SameMeshForEveryThreadCount) {
+  const TwoLayerPanorama p = testing::MakeBlocksPanorama();
+  MeshBuildOptions o;
+  o.num_threads = 1;
+  auto one = BuildMesh(p, o);
+  ASSERT_TRUE(one.ok());
+  for (int threads : {2, 3, 7}) {
+    o.num_threads = threads;
+    auto many = BuildMesh(p, o);
+    ASSERT_TRUE(many.ok());
+    EXPECT_EQ(testing::MeshChecksum(*many), testing::MeshChecksum(*one)) << threads;
+    EXPECT_EQ(many->indices, one->indices);
+    EXPECT_EQ(many->normals, one->normals);
+  }
+  o.num_threads = 300;
+  EXPECT_EQ(BuildMesh(p, o).status().message(), "num_threads 300 is outside [0, 256]");
+}
+
 }  // namespace
 }  // namespace casual3d

@@ -5,9 +5,11 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "format/f64x2.h"
+#include "format/parallel.h"
 
 namespace casual3d {
 namespace {
@@ -55,6 +57,14 @@ struct Directions {
   }
 };
 
+// The tile a thread is evaluating (its top-left quad) and its node positions
+// (LayerPyramid::PrepareTile).
+struct TileCache {
+  int x0 = 0, y0 = 0;
+  bool ready = false;
+  std::vector<double> px, py, pz;
+};
+
 // The quadtree of one layer. Level 0 holds pixel quads (x, y) .. (x+1, y+1),
 // level k blocks of 2^k x 2^k quads whose top-left quad is (bx 2^k, by 2^k);
 // only blocks wholly inside the quad grid (width columns with wrap, height - 1
@@ -71,12 +81,15 @@ struct Directions {
 // in a cache small enough for the processor's caches (400 KB for 128 quads).
 class LayerPyramid {
  public:
+  // Finds the full quads (serially; see FullQuads) and allocates the errors.
+  // EvaluateTileRow then fills them, one row of tiles of the largest block
+  // size at a time: rows are independent, so threads may take different rows.
   LayerPyramid(const TwoLayerPanorama& p, const Directions& dirs, int layer, int levels,
-               double max_error)
+               double max_error, int num_threads)
       : p_(p), dirs_(dirs), layer_(layer), max_error_(max_error) {
     const int qw = p.width(), qh = p.height() - 1;
-    const int tile = 1 << levels;
-    FullQuads(tile);
+    tile_ = 1 << levels;
+    FullQuads(num_threads);
     nx_.push_back(qw);
     ny_.push_back(qh);
     error_.emplace_back();  // Level 0 uses full_.
@@ -86,34 +99,41 @@ class LayerPyramid {
       ny_.push_back(qh / s);
       error_.emplace_back(static_cast<size_t>(nx_[k]) * ny_[k], kInf);
     }
-    // Blocks nest inside tiles, so a block's children are evaluated before it.
-    // A tile without a full quad has no mergeable block.
+  }
+
+  // Rows of tiles of the largest block size.
+  int num_tile_rows() const { return (nx_[0] > 0 ? ny_[0] + tile_ - 1 : 0) / tile_; }
+
+  // The errors of every block in tile row `ty`. Blocks nest inside tiles, so
+  // a block's children are evaluated before it; a tile without a full quad
+  // has no mergeable block. `cache` is the calling thread's own.
+  void EvaluateTileRow(int ty, TileCache* cache) {
+    const int qw = nx_[0];
+    const int tile = tile_;
     const int tiles_x = (qw + tile - 1) / tile;
-    for (int y0 = 0; y0 < qh; y0 += tile) {
-      for (int x0 = 0; x0 < qw; x0 += tile) {
-        if (!tile_has_full_[static_cast<size_t>(y0 / tile) * tiles_x + x0 / tile]) continue;
-        tile_x0_ = x0;
-        tile_y0_ = y0;
-        tile_ready_ = false;
-        for (int k = 1; k <= levels; ++k) {
-          const int s = 1 << k;
-          const int by_end = std::min(ny_[k], (y0 + tile) / s);
-          const int bx_end = std::min(nx_[k], (x0 + tile) / s);
-          for (int by = y0 / s; by < by_end; ++by) {
-            int bx = x0 / s;
-            if (k == 1) bx = Level1Pairs(by, bx, bx_end);
-            for (; bx < bx_end; ++bx) {
-              error_[k][Index(k, bx, by)] = BlockError(k, bx, by);
-            }
+    const int y0 = ty * tile;
+    for (int x0 = 0; x0 < qw; x0 += tile) {
+      if (!tile_has_full_[static_cast<size_t>(ty) * tiles_x + x0 / tile]) continue;
+      cache->x0 = x0;
+      cache->y0 = y0;
+      cache->ready = false;
+      for (int k = 1; k <= levels(); ++k) {
+        const int s = 1 << k;
+        const int by_end = std::min(ny_[k], (y0 + tile) / s);
+        const int bx_end = std::min(nx_[k], (x0 + tile) / s);
+        for (int by = y0 / s; by < by_end; ++by) {
+          int bx = x0 / s;
+          if (k == 1) bx = Level1Pairs(by, bx, bx_end, cache);
+          for (; bx < bx_end; ++bx) {
+            error_[k][Index(k, bx, by)] = BlockError(k, bx, by, cache);
           }
         }
       }
     }
-    std::vector<double>().swap(px_);
-    std::vector<double>().swap(py_);
-    std::vector<double>().swap(pz_);
-    std::vector<uint8_t>().swap(tile_has_full_);
   }
+
+  // Frees what only EvaluateTileRow needs.
+  void ReleaseScratch() { std::vector<uint8_t>().swap(tile_has_full_); }
 
   int levels() const { return static_cast<int>(error_.size()) - 1; }
   int nx(int k) const { return nx_[k]; }
@@ -132,15 +152,16 @@ class LayerPyramid {
   // to each other around the quad. Per node, bit 7: present; bit 2d: the link
   // in direction d leads to this layer. Byte-wise arithmetic without tables,
   // eight nodes per 64-bit word. Also notes which tiles of the largest block
-  // size hold a full quad at all (tile_has_full_).
-  void FullQuads(int tile) {
+  // size hold a full quad at all (tile_has_full_). Bands of one tile's rows
+  // are independent and go to different threads.
+  void FullQuads(int num_threads) {
     const int w = p_.width(), qh = p_.height() - 1;
+    const int tile = tile_;
     const LayerData& d = p_.layer(layer_);
     const bool front = layer_ == kFront;
     // Rows of node bits, padded to whole 8-byte words plus one byte (column
     // w repeats column 0), processed 8 nodes at a time in 64-bit words.
     const size_t words = (static_cast<size_t>(w) + 1 + 7) / 8;
-    std::vector<uint8_t> upper(8 * words + 8, 0), lower(8 * words + 8, 0);
     auto row_bits = [&](int y, std::vector<uint8_t>* out) {
       const uint8_t* links = &d.links[p_.index(0, y)];
       const uint8_t* present = &d.present[p_.index(0, y)];
@@ -166,65 +187,73 @@ class LayerPyramid {
                        kL = 1u << (2 * kLeft), kU = 1u << (2 * kUp);
     constexpr uint64_t kA = (kP | kR | kD) * kOnes, kB = (kP | kD | kL) * kOnes,
                        kC = (kP | kR | kU) * kOnes, kDD = (kP | kU | kL) * kOnes;
-    full_.assign(static_cast<size_t>(w) * qh + 8, 0);  // 8 bytes of slack for word stores.
+    full_.resize(static_cast<size_t>(w) * qh + 8);  // 8 bytes of slack for word loads.
     const int tiles_x = (w + tile - 1) / tile;
-    tile_has_full_.assign(static_cast<size_t>(tiles_x) * ((qh + tile - 1) / tile), 0);
-    if (qh > 0) row_bits(0, &upper);
-    for (int y = 0; y < qh; ++y) {
-      row_bits(y + 1, &lower);
-      uint8_t* full = &full_[static_cast<size_t>(y) * w];
-      const uint8_t* u = upper.data();
-      const uint8_t* l = lower.data();
-      // A quad is full when no required bit is missing at any of its corners.
-      for (int x = 0; x < w; x += 8) {
-        const uint64_t missing = (~Load64(u + x) & kA) | (~Load64(u + x + 1) & kB) |
-                                 (~Load64(l + x) & kC) | (~Load64(l + x + 1) & kDD);
-        const uint64_t any_missing = ((missing & (0x7f * kOnes)) + 0x7f * kOnes) | missing;
-        const uint64_t bits = (~any_missing >> 7) & kOnes;
-        std::memcpy(full + x, &bits, sizeof(bits));  // Past w only into the next row or slack.
+    const int tiles_y = (qh + tile - 1) / tile;
+    tile_has_full_.assign(static_cast<size_t>(tiles_x) * tiles_y, 0);
+    ParallelFor(0, tiles_y, num_threads, [&](int64_t ty) {
+      std::vector<uint8_t> upper(8 * words + 8, 0), lower(8 * words + 8, 0);
+      const int y_begin = static_cast<int>(ty) * tile;
+      const int y_end = std::min(qh, y_begin + tile);
+      row_bits(y_begin, &upper);
+      uint8_t* has = &tile_has_full_[static_cast<size_t>(ty) * tiles_x];
+      for (int y = y_begin; y < y_end; ++y) {
+        row_bits(y + 1, &lower);
+        uint8_t* full = &full_[static_cast<size_t>(y) * w];
+        const uint8_t* u = upper.data();
+        const uint8_t* l = lower.data();
+        // A quad is full when no required bit is missing at any of its
+        // corners. The last word of a row is stored only up to column w - 1:
+        // the next row may belong to another thread.
+        for (int x = 0; x < w; x += 8) {
+          const uint64_t missing = (~Load64(u + x) & kA) | (~Load64(u + x + 1) & kB) |
+                                   (~Load64(l + x) & kC) | (~Load64(l + x + 1) & kDD);
+          const uint64_t any_missing = ((missing & (0x7f * kOnes)) + 0x7f * kOnes) | missing;
+          const uint64_t bits = (~any_missing >> 7) & kOnes;
+          std::memcpy(full + x, &bits, static_cast<size_t>(std::min(8, w - x)));
+        }
+        for (int tx = 0; tx < tiles_x; ++tx) {
+          const int end = std::min(w, (tx + 1) * tile);
+          uint64_t any = 0;
+          int x = tx * tile;
+          for (; x + 8 <= end; x += 8) any |= Load64(full + x);
+          for (; x < end; ++x) any |= full[x];
+          has[tx] |= any != 0 ? 1 : 0;
+        }
+        upper.swap(lower);
       }
-      uint8_t* has = &tile_has_full_[static_cast<size_t>(y / tile) * tiles_x];
-      for (int tx = 0; tx < tiles_x; ++tx) {
-        const int end = std::min(w, (tx + 1) * tile);
-        uint64_t any = 0;
-        int x = tx * tile;
-        for (; x + 8 <= end; x += 8) any |= Load64(full + x);
-        for (; x < end; ++x) any |= full[x];
-        has[tx] |= any != 0 ? 1 : 0;
-      }
-      upper.swap(lower);
-    }
+    });
   }
 
-  // Positions (x, y, z) of the nodes of the current tile: rows tile_y0_ ..
-  // tile_y0_ + tile size and columns tile_x0_ .. tile_x0_ + tile size, clipped
+  // Positions (x, y, z) of the nodes of the current tile: rows c->y0 ..
+  // c->y0 + tile size and columns c->x0 .. c->x0 + tile size, clipped
   // to the grid (column `width` repeats column 0), computed on first use and
-  // stored as three planes (px_, py_, pz_) of (tile + 1)^2 doubles.
-  void PrepareTile() {
-    if (tile_ready_) return;
-    tile_ready_ = true;
+  // stored as three planes (px, py, pz) of (tile + 1)^2 doubles.
+  void PrepareTile(TileCache* c) {
+    if (c->ready) return;
+    c->ready = true;
     const int w = p_.width(), last_row = p_.height() - 1;
-    const int tile = 1 << levels();
-    const int rows = std::min(tile, last_row - tile_y0_) + 1;
-    const int cols = std::min(tile, w - tile_x0_) + 1;
+    const int tile = tile_;
+    const int rows = std::min(tile, last_row - c->y0) + 1;
+    const int cols = std::min(tile, w - c->x0) + 1;
     const size_t stride = static_cast<size_t>(tile) + 1;
     // Two doubles of padding: Level1Pairs loads one past a row's last node.
-    px_.resize(stride * stride + 2);
-    py_.resize(stride * stride + 2);
-    pz_.resize(stride * stride + 2);
+    c->px.resize(stride * stride + 2);
+    c->py.resize(stride * stride + 2);
+    c->pz.resize(stride * stride + 2);
     const LayerData& d = p_.layer(layer_);
-    // Columns tile_x0_ .. tile_x0_ + inner - 1 need no wrap.
-    const int inner = std::min(cols, w - tile_x0_);
-    const double* sin_lon = &dirs_.sin_lon[tile_x0_];
-    const double* cos_lon = &dirs_.cos_lon[tile_x0_];
+    // Columns c->x0 .. c->x0 + inner - 1 need no wrap.
+    const int inner = std::min(cols, w - c->x0);
+    const double* sin_lon = &dirs_.sin_lon[c->x0];
+    const double* cos_lon = &dirs_.cos_lon[c->x0];
     for (int r = 0; r < rows; ++r) {
-      const int y = tile_y0_ + r;
+      const int y = c->y0 + r;
       const float* depth_row = &d.depth_m[p_.index(0, y)];
-      const float* depth = depth_row + tile_x0_;
+      const float* depth = depth_row + c->x0;
       const double cos_lat = dirs_.cos_lat[y], sin_lat = dirs_.sin_lat[y];
-      double* ox = &px_[r * stride];
-      double* oy = &py_[r * stride];
-      double* oz = &pz_[r * stride];
+      double* ox = &c->px[r * stride];
+      double* oy = &c->py[r * stride];
+      double* oz = &c->pz[r * stride];
       for (int i = 0; i < inner; ++i) {
         const double horizontal = cos_lat * static_cast<double>(depth[i]);
         ox[i] = horizontal * sin_lon[i];
@@ -244,7 +273,7 @@ class LayerPyramid {
   // current tile, two blocks per vector (lane 0 block bx, lane 1 block bx + 1),
   // with exactly the arithmetic of BlockError. Returns the first block not
   // done (at most one is left for BlockError).
-  int Level1Pairs(int by, int bx_begin, int bx_end) {
+  int Level1Pairs(int by, int bx_begin, int bx_end, TileCache* c) {
     using internal::F64x2;
     using internal::LoadF64x2;
     using internal::UnpackHi;
@@ -259,10 +288,10 @@ class LayerPyramid {
       const bool mergeable[2] = {(f0[0] & f0[1] & f1[0] & f1[1]) != 0,
                                  (f0[2] & f0[3] & f1[2] & f1[3]) != 0};
       if (!mergeable[0] && !mergeable[1]) continue;  // Both stay infinite.
-      PrepareTile();
+      PrepareTile(c);
       // Node (x0 + i, y0 + r) of lane 0 and (x0 + 2 + i, y0 + r) of lane 1:
       // row r of a plane gives nodes i = 0, 1, 2 of both lanes.
-      const size_t top = static_cast<size_t>(y0 - tile_y0_) * stride + (x0 - tile_x0_);
+      const size_t top = static_cast<size_t>(y0 - c->y0) * stride + (x0 - c->x0);
       auto load_row = [](const double* q, F64x2 out[3]) {
         const F64x2 a = LoadF64x2(q), b = LoadF64x2(q + 2), c = LoadF64x2(q + 4);
         out[0] = UnpackLo(a, b);
@@ -281,9 +310,9 @@ class LayerPyramid {
           *v = row2[0] - row0[2];  // C - B
         };
         F64x2 u0, u1, u2, v0, v1, v2;
-        corners(px_, &u0, &v0);
-        corners(py_, &u1, &v1);
-        corners(pz_, &u2, &v2);
+        corners(c->px, &u0, &v0);
+        corners(c->py, &u1, &v1);
+        corners(c->pz, &u2, &v2);
         n0 = u1 * v2 - u2 * v1;
         n1 = u2 * v0 - u0 * v2;
         n2 = u0 * v1 - u1 * v0;
@@ -296,9 +325,9 @@ class LayerPyramid {
       for (int r = 0; r < 3; ++r) {
         const size_t at = top + r * stride;
         F64x2 X[3], Y[3], Z[3];
-        load_row(&px_[at], X);
-        load_row(&py_[at], Y);
-        load_row(&pz_[at], Z);
+        load_row(&c->px[at], X);
+        load_row(&c->py[at], Y);
+        load_row(&c->pz[at], Z);
         for (int i = 0; i < 3; ++i) {
           const F64x2 t = n0 * X[i] + n1 * Y[i] + n2 * Z[i];
           lo = internal::MinF64x2(lo, t);
@@ -319,7 +348,7 @@ class LayerPyramid {
   // Spec/mesh.md Sec. 5.2: the children must be mergeable; the plane normal is
   // the cross product of the block's diagonals; the slab is the range of n.p
   // over the block's (s+1)^2 nodes.
-  double BlockError(int k, int bx, int by) {
+  double BlockError(int k, int bx, int by, TileCache* cache) {
     const int s = 1 << k;
     const int x0 = bx * s, y0 = by * s;
     double children = 0.0;
@@ -333,15 +362,15 @@ class LayerPyramid {
       }
     }
     if (!(children <= max_error_)) return kInf;
-    PrepareTile();
+    PrepareTile(cache);
     // Node (x0 + i, y0 + j) is cached at index top + j * stride + i.
     const size_t stride = (size_t{1} << levels()) + 1;
-    const size_t top = static_cast<size_t>(y0 - tile_y0_) * stride + (x0 - tile_x0_);
+    const size_t top = static_cast<size_t>(y0 - cache->y0) * stride + (x0 - cache->x0);
     const size_t bottom = top + static_cast<size_t>(s) * stride;
     auto position = [&](size_t node, double out[3]) {
-      out[0] = px_[node];
-      out[1] = py_[node];
-      out[2] = pz_[node];
+      out[0] = cache->px[node];
+      out[1] = cache->py[node];
+      out[2] = cache->pz[node];
     };
     double a[3], b[3], c[3], d[3];
     position(top, a);
@@ -364,9 +393,9 @@ class LayerPyramid {
     F64x2 lo2b = lo2, hi2b = hi2;
     double lo0 = kInf, hi0 = -kInf;
     for (size_t row = top; row <= bottom; row += stride) {
-      const double* qx = &px_[row];
-      const double* qy = &py_[row];
-      const double* qz = &pz_[row];
+      const double* qx = &cache->px[row];
+      const double* qy = &cache->py[row];
+      const double* qz = &cache->pz[row];
       int x = 0;
       for (; x + 4 <= s; x += 4) {
         const F64x2 t = n0 * internal::LoadF64x2(qx + x) + n1 * internal::LoadF64x2(qy + x) +
@@ -415,10 +444,7 @@ class LayerPyramid {
   std::vector<uint8_t> tile_has_full_;  // Per tile of the largest block size, row-major.
   std::vector<int> nx_, ny_;
   std::vector<std::vector<double>> error_;
-  // The tile being evaluated (its top-left quad) and its node positions.
-  int tile_x0_ = 0, tile_y0_ = 0;
-  bool tile_ready_ = false;
-  std::vector<double> px_, py_, pz_;
+  int tile_ = 1;  // Side of the largest block, in quads.
 };
 
 // The triangles of BuildMesh(). A quad whose four front nodes are linked
@@ -461,33 +487,47 @@ int64_t CountFullTriangles(const TwoLayerPanorama& p, const LayerPyramid& front,
 // steps i with error <= steps[i] < its parent's error. step_of(e) is the
 // finest step i with e <= steps[i], or -1.
 template <typename StepOf>
-void AddSavings(const LayerPyramid& py, const StepOf& step_of, std::vector<int64_t>* saving) {
+void AddSavings(const LayerPyramid& py, const StepOf& step_of, int threads,
+                std::vector<int64_t>* saving) {
   // Each block's step, level by level from the top, so that a block finds its
-  // parent's step in the level above.
+  // parent's step in the level above. Rows of a level go to threads in
+  // chunks, each with its own difference array (sums do not depend on the
+  // order).
   std::vector<int8_t> parent_steps, block_steps;
+  const int64_t chunks = 4 * static_cast<int64_t>(threads);
+  std::vector<std::vector<int64_t>> partial(static_cast<size_t>(chunks),
+                                            std::vector<int64_t>(saving->size(), 0));
   for (int k = py.levels(); k >= 1; --k) {
     const int64_t s = (int64_t{2} << (2 * k)) - 2;
     const int nx = py.nx(k);
     block_steps.assign(static_cast<size_t>(nx) * py.ny(k), -1);
-    for (int by = 0; by < py.ny(k); ++by) {
-      const double* error = py.ErrorRow(k, by);
-      int8_t* steps = &block_steps[static_cast<size_t>(by) * nx];
-      // Blocks with a parent: columns below parent_nx in a row below the
-      // parent level's last row.
-      const bool parent_row = k < py.levels() && by / 2 < py.ny(k + 1);
-      const int parent_nx = parent_row ? py.nx(k + 1) : 0;
-      const int8_t* parents =
-          parent_row ? &parent_steps[static_cast<size_t>(by / 2) * parent_nx] : nullptr;
-      for (int bx = 0; bx < nx; ++bx) {
-        const int last = step_of(error[bx]);
-        if (last < 0) continue;
-        steps[bx] = static_cast<int8_t>(last);
-        const int parent = bx / 2 < parent_nx ? parents[bx / 2] : -1;
-        (*saving)[parent + 1] += s;  // i in (parent, last].
-        (*saving)[last + 1] -= s;
+    ParallelFor(0, chunks, threads, [&](int64_t c) {
+      int64_t row_begin, row_end;
+      ChunkRange(py.ny(k), chunks, c, &row_begin, &row_end);
+      std::vector<int64_t>& out = partial[c];
+      for (int by = static_cast<int>(row_begin); by < row_end; ++by) {
+        const double* error = py.ErrorRow(k, by);
+        int8_t* steps = &block_steps[static_cast<size_t>(by) * nx];
+        // Blocks with a parent: columns below parent_nx in a row below the
+        // parent level's last row.
+        const bool parent_row = k < py.levels() && by / 2 < py.ny(k + 1);
+        const int parent_nx = parent_row ? py.nx(k + 1) : 0;
+        const int8_t* parents =
+            parent_row ? &parent_steps[static_cast<size_t>(by / 2) * parent_nx] : nullptr;
+        for (int bx = 0; bx < nx; ++bx) {
+          const int last = step_of(error[bx]);
+          if (last < 0) continue;
+          steps[bx] = static_cast<int8_t>(last);
+          const int parent = bx / 2 < parent_nx ? parents[bx / 2] : -1;
+          out[parent + 1] += s;  // i in (parent, last].
+          out[last + 1] -= s;
+        }
       }
-    }
+    });
     parent_steps.swap(block_steps);
+  }
+  for (const std::vector<int64_t>& p : partial) {
+    for (size_t i = 0; i < p.size(); ++i) (*saving)[i] += p[i];
   }
 }
 
@@ -497,76 +537,110 @@ struct Leaf {
 };
 
 // The merged blocks at threshold tau, ordered by (layer, level from largest,
-// block row, block column).
-std::vector<Leaf> SelectLeaves(const std::vector<LayerPyramid>& pyramids, double tau) {
+// block row, block column). Rows of a level go to threads in chunks whose
+// leaves are joined in order.
+std::vector<Leaf> SelectLeaves(const std::vector<LayerPyramid>& pyramids, double tau,
+                               int threads) {
   std::vector<Leaf> leaves;
   if (tau < 0) return leaves;
+  const int64_t chunks = 4 * static_cast<int64_t>(threads);
+  std::vector<std::vector<Leaf>> parts(static_cast<size_t>(chunks));
   for (size_t l = 0; l < pyramids.size(); ++l) {
     const LayerPyramid& py = pyramids[l];
     for (int k = py.levels(); k >= 1; --k) {
-      for (int by = 0; by < py.ny(k); ++by) {
-        const double* error = py.ErrorRow(k, by);
-        const bool parent_row = k < py.levels() && by / 2 < py.ny(k + 1);
-        const int parent_nx = parent_row ? py.nx(k + 1) : 0;
-        const double* parents = parent_row ? py.ErrorRow(k + 1, by / 2) : nullptr;
-        for (int bx = 0; bx < py.nx(k); ++bx) {
-          const double e = error[bx];
-          if (!(e <= tau)) continue;
-          if (bx / 2 < parent_nx && parents[bx / 2] <= tau) continue;  // The parent is merged.
-          leaves.push_back({static_cast<int>(l), k, bx << k, by << k, e});
+      ParallelFor(0, chunks, threads, [&](int64_t c) {
+        int64_t row_begin, row_end;
+        ChunkRange(py.ny(k), chunks, c, &row_begin, &row_end);
+        std::vector<Leaf>& out = parts[c];
+        out.clear();
+        for (int by = static_cast<int>(row_begin); by < row_end; ++by) {
+          const double* error = py.ErrorRow(k, by);
+          const bool parent_row = k < py.levels() && by / 2 < py.ny(k + 1);
+          const int parent_nx = parent_row ? py.nx(k + 1) : 0;
+          const double* parents = parent_row ? py.ErrorRow(k + 1, by / 2) : nullptr;
+          for (int bx = 0; bx < py.nx(k); ++bx) {
+            const double e = error[bx];
+            if (!(e <= tau)) continue;
+            if (bx / 2 < parent_nx && parents[bx / 2] <= tau) continue;  // The parent is merged.
+            out.push_back({static_cast<int>(l), k, bx << k, by << k, e});
+          }
         }
-      }
+      });
+      for (const std::vector<Leaf>& part : parts) leaves.insert(leaves.end(), part.begin(), part.end());
     }
   }
   return leaves;
 }
 
-// Builds the simplified mesh for a set of leaves (spec/mesh.md Sec. 5.4).
-Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>& leaves) {
+// Builds the simplified mesh for a set of leaves (spec/mesh.md Sec. 5.4) and
+// sets *triangles to its triangle count. If `count_limit` >= 0 and the count
+// exceeds it, returns an empty mesh (the caller only needs the count). Rows
+// of quads and runs of leaves go to threads in bands whose triangles are
+// joined in order, so the mesh does not depend on the number of threads.
+Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>& leaves,
+              int threads, int64_t count_limit, int64_t* triangles) {
   const int w = p.width(), qh = p.height() - 1;
   // Per layer, whether a leaf of that layer covers the quad (1 or 0).
   std::vector<uint8_t> covered[kNumLayers];
   for (int l = 0; l < (use_back ? kNumLayers : 1); ++l) {
     covered[l].assign(static_cast<size_t>(w) * qh, 0);
   }
-  for (const Leaf& leaf : leaves) {
+  const int64_t num_leaves = static_cast<int64_t>(leaves.size());
+  ParallelFor(0, num_leaves, threads, [&](int64_t i) {  // Leaves never overlap.
+    const Leaf& leaf = leaves[i];
     const int s = 1 << leaf.level;
     uint8_t* row = &covered[leaf.layer][static_cast<size_t>(leaf.y0) * w + leaf.x0];
     for (int y = 0; y < s; ++y, row += w) std::memset(row, 1, static_cast<size_t>(s));
-  }
-  MeshAssembler out(p);
-  out.Reserve(2 * static_cast<size_t>(w) * qh / 4 + 1024);
-  // A quad covered by leaves of every layer that has a node at its corners
-  // has no triangle left (each triangle starts at a corner node of an
-  // uncovered layer).
-  std::vector<uint8_t> back_in_column(w + 8, 0);  // See BackInColumns; zero without the back layer.
-  const uint8_t* bic = back_in_column.data();
-  for (int y = 0; y < qh; ++y) {
-    const uint8_t* front_covered = &covered[kFront][static_cast<size_t>(y) * w];
-    const uint8_t* back_covered =
-        use_back ? &covered[kBack][static_cast<size_t>(y) * w] : nullptr;
-    if (use_back) BackInColumns(p, y, back_in_column.data());
-    for (int x = 0; x < w; ++x) {
-      // Eight quads covered in front without back nodes have no triangle.
-      if ((x & 7) == 0 && x + 8 <= w &&
-          (Load64(front_covered + x) & ~(Load64(bic + x) | Load64(bic + x + 1))) == kOnes) {
-        x += 7;
-        continue;
+  }, 256);
+
+  // Step 1, remaining pixel-quad triangles, in bands of rows.
+  const int64_t row_bands = std::min<int64_t>(qh, 8 * static_cast<int64_t>(threads));
+  std::vector<MeshAssembler> quad_parts(static_cast<size_t>(std::max<int64_t>(row_bands, 0)),
+                                        MeshAssembler(p));
+  ParallelFor(0, row_bands, threads, [&](int64_t band) {
+    int64_t y_begin, y_end;
+    ChunkRange(qh, row_bands, band, &y_begin, &y_end);
+    MeshAssembler& out = quad_parts[band];
+    out.Reserve(static_cast<size_t>(w) * (y_end - y_begin) / 2 + 1024);
+    // A quad covered by leaves of every layer that has a node at its corners
+    // has no triangle left (each triangle starts at a corner node of an
+    // uncovered layer).
+    std::vector<uint8_t> back_in_column(w + 8, 0);  // See BackInColumns; zero without the back layer.
+    const uint8_t* bic = back_in_column.data();
+    for (int y = static_cast<int>(y_begin); y < y_end; ++y) {
+      const uint8_t* front_covered = &covered[kFront][static_cast<size_t>(y) * w];
+      const uint8_t* back_covered =
+          use_back ? &covered[kBack][static_cast<size_t>(y) * w] : nullptr;
+      if (use_back) BackInColumns(p, y, back_in_column.data());
+      for (int x = 0; x < w; ++x) {
+        // Eight quads covered in front without back nodes have no triangle.
+        if ((x & 7) == 0 && x + 8 <= w &&
+            (Load64(front_covered + x) & ~(Load64(bic + x) | Load64(bic + x + 1))) == kOnes) {
+          x += 7;
+          continue;
+        }
+        if (!front_covered[x]) {
+          const unsigned skip = use_back ? static_cast<unsigned>(back_covered[x]) << 1 : 0u;
+          AddQuadTriangles(p, x, y, use_back, skip, &out);
+          continue;
+        }
+        // Covered in front: triangles remain only from back nodes not covered.
+        if (!(bic[x] | bic[x + 1]) || back_covered[x]) continue;
+        AddQuadTriangles(p, x, y, use_back, 1u, &out);
       }
-      if (!front_covered[x]) {
-        const unsigned skip = use_back ? static_cast<unsigned>(back_covered[x]) << 1 : 0u;
-        AddQuadTriangles(p, x, y, use_back, skip, &out);
-        continue;
-      }
-      // Covered in front: triangles remain only from back nodes not covered.
-      if (!(bic[x] | bic[x + 1]) || back_covered[x]) continue;
-      AddQuadTriangles(p, x, y, use_back, 1u, &out);
     }
+  });
+  // Step 2, kept nodes: every vertex of the remaining pixel-quad triangles
+  // and every leaf corner. A band's triangles use the nodes of its rows and
+  // of the row below, so bands of one parity never share a node: even bands,
+  // then odd ones. Leaf corners are few.
+  const size_t num_nodes = static_cast<size_t>(w) * p.height() * 2;
+  std::vector<uint8_t> kept(num_nodes, 0);
+  for (int parity = 0; parity < 2; ++parity) {
+    ParallelFor(0, (row_bands + 1 - parity) / 2, threads, [&](int64_t half) {
+      for (NodeRef r : quad_parts[2 * half + parity].refs()) kept[r & ~kSeamBit] = 1;
+    });
   }
-  // Nodes that geometry outside a leaf uses: every vertex of the remaining
-  // pixel-quad triangles and every leaf corner.
-  std::vector<uint8_t> kept(static_cast<size_t>(w) * p.height() * 2, 0);
-  for (NodeRef r : out.refs()) kept[r & ~kSeamBit] = 1;
   auto node = [&](int x, int y, int layer) { return p.index(x == w ? 0 : x, y) * 2 + layer; };
   for (const Leaf& leaf : leaves) {
     const int s = 1 << leaf.level;
@@ -575,62 +649,86 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
     kept[node(leaf.x0, leaf.y0 + s, leaf.layer)] = 1;
     kept[node(leaf.x0 + s, leaf.y0 + s, leaf.layer)] = 1;
   }
-  std::vector<NodeRef> ring;
-  for (const Leaf& leaf : leaves) {
-    const int s = 1 << leaf.level, x0 = leaf.x0, y0 = leaf.y0, l = leaf.layer;
-    auto ref = [&](int x, int y) {
-      return x == w ? MakeNodeRef(p, 0, y, l, true) : MakeNodeRef(p, x, y, l, false);
-    };
-    // Border counter-clockwise seen from the centre: down the left side, right
-    // along the bottom, up the right side, left along the top. corner[] holds
-    // the ring positions of A, C, D, B; side i runs from corner i to i + 1.
-    ring.clear();
-    size_t corner[4];
-    corner[0] = ring.size();
-    for (int y = y0; y < y0 + s; ++y) {
-      if (y == y0 || kept[node(x0, y, l)]) ring.push_back(ref(x0, y));
-    }
-    corner[1] = ring.size();
-    for (int x = x0; x < x0 + s; ++x) {
-      if (x == x0 || kept[node(x, y0 + s, l)]) ring.push_back(ref(x, y0 + s));
-    }
-    corner[2] = ring.size();
-    for (int y = y0 + s; y > y0; --y) {
-      if (y == y0 + s || kept[node(x0 + s, y, l)]) ring.push_back(ref(x0 + s, y));
-    }
-    corner[3] = ring.size();
-    for (int x = x0 + s; x > x0; --x) {
-      if (x == x0 + s || kept[node(x, y0, l)]) ring.push_back(ref(x, y0));
-    }
-    const size_t n = ring.size();
-    if (n == 4) {
-      // Corners A, C, D, B: the two triangles of a pixel quad (A-D diagonal).
-      out.AddTriangle(ring[3], ring[0], ring[2]);
-      out.AddTriangle(ring[1], ring[2], ring[0]);
-      continue;
-    }
-    // A fan from a corner whose two sides have no extra vertex has no
-    // degenerate triangle and needs n - 2 triangles; otherwise fan from the
-    // block's centre node (n triangles).
-    auto side_extra = [&](int i) {
-      const size_t end = i == 3 ? n : corner[i + 1];
-      return end - corner[i] > 1;
-    };
-    int apex = -1;
-    for (int c = 0; c < 4 && apex < 0; ++c) {
-      if (!side_extra(c) && !side_extra((c + 3) & 3)) apex = c;
-    }
-    if (apex >= 0) {
-      const size_t v = corner[apex];
-      for (size_t i = 1; i + 1 < n; ++i) {
-        out.AddTriangle(ring[v], ring[(v + i) % n], ring[(v + i + 1) % n]);
+  auto is_kept = [&](size_t node) { return kept[node] != 0; };
+  // Step 3, patches, in runs of leaves.
+  const int64_t leaf_runs = std::min<int64_t>(num_leaves, 8 * static_cast<int64_t>(threads));
+  std::vector<MeshAssembler> patch_parts(static_cast<size_t>(leaf_runs), MeshAssembler(p));
+  ParallelFor(0, leaf_runs, threads, [&](int64_t run) {
+    int64_t first, last;
+    ChunkRange(num_leaves, leaf_runs, run, &first, &last);
+    MeshAssembler& out = patch_parts[run];
+    size_t most = 0;  // A ring has at most 4 s nodes, a patch as many triangles.
+    for (int64_t li = first; li < last; ++li) most += size_t{4} << leaves[li].level;
+    out.Reserve(most);
+    std::vector<NodeRef> ring;
+    for (int64_t li = first; li < last; ++li) {
+      const Leaf& leaf = leaves[li];
+      const int s = 1 << leaf.level, x0 = leaf.x0, y0 = leaf.y0, l = leaf.layer;
+      auto ref = [&](int x, int y) {
+        return x == w ? MakeNodeRef(p, 0, y, l, true) : MakeNodeRef(p, x, y, l, false);
+      };
+      // Border counter-clockwise seen from the centre: down the left side,
+      // right along the bottom, up the right side, left along the top.
+      // corner[] holds the ring positions of A, C, D, B; side i runs from
+      // corner i to i + 1.
+      ring.clear();
+      size_t corner[4];
+      corner[0] = ring.size();
+      for (int y = y0; y < y0 + s; ++y) {
+        if (y == y0 || is_kept(node(x0, y, l))) ring.push_back(ref(x0, y));
       }
-    } else {
-      const NodeRef centre = ref(x0 + s / 2, y0 + s / 2);
-      for (size_t i = 0; i < n; ++i) out.AddTriangle(centre, ring[i], ring[(i + 1) % n]);
+      corner[1] = ring.size();
+      for (int x = x0; x < x0 + s; ++x) {
+        if (x == x0 || is_kept(node(x, y0 + s, l))) ring.push_back(ref(x, y0 + s));
+      }
+      corner[2] = ring.size();
+      for (int y = y0 + s; y > y0; --y) {
+        if (y == y0 + s || is_kept(node(x0 + s, y, l))) ring.push_back(ref(x0 + s, y));
+      }
+      corner[3] = ring.size();
+      for (int x = x0 + s; x > x0; --x) {
+        if (x == x0 + s || is_kept(node(x, y0, l))) ring.push_back(ref(x, y0));
+      }
+      const size_t n = ring.size();
+      if (n == 4) {
+        // Corners A, C, D, B: the two triangles of a pixel quad (A-D diagonal).
+        out.AddTriangle(ring[3], ring[0], ring[2]);
+        out.AddTriangle(ring[1], ring[2], ring[0]);
+        continue;
+      }
+      // A fan from a corner whose two sides have no extra vertex has no
+      // degenerate triangle and needs n - 2 triangles; otherwise fan from the
+      // block's centre node (n triangles).
+      auto side_extra = [&](int i) {
+        const size_t end = i == 3 ? n : corner[i + 1];
+        return end - corner[i] > 1;
+      };
+      int apex = -1;
+      for (int c = 0; c < 4 && apex < 0; ++c) {
+        if (!side_extra(c) && !side_extra((c + 3) & 3)) apex = c;
+      }
+      if (apex >= 0) {
+        const size_t v = corner[apex];
+        for (size_t i = 1; i + 1 < n; ++i) {
+          out.AddTriangle(ring[v], ring[(v + i) % n], ring[(v + i + 1) % n]);
+        }
+      } else {
+        const NodeRef centre = ref(x0 + s / 2, y0 + s / 2);
+        for (size_t i = 0; i < n; ++i) out.AddTriangle(centre, ring[i], ring[(i + 1) % n]);
+      }
     }
-  }
-  return out.Finish();
+  });
+  std::vector<uint8_t>().swap(kept);
+  MeshAssembler out(p);
+  size_t total = 0;
+  for (const MeshAssembler& part : quad_parts) total += part.num_triangles();
+  for (const MeshAssembler& part : patch_parts) total += part.num_triangles();
+  *triangles = static_cast<int64_t>(total);
+  if (count_limit >= 0 && *triangles > count_limit) return Mesh();
+  out.Reserve(total);
+  for (MeshAssembler& part : quad_parts) out.Append(&part);
+  for (MeshAssembler& part : patch_parts) out.Append(&part);
+  return out.Finish(threads);
 }
 
 }  // namespace
@@ -650,6 +748,7 @@ Status MeshSimplifyOptions::Check() const {
   }
   MeshBuildOptions build;
   build.max_pixels = max_pixels;
+  build.num_threads = num_threads;
   return build.Check();
 }
 
@@ -663,9 +762,23 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
   int levels = 0;
   while ((2 << levels) <= options.max_block_size) ++levels;
   const Directions dirs(w, pano.height());
+  const int threads = ResolveThreads(options.num_threads);
   std::vector<LayerPyramid> pyramids;
+  pyramids.reserve(kNumLayers);
   for (int l = 0; l < (use_back ? kNumLayers : 1); ++l) {
-    pyramids.emplace_back(pano, dirs, l, levels, options.max_relative_error);
+    pyramids.emplace_back(pano, dirs, l, levels, options.max_relative_error, threads);
+  }
+  {
+    // Block errors, by rows of tiles of both layers.
+    std::vector<std::pair<int, int>> rows;  // (layer, tile row)
+    for (size_t l = 0; l < pyramids.size(); ++l) {
+      for (int ty = 0; ty < pyramids[l].num_tile_rows(); ++ty) rows.emplace_back(static_cast<int>(l), ty);
+    }
+    ParallelFor(0, static_cast<int64_t>(rows.size()), threads, [&](int64_t i) {
+      TileCache cache;  // 400 KB for 128-quad tiles, once per row of about 30 tiles.
+      pyramids[rows[i].first].EvaluateTileRow(rows[i].second, &cache);
+    });
+    for (LayerPyramid& py : pyramids) py.ReleaseScratch();
   }
 
   SimplifiedMesh result;
@@ -719,7 +832,7 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
     return e <= steps[g] ? g : g - 1;
   };
   std::vector<int64_t> saving(kNumSteps + 2, 0);  // Difference array over step indices.
-  for (const LayerPyramid& py : pyramids) AddSavings(py, step_of, &saving);
+  for (const LayerPyramid& py : pyramids) AddSavings(py, step_of, threads, &saving);
   std::vector<int64_t> estimate(kNumSteps + 1);
   int64_t running = 0;
   for (int i = 0; i <= kNumSteps; ++i) {
@@ -740,12 +853,16 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
       while (step < kNumSteps && estimate[step + 1] <= target) ++step;
       tau = steps[step];
     }
-    const std::vector<Leaf> leaves = SelectLeaves(pyramids, tau);
-    result.mesh = Assemble(pano, use_back, leaves);
+    const std::vector<Leaf> leaves = SelectLeaves(pyramids, tau, threads);
+    // An attempt that another one will follow if it is over budget only
+    // needs its triangle count.
+    const bool may_retry = options.max_triangles > 0 && step != 0 && attempt + 1 < 8;
+    int64_t triangles = 0;
+    result.mesh = Assemble(pano, use_back, leaves, threads,
+                           may_retry ? options.max_triangles : -1, &triangles);
     result.merged_blocks = static_cast<int64_t>(leaves.size());
     result.error_bound = 0.0;
     for (const Leaf& leaf : leaves) result.error_bound = std::max(result.error_bound, leaf.error);
-    const int64_t triangles = static_cast<int64_t>(result.mesh.num_triangles());
     result.budget_met = options.max_triangles == 0 || triangles <= options.max_triangles;
     if (result.budget_met || step == 0) break;
     const int64_t excess = triangles - estimate[step];

@@ -46,6 +46,9 @@ struct MeshSimplifyOptions {
   bool include_back_layer = true;
   bool validate_input = true;
   int64_t max_pixels = int64_t{8192} * 4096;
+  // Threads for the per-pixel passes (format/parallel.h); 0: all hardware
+  // threads. The mesh does not depend on it. Range [0, 256].
+  int num_threads = 0;
 
   // InvalidArgument naming the field when a value is out of range.
   Status Check() const;

@@ -278,6 +278,35 @@ TEST(MeshSimplifyTest, Deterministic) {
   EXPECT_EQ(a->error_bound, b->error_bound);
 }
 
+// Bands, tile rows and runs of leaves go to threads; the mesh must not depend
+// on how many there are. The room at this budget takes more than one attempt
+// (the first over budget gives only its count), the blocks scene has open
+// edges, seams and back nodes.
+TEST(MeshSimplifyTest, SameMeshForEveryThreadCount) {
+  const TwoLayerPanorama room = testing::MakeRoomPanorama(512, 256);
+  const TwoLayerPanorama blocks = testing::MakeBlocksPanorama();
+  for (const TwoLayerPanorama* p : {&room, &blocks}) {
+    for (int64_t budget : {int64_t{0}, int64_t{9000}, int64_t{60000}}) {
+      MeshSimplifyOptions o;
+      o.max_triangles = budget;
+      o.num_threads = 1;
+      auto one = BuildSimplifiedMesh(*p, o);
+      ASSERT_TRUE(one.ok());
+      for (int threads : {2, 3, 8}) {
+        o.num_threads = threads;
+        auto many = BuildSimplifiedMesh(*p, o);
+        ASSERT_TRUE(many.ok());
+        EXPECT_EQ(testing::MeshChecksum(many->mesh), testing::MeshChecksum(one->mesh))
+            << threads << " threads, budget " << budget;
+        EXPECT_EQ(many->mesh.indices, one->mesh.indices);
+        EXPECT_EQ(many->error_bound, one->error_bound);
+        EXPECT_EQ(many->merged_blocks, one->merged_blocks);
+        EXPECT_EQ(many->budget_met, one->budget_met);
+      }
+    }
+  }
+}
+
 TEST(MeshSimplifyTest, FrontOnlyIgnoresTheBackLayer) {
   const TwoLayerPanorama p = testing::MakeRoomPanorama(128, 64);
   MeshSimplifyOptions o;
@@ -303,6 +332,9 @@ TEST(MeshSimplifyTest, OptionsAreChecked) {
   o = {};
   o.max_pixels = 100;
   EXPECT_EQ(BuildSimplifiedMesh(p, o).status().code(), StatusCode::kLimitExceeded);
+  o = {};
+  o.num_threads = -1;
+  EXPECT_EQ(BuildSimplifiedMesh(p, o).status().message(), "num_threads -1 is outside [0, 256]");
 }
 
 // Pins the exact output; the Emscripten build gives the same checksum.

@@ -56,7 +56,8 @@ Status PackageReader::BeginLevel(int level, int64_t max_pixels) {
   return Status::Ok();
 }
 
-Status PackageReader::AddTileImage(int tile, TileImageKind kind, ImageView<const uint8_t> pixels) {
+Status PackageReader::AddTileImage(int tile, TileImageKind kind, ImageView<const uint8_t> pixels,
+                                   int num_threads) {
   if (level_ < 0) return InvalidArgument("AddTileImage before BeginLevel");
   const LevelEntry& L = manifest_.levels[level_];
   const int k = static_cast<int>(kind);
@@ -65,7 +66,7 @@ Status PackageReader::AddTileImage(int tile, TileImageKind kind, ImageView<const
                            " is out of range");
   int x, y, w, h;
   manifest_.TileRect(level_, tile, &x, &y, &w, &h);
-  Status s = DecodeTileImage(pixels, kind, x, y, w, h, *tile_decoder_, &pano_);
+  Status s = DecodeTileImage(pixels, kind, x, y, w, h, *tile_decoder_, &pano_, num_threads);
   if (!s.ok()) return Status(s.code(), L.tiles[tile].files[k] + ": " + s.message());
   received_[static_cast<size_t>(tile) * kNumTileImageKinds + k] = 1;
   return Status::Ok();
@@ -84,7 +85,7 @@ Status PackageReader::AddTileFile(int tile, TileImageKind kind, const uint8_t* d
   return AddTileImage(tile, kind, decoded.view());
 }
 
-StatusOr<TwoLayerPanorama> PackageReader::FinishLevel() {
+StatusOr<TwoLayerPanorama> PackageReader::FinishLevel(int num_threads) {
   if (level_ < 0) return InvalidArgument("FinishLevel before BeginLevel");
   const LevelEntry& L = manifest_.levels[level_];
   for (size_t i = 0; i < received_.size(); ++i) {
@@ -93,11 +94,11 @@ StatusOr<TwoLayerPanorama> PackageReader::FinishLevel() {
                              L.tiles[i / kNumTileImageKinds].files[i % kNumTileImageKinds] +
                              " was not added");
   }
-  CASUAL3D_RETURN_IF_ERROR(FinishDecodedPanorama(&pano_));
+  CASUAL3D_RETURN_IF_ERROR(FinishDecodedPanorama(&pano_, num_threads));
   // Decoding leaves only valid node values (FinishDecodedPanorama checks the
   // depths and clears absent nodes; the decoder's normal table holds only
   // valid normals, tile_codec_test.cc), so the links are what remains to check.
-  Status valid = pano_.ValidateLinks();
+  Status valid = pano_.ValidateLinks(num_threads);
   if (!valid.ok())
     return InvalidData("level " + std::to_string(level_) + ": the decoded panorama is invalid: " +
                        valid.message());

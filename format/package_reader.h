@@ -60,7 +60,9 @@ class PackageReader {
   // the level being assembled; the image is 3- or 4-channel 8-bit. Tiles and
   // kinds may come in any order; calls for different (tile, kind) pairs may run
   // concurrently.
-  Status AddTileImage(int tile, TileImageKind kind, ImageView<const uint8_t> pixels);
+  // Its rows are decoded on up to `num_threads` threads (DecodeTileImage).
+  Status AddTileImage(int tile, TileImageKind kind, ImageView<const uint8_t> pixels,
+                      int num_threads = 1);
 
   // Decodes a compressed file of tile `tile` with `decoder` and adds it.
   Status AddTileFile(int tile, TileImageKind kind, const uint8_t* data, size_t size,
@@ -69,7 +71,8 @@ class PackageReader {
   // After every image of every tile was added: clears absent nodes, validates
   // the panorama (TwoLayerPanorama::Validate) and returns it. The reader can
   // then begin another level.
-  StatusOr<TwoLayerPanorama> FinishLevel();
+  // Up to `num_threads` threads share the passes over the nodes.
+  StatusOr<TwoLayerPanorama> FinishLevel(int num_threads = 1);
 
  private:
   explicit PackageReader(Manifest manifest);

@@ -1,14 +1,18 @@
 #include "format/tile_codec.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <vector>
 
 #if defined(__wasm_simd128__)
 #include <wasm_simd128.h>
 #endif
+
+#include "format/parallel.h"
 
 namespace casual3d {
 namespace {
@@ -256,15 +260,16 @@ Status DecodeError(ImageView<const uint8_t> image, TileImageKind kind, int x0, i
   return Status::Ok();
 }
 
-// The per-kind loops of DecodeTileImage for images of `kChannels` channels.
-// Each returns false if some pixel was invalid (the caller then finds the
-// first one for the message); they never read or write out of bounds.
+// The per-kind loops of DecodeTileImage for images of `kChannels` channels,
+// over the tile's rows [row_begin, row_end). Each returns false if some pixel
+// was invalid (the caller then finds the first one for the message); they
+// never read or write out of bounds.
 template <int kChannels>
-bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int h,
-                     TwoLayerPanorama* pano, int* bad_x, int* bad_y) {
+bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int row_begin,
+                     int row_end, TwoLayerPanorama* pano, int* bad_x, int* bad_y) {
   LayerData& F = pano->layer(kFront);
   LayerData& B = pano->layer(kBack);
-  for (int y = 0; y < h; ++y) {
+  for (int y = row_begin; y < row_end; ++y) {
     const uint8_t* px = image.row(y);
     const size_t i0 = pano->index(x0, y0 + y);
     uint8_t* __restrict front_present = &F.present[i0];
@@ -332,11 +337,12 @@ bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int 
 
 template <int kChannels>
 bool DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
-                     int h, const TileDecoder& decoder, TwoLayerPanorama* pano) {
+                     int h, int row_begin, int row_end, const TileDecoder& decoder,
+                     TwoLayerPanorama* pano) {
   bool ok = true;
   for (int l = 0; l < kNumLayers; ++l) {
     LayerData& L = pano->layer(l);
-    for (int y = 0; y < h; ++y) {
+    for (int y = row_begin; y < row_end; ++y) {
       const uint8_t* px = image.row(l * h + y);
       const size_t i0 = pano->index(x0, y0 + y);
       if (kind == TileImageKind::kColor) {
@@ -383,7 +389,8 @@ bool DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0,
 }  // namespace
 
 Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
-                       int h, const TileDecoder& decoder, TwoLayerPanorama* pano) {
+                       int h, const TileDecoder& decoder, TwoLayerPanorama* pano,
+                       int num_threads) {
   if (w <= 0 || h <= 0 || x0 < 0 || y0 < 0 || x0 > pano->width() - w || y0 > pano->height() - h)
     return InvalidArgument("tile region " + std::to_string(w) + "x" + std::to_string(h) + " at " +
                            PixelName(x0, y0) + " lies outside the panorama");
@@ -397,34 +404,62 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
     return InvalidData(std::string(TileImageKindName(kind)) + " image has " +
                        std::to_string(image.channels()) + " channels, expected 3 or 4");
   const bool rgba = image.channels() == 4;
-  if (kind == TileImageKind::kGraph) {
-    int bad_x = 0, bad_y = 0;
-    const bool ok = rgba ? DecodeGraphRows<4>(image, x0, y0, w, h, pano, &bad_x, &bad_y)
-                         : DecodeGraphRows<3>(image, x0, y0, w, h, pano, &bad_x, &bad_y);
-    if (!ok)
-      return InvalidData("graph image: reserved flag bits set at pixel " + PixelName(bad_x, bad_y));
-    return Status::Ok();
+  // Bands of rows write disjoint nodes; a band's first invalid pixel is the
+  // tile's first when no earlier band has one.
+  const int threads = ResolveThreads(num_threads);
+  const int bands = std::min(h, threads > 1 ? 4 * threads : 1);
+  std::vector<uint8_t> band_ok(static_cast<size_t>(bands), 1);
+  std::vector<int> band_bad(2 * static_cast<size_t>(bands), 0);
+  ParallelFor(0, bands, threads, [&](int64_t b) {
+    int64_t r0, r1;
+    ChunkRange(h, bands, b, &r0, &r1);
+    const int row_begin = static_cast<int>(r0), row_end = static_cast<int>(r1);
+    bool ok;
+    if (kind == TileImageKind::kGraph) {
+      int* bad = &band_bad[2 * b];
+      ok = rgba ? DecodeGraphRows<4>(image, x0, y0, w, row_begin, row_end, pano, bad, bad + 1)
+                : DecodeGraphRows<3>(image, x0, y0, w, row_begin, row_end, pano, bad, bad + 1);
+    } else {
+      ok = rgba ? DecodeLayerRows<4>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano)
+                : DecodeLayerRows<3>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano);
+    }
+    band_ok[b] = ok ? 1 : 0;
+  });
+  for (int b = 0; b < bands; ++b) {
+    if (band_ok[b]) continue;
+    if (kind == TileImageKind::kGraph)
+      return InvalidData("graph image: reserved flag bits set at pixel " +
+                         PixelName(band_bad[2 * b], band_bad[2 * b + 1]));
+    return DecodeError(image, kind, x0, y0, w, h, decoder);
   }
-  const bool ok = rgba ? DecodeLayerRows<4>(image, kind, x0, y0, w, h, decoder, pano)
-                       : DecodeLayerRows<3>(image, kind, x0, y0, w, h, decoder, pano);
-  return ok ? Status::Ok() : DecodeError(image, kind, x0, y0, w, h, decoder);
+  return Status::Ok();
 }
 
-Status FinishDecodedPanorama(TwoLayerPanorama* pano) {
+Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads) {
+  const int threads = ResolveThreads(num_threads);
   for (int l = 0; l < kNumLayers; ++l) {
     LayerData& L = pano->layer(l);
     const size_t n = L.present.size();
     const uint8_t* present = L.present.data();
+    // Nodes in chunks on up to `threads` threads; a chunk's runs of absent
+    // nodes end at its end, and clearing a node twice changes nothing.
+    const int64_t chunks = threads > 1 && n >= (size_t{1} << 16) ? 4 * threads : 1;
     // Present nodes must have a finite depth (code 0 means none; a depth
     // range beyond 32-bit floats decodes to infinity): one branch-free pass,
     // then the first offender for the message.
     constexpr float kMaxDepth = std::numeric_limits<float>::max();
-    bool bad = false;
-    for (size_t i = 0; i < n; ++i) {
-      const float d = L.depth_m[i];
-      bad |= (present[i] != 0) & !((d > 0) & (d <= kMaxDepth));
-    }
-    if (bad) {
+    std::atomic<bool> bad(false);
+    ParallelFor(0, chunks, threads, [&](int64_t c) {
+      int64_t begin, end;
+      ChunkRange(static_cast<int64_t>(n), chunks, c, &begin, &end);
+      bool chunk_bad = false;
+      for (size_t i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
+        const float d = L.depth_m[i];
+        chunk_bad |= (present[i] != 0) & !((d > 0) & (d <= kMaxDepth));
+      }
+      if (chunk_bad) bad.store(true, std::memory_order_relaxed);
+    });
+    if (bad.load()) {
       for (size_t i = 0; i < n; ++i) {
         const float d = L.depth_m[i];
         if (present[i] && !(d > 0 && d <= kMaxDepth))
@@ -453,18 +488,23 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano) {
       return word;
     };
     constexpr uint64_t kAllPresent = 0x0101010101010101ull;
-    size_t i = 0;
-    while (i < n) {
-      // Skip present nodes.
-      while (i + 8 <= n && flags_at(i) == kAllPresent) i += 8;
-      while (i < n && present[i]) ++i;
-      if (i == n) break;
-      size_t end = i + 1;
-      while (end + 8 <= n && flags_at(end) == 0) end += 8;
-      while (end < n && !present[end]) ++end;
-      clear(i, end);
-      i = end;
-    }
+    ParallelFor(0, chunks, threads, [&](int64_t c) {
+      int64_t chunk_begin, chunk_end;
+      ChunkRange(static_cast<int64_t>(n), chunks, c, &chunk_begin, &chunk_end);
+      const size_t stop = static_cast<size_t>(chunk_end);
+      size_t i = static_cast<size_t>(chunk_begin);
+      while (i < stop) {
+        // Skip present nodes.
+        while (i + 8 <= stop && flags_at(i) == kAllPresent) i += 8;
+        while (i < stop && present[i]) ++i;
+        if (i == stop) break;
+        size_t end = i + 1;
+        while (end + 8 <= stop && flags_at(end) == 0) end += 8;
+        while (end < stop && !present[end]) ++end;
+        clear(i, end);
+        i = end;
+      }
+    });
   }
   return Status::Ok();
 }

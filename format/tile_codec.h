@@ -130,15 +130,18 @@ class TileDecoder {
 // values whether or not a node is present (FinishDecodedPanorama clears the
 // absent ones). Returns kInvalidData, naming the pixel, for a wrong size,
 // reserved bits, or an invalid depth or normal code. Never reads or writes out
-// of bounds.
+// of bounds. Rows are shared among `num_threads` threads (format/parallel.h;
+// 0: all hardware threads); the result does not depend on it.
 Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
-                       int h, const TileDecoder& decoder, TwoLayerPanorama* pano);
+                       int h, const TileDecoder& decoder, TwoLayerPanorama* pano,
+                       int num_threads = 1);
 
 // After all tiles are decoded: zeroes every field of absent nodes and checks
 // that every present node has a finite depth (code != 0, and a depth range
 // within 32-bit floats). Returns the first problem. Afterwards every node value
 // is one that TwoLayerPanorama::Validate() accepts, so only the links remain
 // to check (TwoLayerPanorama::ValidateLinks()).
-Status FinishDecodedPanorama(TwoLayerPanorama* pano);
+// Nodes are shared among `num_threads` threads as in DecodeTileImage.
+Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads = 1);
 
 }  // namespace casual3d

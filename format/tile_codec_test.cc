@@ -296,5 +296,47 @@ TEST(TileCodecTest, ErrorsNameTheFirstInvalidPixel) {
   EXPECT_NE(s.message().find("(4, 2)"), std::string::npos) << s.message();
 }
 
+// Rows are decoded in bands on several threads: the panorama and the first
+// invalid pixel named must not depend on how many.
+TEST(TileCodecTest, SameResultForEveryThreadCount) {
+  const TwoLayerPanorama pano = casual3d::testing::MakePackageTestPanorama(96, 64);
+  TileQuantization q;
+  q.depth.near_m = 2.0;
+  q.depth.far_m = 100.0;
+  q.depth.bits = 12;
+  const TileDecoder decoder(q);
+  TwoLayerPanorama reference;
+  for (int threads : {1, 2, 3, 8}) {
+    TwoLayerPanorama out(96, 64);
+    out.frame() = pano.frame();
+    for (int k = 0; k < kNumTileImageKinds; ++k) {
+      const Image8 image = EncodeTileImage(pano, 0, 0, 96, 64, static_cast<TileImageKind>(k), q);
+      ASSERT_TRUE(DecodeTileImage(image.view(), static_cast<TileImageKind>(k), 0, 0, 96, 64,
+                                  decoder, &out, threads)
+                      .ok());
+    }
+    ASSERT_TRUE(FinishDecodedPanorama(&out, threads).ok());
+    ASSERT_TRUE(out.ValidateLinks(threads).ok());
+    if (threads == 1) {
+      reference = out;
+    } else {
+      EXPECT_TRUE(out == reference) << threads << " threads";
+    }
+    // Two bad pixels in different bands: the earlier row is named.
+    Image8 graph(96, 64, 4, 0);
+    graph.at(40, 50, 2) = 0x80;
+    graph.at(70, 9, 2) = 0x20;
+    const Status s =
+        DecodeTileImage(V(graph), TileImageKind::kGraph, 0, 0, 96, 64, decoder, &out, threads);
+    EXPECT_NE(s.message().find("(70, 9)"), std::string::npos) << threads << ": " << s.message();
+    Image8 depth(96, 128, 3, 0);
+    depth.at(30, 60, 0) = 0xff;     // Front (30, 60): code 65280 > 4095.
+    depth.at(3, 64 + 5, 0) = 0xff;  // Back (3, 5): rows come first, so it is named.
+    const Status d =
+        DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 96, 64, decoder, &out, threads);
+    EXPECT_NE(d.message().find("(3, 5)"), std::string::npos) << threads << ": " << d.message();
+  }
+}
+
 }  // namespace
 }  // namespace casual3d

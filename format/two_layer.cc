@@ -1,10 +1,13 @@
 #include "format/two_layer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
+
+#include "format/parallel.h"
 
 namespace casual3d {
 namespace {
@@ -207,7 +210,7 @@ bool TwoLayerPanorama::Neighbour(int x, int y, Direction d, int* nx, int* ny) co
 }
 
 template <bool kCheckNodes>
-bool TwoLayerPanorama::ScanIsValid() const {
+bool TwoLayerPanorama::ScanIsValid(int num_threads) const {
   const LayerData& front = layers_[kFront];
   const LayerData& back = layers_[kBack];
   const uint8_t* front_links = front.links.data();
@@ -219,35 +222,47 @@ bool TwoLayerPanorama::ScanIsValid() const {
     if (((front_links[x] | back_links[x]) >> kUpBits) & 3) return false;
     if (((front_links[bottom] | back_links[bottom]) >> kDownBits) & 3) return false;
   }
-  for (int y = 0; y < height_; ++y) {
-    const size_t row = static_cast<size_t>(y) * w;
-    const bool has_below = y + 1 < height_;
-    bool bad = false;
-    for (size_t x = 0; x < w; ++x) {
-      const size_t i = row + x;
-      if (kCheckNodes) {
-        bad |= NodeInvalid(front, i);
-        bad |= NodeInvalid(back, i);
+  // Bands of rows on up to num_threads threads.
+  const int threads = ResolveThreads(num_threads);
+  const int bands = std::min(height_, threads > 1 ? 4 * threads : 1);
+  std::atomic<bool> valid(true);
+  ParallelFor(0, bands, threads, [&](int64_t band) {
+    int64_t y_begin, y_end;
+    ChunkRange(height_, bands, band, &y_begin, &y_end);
+    for (int y = static_cast<int>(y_begin); y < y_end; ++y) {
+      if (!valid.load(std::memory_order_relaxed)) return;
+      const size_t row = static_cast<size_t>(y) * w;
+      const bool has_below = y + 1 < height_;
+      bool bad = false;
+      for (size_t x = 0; x < w; ++x) {
+        const size_t i = row + x;
+        if (kCheckNodes) {
+          bad |= NodeInvalid(front, i);
+          bad |= NodeInvalid(back, i);
+        }
+        // The edge to the right neighbour (wrapping at the seam) and the one below.
+        const size_t r = x + 1 == w ? row : i + 1;
+        bad |= kLinkPairs.invalid[PairCode(front_links[i], back_links[i], kRightBits,
+                                           front_links[r], back_links[r], kLeftBits)];
+        if (has_below) {
+          const size_t b = i + w;
+          bad |= kLinkPairs.invalid[PairCode(front_links[i], back_links[i], kDownBits,
+                                             front_links[b], back_links[b], kUpBits)];
+        }
       }
-      // The edge to the right neighbour (wrapping at the seam) and the one below.
-      const size_t r = x + 1 == w ? row : i + 1;
-      bad |= kLinkPairs.invalid[PairCode(front_links[i], back_links[i], kRightBits, front_links[r],
-                                         back_links[r], kLeftBits)];
-      if (has_below) {
-        const size_t b = i + w;
-        bad |= kLinkPairs.invalid[PairCode(front_links[i], back_links[i], kDownBits, front_links[b],
-                                           back_links[b], kUpBits)];
+      if (bad) {
+        valid.store(false, std::memory_order_relaxed);
+        return;
       }
     }
-    if (bad) return false;
-  }
-  return true;
+  });
+  return valid.load();
 }
 
-Status TwoLayerPanorama::Validate() const { return Check(true); }
-Status TwoLayerPanorama::ValidateLinks() const { return Check(false); }
+Status TwoLayerPanorama::Validate(int num_threads) const { return Check(true, num_threads); }
+Status TwoLayerPanorama::ValidateLinks(int num_threads) const { return Check(false, num_threads); }
 
-Status TwoLayerPanorama::Check(bool nodes) const {
+Status TwoLayerPanorama::Check(bool nodes, int num_threads) const {
   if (width_ < 1 || height_ < 1) {
     return InvalidData("panorama size " + std::to_string(width_) + "x" + std::to_string(height_) +
                        " is empty");
@@ -271,7 +286,7 @@ Status TwoLayerPanorama::Check(bool nodes) const {
   // Valid panoramas (the common case: every level the viewer shows) pass one
   // fast scan; only a rejected one is scanned again, node by node, to name its
   // first problem in the order documented below.
-  if (nodes ? ScanIsValid<true>() : ScanIsValid<false>()) return Status::Ok();
+  if (nodes ? ScanIsValid<true>(num_threads) : ScanIsValid<false>(num_threads)) return Status::Ok();
   return FirstNodeOrLinkProblem();
 }
 

@@ -108,13 +108,15 @@ class TwoLayerPanorama {
 
   // Checks sizes, value ranges, and that every link is mutual and points at an
   // existing node. Returns the first problem found, naming layer and pixel.
-  Status Validate() const;
+  // Rows are scanned on up to `num_threads` threads (format/parallel.h; 0: all
+  // hardware threads); the result does not depend on it.
+  Status Validate(int num_threads = 1) const;
   // Validate() for a panorama whose node values are valid by construction,
   // such as the output of FinishDecodedPanorama (format/tile_codec.h): checks
   // sizes, the frame and every link, but not each node's values. A panorama
   // that fails is scanned node by node, naming its first problem exactly as
   // Validate() would.
-  Status ValidateLinks() const;
+  Status ValidateLinks(int num_threads = 1) const;
 
   bool operator==(const TwoLayerPanorama& o) const;
 
@@ -123,10 +125,10 @@ class TwoLayerPanorama {
   // size and frame checks, then a single branch-light scan that only says
   // whether every node (if `nodes`) and link is valid, and the node-by-node
   // scan that names the first problem (run only when the first one fails).
-  Status Check(bool nodes) const;
+  Status Check(bool nodes, int num_threads) const;
   // The single scan; kCheckNodes false checks the links only.
   template <bool kCheckNodes>
-  bool ScanIsValid() const;
+  bool ScanIsValid(int num_threads) const;
   Status FirstNodeOrLinkProblem() const;
   friend struct TwoLayerPanoramaTestAccess;  // two_layer_test.cc compares the two scans.
 

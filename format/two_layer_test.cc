@@ -16,7 +16,9 @@ namespace casual3d {
 
 // Runs Validate's two scans separately.
 struct TwoLayerPanoramaTestAccess {
-  static bool FastScanAccepts(const TwoLayerPanorama& p) { return p.ScanIsValid<true>(); }
+  static bool FastScanAccepts(const TwoLayerPanorama& p, int threads = 1) {
+    return p.ScanIsValid<true>(threads);
+  }
   static Status NodeByNodeScan(const TwoLayerPanorama& p) { return p.FirstNodeOrLinkProblem(); }
 };
 
@@ -398,6 +400,9 @@ TEST(TwoLayerTest, FastScanAgreesWithNodeByNodeScan) {
     const bool fast = TwoLayerPanoramaTestAccess::FastScanAccepts(p);
     const Status slow = TwoLayerPanoramaTestAccess::NodeByNodeScan(p);
     ASSERT_EQ(fast, slow.ok()) << "trial " << trial << ": " << slow.ToString();
+    // The scan in bands on several threads agrees, and so does the message.
+    ASSERT_EQ(TwoLayerPanoramaTestAccess::FastScanAccepts(p, 3), fast) << "trial " << trial;
+    ASSERT_EQ(p.Validate(3).ToString(), p.Validate().ToString()) << "trial " << trial;
     (fast ? accepted : rejected) += 1;
   }
   // Both outcomes are exercised.

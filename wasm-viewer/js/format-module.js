@@ -1,15 +1,19 @@
 // JavaScript face of the format library compiled to WebAssembly
 // (casual3d-format.wasm, src/binding.cc). Works in browsers, workers and Node.
+// Two builds of it exist: casual3d-format-mt.{js,wasm} shares the per-pixel
+// loops among threads (WebAssembly threads on shared memory, which browsers
+// allow only on cross-origin isolated pages, served with the headers
+// Cross-Origin-Opener-Policy: same-origin and Cross-Origin-Embedder-Policy:
+// require-corp), casual3d-format.{js,wasm} runs on one thread anywhere. Both
+// give the same results.
 //
 //   const format = await FormatModule.create();            // browser / worker
-//   const format = await FormatModule.create({ wasmBinary }); // Node: the bytes
+//   const format = await FormatModule.create({ threads, wasmBinary }); // Node: the bytes of that build
 //   const pano = format.parsePanoramaBlob(bytes);
 //   const mesh = format.buildMesh(pano, { maxTriangles: 0 });  // copies out
 //   pano.free();
 //
 // Every failure throws an Error with the library's message.
-
-import createCasual3dFormat from './casual3d-format.js';
 
 /**
  * A module whose one function uses a SIMD instruction (i8x16.popcnt): it
@@ -21,11 +25,27 @@ const SIMD_PROBE = new Uint8Array([
   253, 98, 11,
 ]);
 
+/**
+ * The heap's current bytes. The threaded build's memory is shared and may grow
+ * on another thread, which leaves the module's HEAPU8 view stale; its
+ * wasmMemory always has the current buffer.
+ */
+function heapU8(module) {
+  return module.wasmMemory ? new Uint8Array(module.wasmMemory.buffer) : module.HEAPU8;
+}
+
 /** Copies `count` elements of a typed-array type out of the wasm heap. */
 function copyOut(module, Type, ptr, count) {
   if (count === 0) return new Type(0);
-  const view = new Type(module.HEAPU8.buffer, ptr, count);
+  const view = new Type(heapU8(module).buffer, ptr, count);
   return view.slice();
+}
+
+/** Whether this context may use the threaded build (shared memory is available). */
+export function threadsAvailable() {
+  if (typeof SharedArrayBuffer !== 'function') return false;
+  // Browsers define crossOriginIsolated; Node does not and always shares memory.
+  return typeof crossOriginIsolated === 'undefined' || crossOriginIsolated === true;
 }
 
 export class FormatModule {
@@ -37,13 +57,32 @@ export class FormatModule {
     this._scratchSize = 0;
   }
 
-  /** Instantiates the wasm module; `options` go to the Emscripten factory. */
-  static async create(options = {}) {
+  /**
+   * Instantiates the wasm module. `threads`: true for the threaded build,
+   * false for the single-threaded one, 'auto' (the default) for the threaded
+   * one where threadsAvailable(). Other options go to the Emscripten factory.
+   */
+  static async create({ threads = 'auto', ...options } = {}) {
     if (!WebAssembly.validate(SIMD_PROBE)) {
       throw new Error('this browser lacks WebAssembly SIMD, which the viewer needs ' +
                       '(Chrome or Edge 91, Firefox 89, Safari 16.4 or later)');
     }
-    return new FormatModule(await createCasual3dFormat(options));
+    const useThreads = threads === 'auto' ? threadsAvailable() : threads === true;
+    const { default: factory } = useThreads ? await import('./casual3d-format-mt.js')
+      : await import('./casual3d-format.js');
+    const module = await factory(options);
+    // Under Node the threaded build's workers would keep the process alive
+    // after its last task; browsers' Workers have no unref.
+    const pthreads = module.PThread;
+    if (pthreads) {
+      for (const w of [...(pthreads.unusedWorkers ?? []), ...(pthreads.runningWorkers ?? [])]) w.unref?.();
+    }
+    return new FormatModule(module);
+  }
+
+  /** Threads the library's loops use: 1 for the single-threaded build. */
+  get numThreads() {
+    return this.m._c3d_num_threads();
   }
 
   /** The library's last error; `what` prefixes messages that do not name their input. */
@@ -56,7 +95,7 @@ export class FormatModule {
   _copyIn(bytes) {
     const ptr = this.m._malloc(Math.max(1, bytes.length));
     if (!ptr) throw new Error(`out of memory for ${bytes.length} bytes`);
-    this.m.HEAPU8.set(bytes, ptr);
+    heapU8(this.m).set(bytes, ptr);
     return ptr;
   }
 
@@ -75,7 +114,7 @@ export class FormatModule {
       this._scratchPtr = ptr;
       this._scratchSize = size;
     }
-    this.m.HEAPU8.set(bytes, this._scratchPtr);
+    heapU8(this.m).set(bytes, this._scratchPtr);
     return this._scratchPtr;
   }
 

@@ -25,6 +25,7 @@
 #include "format/mesh_builder.h"
 #include "format/mesh_simplify.h"
 #include "format/package_reader.h"
+#include "format/parallel.h"
 #include "format/sha256.h"
 #include "format/tile_codec.h"
 #include "format/two_layer.h"
@@ -89,6 +90,10 @@ extern "C" {
 
 // The message of the last failure ("" if none).
 EMSCRIPTEN_KEEPALIVE const char* c3d_last_error() { return casual3d::viewer::g_last_error.c_str(); }
+
+// Threads the library's loops use (format/parallel.h): 1 in the build without
+// threads, min(hardware threads, CASUAL3D_MAX_THREADS) in the threaded one.
+EMSCRIPTEN_KEEPALIVE int c3d_num_threads() { return casual3d::ResolveThreads(0); }
 
 // --- Panoramas -----------------------------------------------------------------
 
@@ -274,7 +279,7 @@ EMSCRIPTEN_KEEPALIVE int c3d_reader_add_image(Reader* r, int level, int tile, in
   casual3d::ImageView<const uint8_t> view(pixels, width, height, channels,
                                           static_cast<std::ptrdiff_t>(width) * channels);
   const casual3d::Status s =
-      r->reader->AddTileImage(tile, static_cast<casual3d::TileImageKind>(kind), view);
+      r->reader->AddTileImage(tile, static_cast<casual3d::TileImageKind>(kind), view, 0);
   if (!s.ok()) {
     SetError(s);
     return 0;
@@ -290,7 +295,7 @@ EMSCRIPTEN_KEEPALIVE Panorama* c3d_reader_assemble(Reader* r, int level) {
     return nullptr;
   }
   r->level = -1;
-  auto pano = r->reader->FinishLevel();
+  auto pano = r->reader->FinishLevel(0);
   if (!pano.ok()) {
     SetError("level " + std::to_string(level) + ": " + pano.status().ToString());
     return nullptr;

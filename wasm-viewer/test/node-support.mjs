@@ -13,14 +13,19 @@ export const BINARY_DIR = process.env.CASUAL3D_BINARY_DIR ?? path.join(SOURCE_DI
 export const DIST_DIR = path.join(BINARY_DIR, 'wasm-viewer', 'dist');
 export const TOOLS_DIR = path.join(BINARY_DIR, 'wasm-viewer');
 
-/** The wasm format library (js/format-module.js) instantiated under Node. */
-export async function loadFormatModule() {
+/**
+ * The wasm format library (js/format-module.js) instantiated under Node: the
+ * threaded build (casual3d-format-mt.wasm) if `threads`, else the
+ * single-threaded one.
+ */
+export async function loadFormatModule({ threads = false } = {}) {
   // The ES6 Emscripten loader expects CommonJS globals under Node.
   globalThis.require ??= createRequire(import.meta.url);
   globalThis.__dirname ??= DIST_DIR;
   const { FormatModule } = await import(pathToFileURL(path.join(DIST_DIR, 'format-module.js')).href);
-  const wasmBinary = fs.readFileSync(path.join(DIST_DIR, 'casual3d-format.wasm'));
-  return FormatModule.create({ wasmBinary });
+  const name = threads ? 'casual3d-format-mt.wasm' : 'casual3d-format.wasm';
+  const wasmBinary = fs.readFileSync(path.join(DIST_DIR, name));
+  return FormatModule.create({ threads, wasmBinary });
 }
 
 /** Runs a native helper built in <build>/wasm-viewer; returns stdout. */
