@@ -158,7 +158,10 @@ std::string OkHeader(const std::string& type, uintmax_t length) {
   return "HTTP/1.1 200 OK\r\nContent-Type: " + type +
          "\r\nContent-Length: " + std::to_string(length) +
          "\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\n"
-         "Access-Control-Allow-Origin: *\r\nConnection: close\r\n\r\n";
+         "Access-Control-Allow-Origin: *\r\n"
+         // Cross-origin isolation lets the viewer use its threaded wasm build.
+         "Cross-Origin-Opener-Policy: same-origin\r\nCross-Origin-Embedder-Policy: require-corp\r\n"
+         "Cross-Origin-Resource-Policy: cross-origin\r\nConnection: close\r\n\r\n";
 }
 
 class Server {

@@ -117,7 +117,7 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
     progress(chosen[0].level, true);
 
     for (const { level, info } of chosen) {
-      const timing = { level, fetchDecodeMs: 0, meshMs: 0 };
+      const timing = { level, fetchDecodeMs: 0, meshMs: 0, threads: format.numThreads };
       const t0 = performance.now();
       try {
         // Tiles in view first: order by the longitude distance of the tile's

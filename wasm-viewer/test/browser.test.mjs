@@ -107,7 +107,7 @@ before(async () => {
     '/bad.html': viewerPage('/bad/manifest.json', { width: W, height: H, maxLevelWidth: 1024 }),
     '/missing.html': viewerPage('/nothing-here/manifest.json', { width: W, height: H }),
     '/favicon.ico': '',
-  });
+  }, { isolated: true });  // As `casual3d view` serves: the viewer may use its threaded build.
   browser = await chromium.launch({ executablePath: CHROMIUM, args: chromiumArgs() });
   page = await browser.newPage({ viewport: { width: W, height: H }, deviceScaleFactor: 1 });
   page.on('pageerror', (e) => console.log(`page error: ${e.message}`));
@@ -150,6 +150,38 @@ test('loads a package and reports the first frame', async () => {
   assert.ok(first.detail.bytesBeforeFirstFrame > 0 && first.detail.bytesBeforeFirstFrame <= 300 * 1024,
     `package bytes before the first frame: ${first.detail.bytesBeforeFirstFrame}`);
   await page.screenshot({ path: path.join(OUT, 'loaded.png') });
+});
+
+test('the worker decodes with threads on a cross-origin isolated page, on one thread elsewhere', async () => {
+  const isolated = await page.evaluate(() => ({
+    isolated: window.crossOriginIsolated, cores: navigator.hardwareConcurrency,
+    threads: document.getElementById('v').viewer.stats.workerMs.map((t) => t.threads),
+  }));
+  assert.equal(isolated.isolated, true);
+  for (const t of isolated.threads) assert.equal(t, Math.max(1, Math.min(4, isolated.cores)));
+  metrics.workerThreads = isolated.threads[0];
+  // The same page from a server without the isolation headers.
+  const plain = await startServer({ '/viewer/': DIST_DIR, '/pkg/': path.join(tmp, 'room') }, {
+    '/index.html': viewerPage('/pkg/manifest.json', { width: W, height: H, maxLevelWidth: 256 }),
+    '/favicon.ico': '',
+  });
+  const other = await browser.newPage({ viewport: { width: W, height: H }, deviceScaleFactor: 1 });
+  try {
+    await other.goto(`${plain.url}/index.html`);
+    await other.waitForFunction(() => (window.__events ?? []).some((e) => e.type === 'load' || e.type === 'error'),
+      null, { timeout: 120000 });
+    const result = await other.evaluate(() => ({
+      isolated: window.crossOriginIsolated,
+      errors: window.__events.filter((e) => e.type === 'error'),
+      threads: document.getElementById('v').viewer.stats.workerMs.map((t) => t.threads),
+    }));
+    assert.equal(result.isolated, false);
+    assert.deepEqual(result.errors, []);
+    assert.ok(result.threads.length > 0 && result.threads.every((t) => t === 1), JSON.stringify(result.threads));
+  } finally {
+    await other.close();
+    await plain.close();
+  }
 });
 
 test('renders like the native renderer from three cameras (PSNR >= 30 dB)', async () => {

@@ -1,7 +1,8 @@
 // The wasm mesh builder and simplifier give the same meshes as the native ones:
 // byte-identical vertices (positions, normals, uvs, colours) and indices. Native meshes come
 // from viewer_mesh_dump (tools/mesh_dump.cc), which also writes the panorama
-// blob the wasm side builds from, so both start from identical bytes.
+// blob the wasm side builds from, so both start from identical bytes. Both wasm
+// builds are checked: the single-threaded one and the threaded one.
 //
 //   node --test wasm-viewer/test/mesh_equivalence.test.mjs   (env CASUAL3D_BINARY_DIR)
 
@@ -23,6 +24,7 @@ const CASES = [
 ];
 
 const format = await loadFormatModule();
+const formatThreaded = await loadFormatModule({ threads: true });
 const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-mesh-eq-'));
 process.on('exit', () => fs.rmSync(dir, { recursive: true, force: true }));
 
@@ -32,18 +34,21 @@ for (const [kind, w, h] of CASES) {
     const base = path.join(dir, `${kind}_${w}x${h}`);
     const native = parseMeshBlob(fs.readFileSync(`${base}.mesh`));
     const nativeSimplified = parseMeshBlob(fs.readFileSync(`${base}.smesh`));
-    const pano = format.parsePanoramaBlob(fs.readFileSync(`${base}.pano`));
-    let wasm, wasmSimplified;
-    try {
-      pano.validate();
-      wasm = format.buildMesh(pano);
-      wasmSimplified = format.buildMesh(pano, { maxTriangles: info.budget });
-    } finally {
-      pano.free();
-    }
+    const meshes = (f) => {
+      const pano = f.parsePanoramaBlob(fs.readFileSync(`${base}.pano`));
+      try {
+        pano.validate();
+        return [f.buildMesh(pano), f.buildMesh(pano, { maxTriangles: info.budget })];
+      } finally {
+        pano.free();
+      }
+    };
+    const [wasm, wasmSimplified] = meshes(format);
+    const [threaded, threadedSimplified] = meshes(formatThreaded);
     assert.ok(native.indices.length > 0, 'the native mesh has triangles');
     assert.ok(nativeSimplified.indices.length < native.indices.length, 'simplification removed triangles');
-    for (const [name, a, b] of [['full', wasm, native], ['simplified', wasmSimplified, nativeSimplified]]) {
+    for (const [name, a, b] of [['full', wasm, native], ['simplified', wasmSimplified, nativeSimplified],
+      ['full, threaded', threaded, native], ['simplified, threaded', threadedSimplified, nativeSimplified]]) {
       for (const field of ['positions', 'normals', 'uvs', 'colors', 'indices']) {
         const r = compareArrays(a[field], b[field]);
         assert.ok(r.sameLength, `${name} ${field}: ${a[field].length} (wasm) vs ${b[field].length} (native) elements`);

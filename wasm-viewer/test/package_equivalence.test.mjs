@@ -3,7 +3,9 @@
 // mesh builder on a synthetic package: positions, normals, uvs and indices
 // byte-identical (depth, normals and links are lossless), colours within 2
 // levels (the colour images are lossy WebP and the two decoders are different
-// builds of libwebp; measured difference printed).
+// builds of libwebp; measured difference printed). Both wasm builds: the
+// single-threaded one and the threaded one (casual3d-format-mt), which must
+// give the same mesh.
 
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
@@ -16,18 +18,27 @@ import { loadFormatModule, runTool } from './node-support.mjs';
 import { readPackageLevel } from './node-package.mjs';
 
 const format = await loadFormatModule();
+const formatThreaded = await loadFormatModule({ threads: true });
 const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-pkg-eq-'));
 process.on('exit', () => fs.rmSync(dir, { recursive: true, force: true }));
 const pkg = path.join(dir, 'pkg');
 runTool('viewer_test_tool', ['package', 'test', '1024', '512', pkg, '256', '2']);
 
-for (const level of [1, 0]) {
-  test(`package level ${level}: wasm reader + mesh == native reader + mesh`, async () => {
-    const { triangles, colours } = await assertLevelMatchesNative(format, pkg, level, path.join(dir, `native_${level}`));
-    assert.ok(triangles > 1000, `only ${triangles} triangles`);
-    console.log(`level ${level}: ${triangles} triangles; colours differing: ${colours.differing}, largest difference ${colours.maxAbs}`);
-  });
+for (const [name, f] of [['single-threaded', format], ['threaded', formatThreaded]]) {
+  for (const level of [1, 0]) {
+    test(`package level ${level}: wasm reader + mesh (${name}) == native reader + mesh`, async () => {
+      const { triangles, colours } = await assertLevelMatchesNative(f, pkg, level, path.join(dir, `native_${name}_${level}`));
+      assert.ok(triangles > 1000, `only ${triangles} triangles`);
+      console.log(`level ${level}, ${name} (${f.numThreads} threads): ${triangles} triangles; colours differing: ${colours.differing}, largest difference ${colours.maxAbs}`);
+    });
+  }
 }
+
+test('the threaded build uses more than one thread where the machine has them', () => {
+  assert.equal(format.numThreads, 1);
+  const cores = os.availableParallelism?.() ?? os.cpus().length;
+  assert.equal(formatThreaded.numThreads, Math.max(1, Math.min(4, cores)));
+});
 
 test('the reader gives the depth range of the manifest', () => {
   const bytes = fs.readFileSync(path.join(pkg, 'manifest.json'));
@@ -49,5 +60,6 @@ test('a damaged tile is refused with a message naming it', async () => {
   const bytes = fs.readFileSync(path.join(bad, file));
   fs.writeFileSync(path.join(bad, file), bytes.subarray(0, bytes.length - 10));
   await assert.rejects(readPackageLevel(format, bad, 1), new RegExp(file.replace(/\./g, '\\.')));
+  await assert.rejects(readPackageLevel(formatThreaded, bad, 1), new RegExp(file.replace(/\./g, '\\.')));
   assert.throws(() => format.openPackage(new TextEncoder().encode('{"format": "casual3d", "version": "9.0"}')), /manifest\.json/);
 });

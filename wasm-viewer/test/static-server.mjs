@@ -14,14 +14,21 @@ const MIME = {
 /**
  * @param {Record<string, string>} routes e.g. {'/viewer/': distDir, '/pkg/': packageDir}
  * @param {Record<string, string>} pages exact paths served from memory (e.g. '/index.html')
+ * @param {{isolated?: boolean}} options isolated: send the cross-origin isolation headers
+ *   (COOP same-origin, COEP require-corp) that let the viewer use its threaded wasm build
  * @returns {Promise<{url: string, close: () => Promise<void>, log: {path: string, bytes: number, t: number}[]}>}
  */
-export async function startServer(routes, pages = {}) {
+export async function startServer(routes, pages = {}, { isolated = false } = {}) {
   const log = [];
   const server = http.createServer((req, res) => {
     const urlPath = decodeURIComponent(new URL(req.url, 'http://x').pathname);
     const send = (code, type, body) => {
-      res.writeHead(code, { 'Content-Type': type, 'Content-Length': body.length, 'Cache-Control': 'no-store' });
+      const headers = { 'Content-Type': type, 'Content-Length': body.length, 'Cache-Control': 'no-store' };
+      if (isolated) {
+        headers['Cross-Origin-Opener-Policy'] = 'same-origin';
+        headers['Cross-Origin-Embedder-Policy'] = 'require-corp';
+      }
+      res.writeHead(code, headers);
       res.end(body);
       log.push({ path: urlPath, bytes: body.length, t: performance.now() });
     };

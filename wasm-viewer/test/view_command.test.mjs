@@ -22,7 +22,7 @@ function request(rawPath, method = 'GET') {
     const req = http.request({ hostname, port, path: rawPath, method }, (res) => {
       const chunks = [];
       res.on('data', (c) => chunks.push(c));
-      res.on('end', () => resolve({ status: res.statusCode, type: res.headers['content-type'], body: Buffer.concat(chunks) }));
+      res.on('end', () => resolve({ status: res.statusCode, type: res.headers['content-type'], headers: res.headers, body: Buffer.concat(chunks) }));
     });
     req.on('error', reject);
     req.end();
@@ -67,6 +67,11 @@ test('serves the page, the viewer and the package with the right types', async (
   assert.equal(wasm.status, 200);
   assert.equal(wasm.type, 'application/wasm');
   assert.deepEqual([...wasm.body.subarray(0, 4)], [0, 0x61, 0x73, 0x6d]);
+  // Cross-origin isolated, so that the viewer may use its threaded build.
+  assert.equal(page.headers['cross-origin-opener-policy'], 'same-origin');
+  assert.equal(page.headers['cross-origin-embedder-policy'], 'require-corp');
+  const worker = await request('/viewer/casual3d-format-mt.worker.js');
+  assert.equal(worker.status, 200);
   const manifest = await request('/manifest.json?x=1');
   assert.equal(manifest.type, 'application/json');
   assert.equal(manifest.body.toString(), '{"format": "casual3d"}\n');
