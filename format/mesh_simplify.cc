@@ -650,8 +650,43 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
     kept[node(leaf.x0 + s, leaf.y0 + s, leaf.layer)] = 1;
   }
   auto is_kept = [&](size_t node) { return kept[node] != 0; };
-  // Step 3, patches, in runs of leaves.
   const int64_t leaf_runs = std::min<int64_t>(num_leaves, 8 * static_cast<int64_t>(threads));
+  if (count_limit >= 0) {
+    // Only the count may be needed: a patch has 2 triangles if its ring has
+    // only the corners, r - 2 if a corner has no extra vertex on either side,
+    // else r (step 3 below), which the kept nodes on each side give.
+    int64_t quad_triangles = 0;
+    for (const MeshAssembler& part : quad_parts) quad_triangles += part.num_triangles();
+    std::vector<int64_t> run_triangles(static_cast<size_t>(leaf_runs), 0);
+    ParallelFor(0, leaf_runs, threads, [&](int64_t run) {
+      int64_t first, last;
+      ChunkRange(num_leaves, leaf_runs, run, &first, &last);
+      int64_t count = 0;
+      for (int64_t li = first; li < last; ++li) {
+        const Leaf& leaf = leaves[li];
+        const int s = 1 << leaf.level, x0 = leaf.x0, y0 = leaf.y0, l = leaf.layer;
+        int extra[4] = {0, 0, 0, 0};  // Sides A-C, C-D, D-B, B-A.
+        for (int i = 1; i < s; ++i) {
+          extra[0] += is_kept(node(x0, y0 + i, l));
+          extra[1] += is_kept(node(x0 + i, y0 + s, l));
+          extra[2] += is_kept(node(x0 + s, y0 + i, l));
+          extra[3] += is_kept(node(x0 + i, y0, l));
+        }
+        const int r = 4 + extra[0] + extra[1] + extra[2] + extra[3];
+        bool apex = false;
+        for (int c = 0; c < 4; ++c) apex |= extra[c] == 0 && extra[(c + 3) & 3] == 0;
+        count += r == 4 ? 2 : (apex ? r - 2 : r);
+      }
+      run_triangles[run] = count;
+    });
+    int64_t total = quad_triangles;
+    for (int64_t c : run_triangles) total += c;
+    if (total > count_limit) {
+      *triangles = total;
+      return Mesh();
+    }
+  }
+  // Step 3, patches, in runs of leaves.
   std::vector<MeshAssembler> patch_parts(static_cast<size_t>(leaf_runs), MeshAssembler(p));
   ParallelFor(0, leaf_runs, threads, [&](int64_t run) {
     int64_t first, last;

@@ -406,7 +406,10 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
   const bool rgba = image.channels() == 4;
   // Bands of rows write disjoint nodes; a band's first invalid pixel is the
   // tile's first when no earlier band has one.
-  const int threads = ResolveThreads(num_threads);
+  // Colour and graph images are plain byte shuffles, faster than handing a
+  // tile to other threads; depth and normals go through look-up tables.
+  const bool worth_sharing = kind == TileImageKind::kDepth || kind == TileImageKind::kNormal;
+  const int threads = worth_sharing ? ResolveThreads(num_threads) : 1;
   const int bands = std::min(h, threads > 1 ? 4 * threads : 1);
   std::vector<uint8_t> band_ok(static_cast<size_t>(bands), 1);
   std::vector<int> band_bad(2 * static_cast<size_t>(bands), 0);

@@ -6,7 +6,12 @@
 // meaningful when other jobs share the cores; every step runs on one thread),
 // next to those of the first run, then the same numbers as one JSON line.
 //
-//   CASUAL3D_BINARY_DIR=build node wasm-viewer/bench/node_decode_bench.mjs [package_dir] [repeats] [level]
+//   CASUAL3D_BINARY_DIR=build node wasm-viewer/bench/node_decode_bench.mjs [package_dir] [repeats] [level] [build]
+//
+// build: `single` (default), the single-threaded wasm build every page can
+// use, or `threaded`, casual3d-format-mt, which shares the format library's
+// loops among min(cores, 4) threads (cross-origin isolated pages). CPU ms then
+// add up all threads' time, so wall ms is the figure to compare.
 //
 // Without package_dir it writes the procedural test panorama's package
 // (viewer_test_tool package test 4096 2048) to a temporary folder.
@@ -20,6 +25,8 @@ import { readPackageLevel } from '../test/node-package.mjs';
 
 const repeats = Number(process.argv[3] ?? 3);
 const level = Number(process.argv[4] ?? 0);
+const build = process.argv[5] ?? 'single';
+if (build !== 'single' && build !== 'threaded') throw new Error(`build ${build}: expected single or threaded`);
 const MAX_TRIANGLES = 2000000;  // The viewer's default budget (js/viewer-core.js).
 let pkg = process.argv[2];
 let tmp = null;
@@ -41,7 +48,7 @@ function measure(fn) {
 }
 
 try {
-  const format = await loadFormatModule();
+  const format = await loadFormatModule({ threads: build === 'threaded' });
   const manifest = JSON.parse(fs.readFileSync(path.join(pkg, 'manifest.json'), 'utf8'));
   const best = {};  // step -> {wall, cpu}, each the minimum over repeats.
   // step -> {wall, cpu} of the first run: a fresh page's first level, while
@@ -88,7 +95,8 @@ try {
     ['wasm format library only, full mesh: check + unpack + assemble + full mesh', ['checkMs', 'addMs', 'finishMs', 'meshFullMs']],
   ];
   const sum = (table, keys, f) => keys.reduce((s, k) => s + table[k][f], 0);
-  console.log(`level ${level} of ${pkg}: ${L.width}x${L.height}, ${levelBytes[level]} bytes; best of ${repeats}, and the first run`);
+  console.log(`level ${level} of ${pkg}: ${L.width}x${L.height}, ${levelBytes[level]} bytes; ${build} wasm build ` +
+              `(${format.numThreads} threads); best of ${repeats}, and the first run`);
   console.log('| step | wall ms | CPU ms | first run: wall ms | CPU ms |\n|---|---|---|---|---|');
   for (const [name, keys] of rows) {
     const cells = [best, first].flatMap((t) => [sum(t, keys, 'wall'), sum(t, keys, 'cpu')].map(Math.round));
@@ -97,6 +105,8 @@ try {
   console.log(JSON.stringify({
     package: { width: manifest.width, height: manifest.height, levels: manifest.levels.length, levelBytes },
     level,
+    build,
+    threads: format.numThreads,
     ms: Object.fromEntries(Object.entries(best).map(([k, v]) => [k, { wall: Math.round(v.wall), cpu: Math.round(v.cpu) }])),
     firstRunMs: Object.fromEntries(Object.entries(first).map(([k, v]) => [k, { wall: Math.round(v.wall), cpu: Math.round(v.cpu) }])),
     triangles: { full, simplified, relativeErrorBound: bound },
