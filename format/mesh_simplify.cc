@@ -590,8 +590,14 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
     const Leaf& leaf = leaves[i];
     const int s = 1 << leaf.level;
     uint8_t* row = &covered[leaf.layer][static_cast<size_t>(leaf.y0) * w + leaf.x0];
+    if (s == 2) {  // Most leaves: two 2-byte stores instead of two memset calls.
+      const uint16_t ones = 0x0101;
+      std::memcpy(row, &ones, 2);
+      std::memcpy(row + w, &ones, 2);
+      return;
+    }
     for (int y = 0; y < s; ++y, row += w) std::memset(row, 1, static_cast<size_t>(s));
-  }, 256);
+  }, 1024);
 
   // Step 1, remaining pixel-quad triangles, in bands of rows.
   const int64_t row_bands = std::min<int64_t>(qh, 8 * static_cast<int64_t>(threads));
@@ -810,7 +816,8 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
       for (int ty = 0; ty < pyramids[l].num_tile_rows(); ++ty) rows.emplace_back(static_cast<int>(l), ty);
     }
     ParallelFor(0, static_cast<int64_t>(rows.size()), threads, [&](int64_t i) {
-      TileCache cache;  // 400 KB for 128-quad tiles, once per row of about 30 tiles.
+      // 1.2 MB for 128-quad tiles: each thread keeps its own between calls.
+      static thread_local TileCache cache;
       pyramids[rows[i].first].EvaluateTileRow(rows[i].second, &cache);
     });
     for (LayerPyramid& py : pyramids) py.ReleaseScratch();
