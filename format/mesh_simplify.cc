@@ -544,15 +544,17 @@ std::vector<Leaf> SelectLeaves(const std::vector<LayerPyramid>& pyramids, double
   std::vector<Leaf> leaves;
   if (tau < 0) return leaves;
   const int64_t chunks = 4 * static_cast<int64_t>(threads);
-  std::vector<std::vector<Leaf>> parts(static_cast<size_t>(chunks));
+  // parts[(layer, level) group * chunks + chunk], joined in order at the end.
+  std::vector<std::vector<Leaf>> parts;
   for (size_t l = 0; l < pyramids.size(); ++l) {
     const LayerPyramid& py = pyramids[l];
     for (int k = py.levels(); k >= 1; --k) {
+      const size_t group = parts.size();
+      parts.resize(group + static_cast<size_t>(chunks));
       ParallelFor(0, chunks, threads, [&](int64_t c) {
         int64_t row_begin, row_end;
         ChunkRange(py.ny(k), chunks, c, &row_begin, &row_end);
-        std::vector<Leaf>& out = parts[c];
-        out.clear();
+        std::vector<Leaf>& out = parts[group + static_cast<size_t>(c)];
         for (int by = static_cast<int>(row_begin); by < row_end; ++by) {
           const double* error = py.ErrorRow(k, by);
           const bool parent_row = k < py.levels() && by / 2 < py.ny(k + 1);
@@ -566,9 +568,12 @@ std::vector<Leaf> SelectLeaves(const std::vector<LayerPyramid>& pyramids, double
           }
         }
       });
-      for (const std::vector<Leaf>& part : parts) leaves.insert(leaves.end(), part.begin(), part.end());
     }
   }
+  size_t total = 0;
+  for (const std::vector<Leaf>& part : parts) total += part.size();
+  leaves.reserve(total);
+  for (const std::vector<Leaf>& part : parts) leaves.insert(leaves.end(), part.begin(), part.end());
   return leaves;
 }
 
