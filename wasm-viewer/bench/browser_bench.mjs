@@ -2,7 +2,7 @@
 // Chromium (SwiftShader) on localhost, for a 4096x2048 package. Prints one
 // JSON line.
 //
-//   CASUAL3D_BINARY_DIR=build node wasm-viewer/bench/browser_bench.mjs [package_dir]
+//   CASUAL3D_BINARY_DIR=build node wasm-viewer/bench/browser_bench.mjs [package_dir] [isolated|plain]
 // Without package_dir it writes the procedural test panorama's package
 // (viewer_test_tool package test 4096 2048) to a temporary folder.
 
@@ -21,10 +21,14 @@ if (!pkg) {
   pkg = path.join(tmp, 'pkg');
   runTool('viewer_test_tool', ['package', 'test', '4096', '2048', pkg]);
 }
+// `isolated` (the default, as `casual3d view` serves): cross-origin isolation
+// headers, so the worker uses the threaded wasm build; `plain`: none, one thread.
+const mode = process.argv[3] ?? 'isolated';
+if (mode !== 'isolated' && mode !== 'plain') throw new Error(`mode ${mode}: expected isolated or plain`);
 const server = await startServer({ '/viewer/': DIST_DIR, '/pkg/': pkg }, {
   '/index.html': viewerPage('/pkg/manifest.json', { width: 960, height: 540 }),
   '/favicon.ico': '',
-});
+}, { isolated: mode === 'isolated' });
 const browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: chromiumArgs() });
 try {
   const page = await browser.newPage({ viewport: { width: 960, height: 540 } });
@@ -41,6 +45,7 @@ try {
     return { workerMs: s.workerMs, error: s.lastError ?? null };
   });
   console.log(JSON.stringify({
+    mode,
     timeToFirstFrameMs: Math.round(first.detail.timeToFirstFrameMs),
     pageLoadToFirstFrameMs: Math.round(first.t),
     packageBytesBeforeFirstFrame: first.detail.bytesBeforeFirstFrame,
