@@ -70,6 +70,12 @@ export interface ViewerStats {
   lastError?: string;
   /** Frames drawn in the current or last immersive VR session. */
   xrFrames?: number;
+  /**
+   * Per level shown, the worker's times (fetch and decode; assembly, mesh and
+   * atlas) and the threads of its wasm build: more than 1 on cross-origin
+   * isolated pages, 1 elsewhere.
+   */
+  workerMs?: { level: number; fetchDecodeMs: number; meshMs: number; threads: number }[];
 }
 
 export class Casual3dViewer extends EventTarget {
