@@ -60,7 +60,9 @@ export class FormatModule {
   /**
    * Instantiates the wasm module. `threads`: true for the threaded build,
    * false for the single-threaded one, 'auto' (the default) for the threaded
-   * one where threadsAvailable(). Other options go to the Emscripten factory.
+   * one where threadsAvailable(), falling back to the single-threaded one if
+   * the threaded one fails to start. Other options go to the Emscripten
+   * factory (a `wasmBinary` must be the bytes of the build that is chosen).
    */
   static async create({ threads = 'auto', ...options } = {}) {
     if (!WebAssembly.validate(SIMD_PROBE)) {
@@ -68,9 +70,21 @@ export class FormatModule {
                       '(Chrome or Edge 91, Firefox 89, Safari 16.4 or later)');
     }
     const useThreads = threads === 'auto' ? threadsAvailable() : threads === true;
-    const { default: factory } = useThreads ? await import('./casual3d-format-mt.js')
-      : await import('./casual3d-format.js');
-    const module = await factory(options);
+    let module;
+    if (useThreads) {
+      try {
+        const { default: factory } = await import('./casual3d-format-mt.js');
+        module = await factory({ ...options });
+      } catch (err) {
+        // Shared memory reserves its 4 GB maximum up front, which a device
+        // short of address space may refuse: fall back to one thread.
+        if (threads !== 'auto') throw err;
+      }
+    }
+    if (!module) {
+      const { default: factory } = await import('./casual3d-format.js');
+      module = await factory(options);
+    }
     // Under Node the threaded build's workers would keep the process alive
     // after its last task; browsers' Workers have no unref.
     const pthreads = module.PThread;

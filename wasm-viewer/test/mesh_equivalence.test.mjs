@@ -11,8 +11,9 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { test } from 'node:test';
+import { pathToFileURL } from 'node:url';
 
-import { compareArrays, loadFormatModule, parseMeshBlob, runTool } from './node-support.mjs';
+import { DIST_DIR, compareArrays, loadFormatModule, parseMeshBlob, runTool } from './node-support.mjs';
 
 const CASES = [
   ['room', 64, 32],          // Depth edges and a back layer behind the sphere.
@@ -57,6 +58,23 @@ for (const [kind, w, h] of CASES) {
     }
   });
 }
+
+test('with threads "auto", a device that refuses shared memory gets the single-threaded build', async () => {
+  const { FormatModule } = await import(pathToFileURL(path.join(DIST_DIR, 'format-module.js')).href);
+  const wasmBinary = fs.readFileSync(path.join(DIST_DIR, 'casual3d-format.wasm'));
+  const Memory = WebAssembly.Memory;
+  WebAssembly.Memory = function (descriptor) {
+    if (descriptor?.shared) throw new RangeError('could not allocate memory');
+    return new Memory(descriptor);
+  };
+  try {
+    const f = await FormatModule.create({ threads: 'auto', wasmBinary });
+    assert.equal(f.numThreads, 1);
+    await assert.rejects(FormatModule.create({ threads: true }), /could not allocate memory/);
+  } finally {
+    WebAssembly.Memory = Memory;
+  }
+});
 
 test('wasm panorama blob parser refuses damaged input', () => {
   assert.throws(() => format.parsePanoramaBlob(new Uint8Array([1, 2, 3])), /bad magic/);
