@@ -616,7 +616,8 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
     // A quad covered by leaves of every layer that has a node at its corners
     // has no triangle left (each triangle starts at a corner node of an
     // uncovered layer).
-    std::vector<uint8_t> back_in_column(w + 8, 0);  // See BackInColumns; zero without the back layer.
+    // See BackInColumns; zero without the back layer.
+    std::vector<uint8_t> back_in_column(w + 8, 0);
     const uint8_t* bic = back_in_column.data();
     for (int y = static_cast<int>(y_begin); y < y_end; ++y) {
       const uint8_t* front_covered = &covered[kFront][static_cast<size_t>(y) * w];
@@ -818,7 +819,9 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
     // Block errors, by rows of tiles of both layers.
     std::vector<std::pair<int, int>> rows;  // (layer, tile row)
     for (size_t l = 0; l < pyramids.size(); ++l) {
-      for (int ty = 0; ty < pyramids[l].num_tile_rows(); ++ty) rows.emplace_back(static_cast<int>(l), ty);
+      for (int ty = 0; ty < pyramids[l].num_tile_rows(); ++ty) {
+        rows.emplace_back(static_cast<int>(l), ty);
+      }
     }
     ParallelFor(0, static_cast<int64_t>(rows.size()), threads, [&](int64_t i) {
       // 1.2 MB for 128-quad tiles: each thread keeps its own between calls.
