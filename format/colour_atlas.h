@@ -18,9 +18,7 @@ namespace casual3d {
 // (x, y, layer); where that node is absent it holds the colour of the other
 // layer's node at (x, y) (the fill rule, normative in spec/mesh.md Sec. 3), and
 // black where neither layer has a node. Returns an empty image if `channels`
-// is neither 3 nor 4 or the panorama is empty. O(width * height), in rows
-// shared among `num_threads` threads (format/parallel.h; 0: all hardware
-// threads); the atlas does not depend on it.
-Image8 BuildColourAtlas(const TwoLayerPanorama& pano, int channels = 3, int num_threads = 1);
+// is neither 3 nor 4 or the panorama is empty. O(width * height).
+Image8 BuildColourAtlas(const TwoLayerPanorama& pano, int channels = 3);
 
 }  // namespace casual3d

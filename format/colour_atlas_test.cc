@@ -73,14 +73,6 @@ TEST(ColourAtlasTest, RgbaMatchesRgbWithOpaqueAlpha) {
   }
 }
 
-TEST(ColourAtlasTest, SameAtlasForEveryThreadCount) {
-  const TwoLayerPanorama p = testing::MakeRoomPanorama(96, 48);
-  const Image8 one = BuildColourAtlas(p, 4, 1);
-  for (int threads : {2, 3, 8}) {
-    EXPECT_TRUE(BuildColourAtlas(p, 4, threads).vector() == one.vector()) << threads;
-  }
-}
-
 TEST(ColourAtlasTest, RefusesUnsupportedChannelCounts) {
   const TwoLayerPanorama p = SmallPanorama();
   EXPECT_TRUE(BuildColourAtlas(p, 1).empty());

@@ -126,7 +126,7 @@ EMSCRIPTEN_KEEPALIVE int c3d_panorama_validate(Panorama* p) {
 // from the other layer where its node is absent (the mesh's uvs rely on it).
 // Owned by the panorama.
 EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_panorama_atlas_rgba(Panorama* p) {
-  casual3d::Image8 atlas = casual3d::BuildColourAtlas(p->pano, 4, 0);
+  casual3d::Image8 atlas = casual3d::BuildColourAtlas(p->pano, 4);
   p->atlas = std::move(atlas.vector());
   return p->atlas.data();
 }
