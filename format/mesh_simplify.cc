@@ -81,7 +81,7 @@ struct TileCache {
 // in a cache small enough for the processor's caches (400 KB for 128 quads).
 class LayerPyramid {
  public:
-  // Finds the full quads (serially; see FullQuads) and allocates the errors.
+  // Finds the full quads (FullQuads) and allocates the errors.
   // EvaluateTileRow then fills them, one row of tiles of the largest block
   // size at a time: rows are independent, so threads may take different rows.
   LayerPyramid(const TwoLayerPanorama& p, const Directions& dirs, int layer, int levels,
@@ -536,6 +536,17 @@ struct Leaf {
   double error;
 };
 
+// The corner a patch fans from (spec/mesh.md Sec. 5.4 step 3), given the
+// number of kept nodes strictly inside each side of its ring (A-C, C-D, D-B,
+// B-A): the first corner, in the order A, C, D, B, with no extra vertex on
+// either of its sides, or -1 (a fan from the block's centre).
+int PatchApex(const size_t extra[4]) {
+  for (int c = 0; c < 4; ++c) {
+    if (extra[c] == 0 && extra[(c + 3) & 3] == 0) return c;
+  }
+  return -1;
+}
+
 // The merged blocks at threshold tau, ordered by (layer, level from largest,
 // block row, block column). Rows of a level go to threads in chunks whose
 // leaves are joined in order.
@@ -663,13 +674,15 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
   }
   auto is_kept = [&](size_t node) { return kept[node] != 0; };
   const int64_t leaf_runs = std::min<int64_t>(num_leaves, 8 * static_cast<int64_t>(threads));
+  // Triangles of each run of leaves, when counted first (then exact
+  // reservations for step 3).
+  std::vector<int64_t> run_triangles;
   if (count_limit >= 0) {
-    // Only the count may be needed: a patch has 2 triangles if its ring has
-    // only the corners, r - 2 if a corner has no extra vertex on either side,
-    // else r (step 3 below), which the kept nodes on each side give.
+    run_triangles.assign(static_cast<size_t>(leaf_runs), 0);
+    // Only the count may be needed: each patch's, from the kept nodes on the
+    // sides of its ring (step 3 below builds the same patches).
     int64_t quad_triangles = 0;
     for (const MeshAssembler& part : quad_parts) quad_triangles += part.num_triangles();
-    std::vector<int64_t> run_triangles(static_cast<size_t>(leaf_runs), 0);
     ParallelFor(0, leaf_runs, threads, [&](int64_t run) {
       int64_t first, last;
       ChunkRange(num_leaves, leaf_runs, run, &first, &last);
@@ -677,17 +690,17 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
       for (int64_t li = first; li < last; ++li) {
         const Leaf& leaf = leaves[li];
         const int s = 1 << leaf.level, x0 = leaf.x0, y0 = leaf.y0, l = leaf.layer;
-        int extra[4] = {0, 0, 0, 0};  // Sides A-C, C-D, D-B, B-A.
+        size_t extra[4] = {0, 0, 0, 0};  // Sides A-C, C-D, D-B, B-A.
         for (int i = 1; i < s; ++i) {
           extra[0] += is_kept(node(x0, y0 + i, l));
           extra[1] += is_kept(node(x0 + i, y0 + s, l));
           extra[2] += is_kept(node(x0 + s, y0 + i, l));
           extra[3] += is_kept(node(x0 + i, y0, l));
         }
-        const int r = 4 + extra[0] + extra[1] + extra[2] + extra[3];
-        bool apex = false;
-        for (int c = 0; c < 4; ++c) apex |= extra[c] == 0 && extra[(c + 3) & 3] == 0;
-        count += r == 4 ? 2 : (apex ? r - 2 : r);
+        // Two triangles for a bare quad, n - 2 for a fan from a corner, n
+        // for a fan from the centre.
+        const int64_t n = static_cast<int64_t>(4 + extra[0] + extra[1] + extra[2] + extra[3]);
+        count += n == 4 ? 2 : (PatchApex(extra) >= 0 ? n - 2 : n);
       }
       run_triangles[run] = count;
     });
@@ -704,9 +717,13 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
     int64_t first, last;
     ChunkRange(num_leaves, leaf_runs, run, &first, &last);
     MeshAssembler& out = patch_parts[run];
-    size_t most = 0;  // A ring has at most 4 s nodes, a patch as many triangles.
-    for (int64_t li = first; li < last; ++li) most += size_t{4} << leaves[li].level;
-    out.Reserve(most);
+    if (!run_triangles.empty()) {
+      out.Reserve(static_cast<size_t>(run_triangles[run]));
+    } else {
+      size_t most = 0;  // A ring has at most 4 s nodes, a patch as many triangles.
+      for (int64_t li = first; li < last; ++li) most += size_t{4} << leaves[li].level;
+      out.Reserve(most);
+    }
     std::vector<NodeRef> ring;
     for (int64_t li = first; li < last; ++li) {
       const Leaf& leaf = leaves[li];
@@ -746,14 +763,9 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
       // A fan from a corner whose two sides have no extra vertex has no
       // degenerate triangle and needs n - 2 triangles; otherwise fan from the
       // block's centre node (n triangles).
-      auto side_extra = [&](int i) {
-        const size_t end = i == 3 ? n : corner[i + 1];
-        return end - corner[i] > 1;
-      };
-      int apex = -1;
-      for (int c = 0; c < 4 && apex < 0; ++c) {
-        if (!side_extra(c) && !side_extra((c + 3) & 3)) apex = c;
-      }
+      size_t extra[4];
+      for (int i = 0; i < 4; ++i) extra[i] = (i == 3 ? n : corner[i + 1]) - corner[i] - 1;
+      const int apex = PatchApex(extra);
       if (apex >= 0) {
         const size_t v = corner[apex];
         for (size_t i = 1; i + 1 < n; ++i) {
@@ -824,7 +836,7 @@ StatusOr<SimplifiedMesh> BuildSimplifiedMesh(const TwoLayerPanorama& pano,
       }
     }
     ParallelFor(0, static_cast<int64_t>(rows.size()), threads, [&](int64_t i) {
-      // 1.2 MB for 128-quad tiles: each thread keeps its own between calls.
+      // 400 KB for 128-quad tiles: each thread keeps its own between calls.
       static thread_local TileCache cache;
       pyramids[rows[i].first].EvaluateTileRow(rows[i].second, &cache);
     });

@@ -36,16 +36,13 @@ namespace casual3d {
 // without threads.
 inline int ResolveThreads(int requested) {
 #if CASUAL3D_HAS_THREADS
-  int n = requested;
-  if (n <= 0) {
-    const unsigned hw = std::thread::hardware_concurrency();
-    n = hw == 0 ? 1 : static_cast<int>(hw);
-  }
+  const unsigned reported = std::thread::hardware_concurrency();
+  const int hw = reported == 0 ? 1 : static_cast<int>(reported);
+  int n = requested > 0 ? requested : hw;
 #ifdef __EMSCRIPTEN_PTHREADS__
   // The pool holds one worker fewer than the hardware threads (at most
   // CASUAL3D_MAX_THREADS - 1); asking for more would wait for ever.
-  const unsigned hw = std::thread::hardware_concurrency();
-  n = std::min(n, hw == 0 ? 1 : static_cast<int>(hw));
+  n = std::min(n, hw);
 #endif
 #ifdef CASUAL3D_MAX_THREADS
   n = std::min(n, CASUAL3D_MAX_THREADS);

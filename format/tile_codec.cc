@@ -6,7 +6,6 @@
 #include <cstring>
 #include <limits>
 #include <string>
-#include <vector>
 
 #if defined(__wasm_simd128__)
 #include <wasm_simd128.h>
@@ -260,16 +259,16 @@ Status DecodeError(ImageView<const uint8_t> image, TileImageKind kind, int x0, i
   return Status::Ok();
 }
 
-// The per-kind loops of DecodeTileImage for images of `kChannels` channels,
-// over the tile's rows [row_begin, row_end). Each returns false if some pixel
-// was invalid (the caller then finds the first one for the message); they
-// never read or write out of bounds.
+// The per-kind loops of DecodeTileImage for images of `kChannels` channels
+// (DecodeLayerRows over the tile's rows [row_begin, row_end)). Each returns
+// false if some pixel was invalid (the caller then finds the first one for
+// the message); they never read or write out of bounds.
 template <int kChannels>
-bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int row_begin,
-                     int row_end, TwoLayerPanorama* pano, int* bad_x, int* bad_y) {
+bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int h,
+                     TwoLayerPanorama* pano, int* bad_x, int* bad_y) {
   LayerData& F = pano->layer(kFront);
   LayerData& B = pano->layer(kBack);
-  for (int y = row_begin; y < row_end; ++y) {
+  for (int y = 0; y < h; ++y) {
     const uint8_t* px = image.row(y);
     const size_t i0 = pano->index(x0, y0 + y);
     uint8_t* __restrict front_present = &F.present[i0];
@@ -404,38 +403,30 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
     return InvalidData(std::string(TileImageKindName(kind)) + " image has " +
                        std::to_string(image.channels()) + " channels, expected 3 or 4");
   const bool rgba = image.channels() == 4;
-  // Bands of rows write disjoint nodes; a band's first invalid pixel is the
-  // tile's first when no earlier band has one.
-  // Colour and graph images are plain byte shuffles, faster than handing a
-  // tile to other threads; depth and normals go through look-up tables.
-  const bool worth_sharing = kind == TileImageKind::kDepth || kind == TileImageKind::kNormal;
-  const int threads = worth_sharing ? ResolveThreads(num_threads) : 1;
+  if (kind == TileImageKind::kGraph) {
+    int bad_x = 0, bad_y = 0;
+    const bool ok = rgba ? DecodeGraphRows<4>(image, x0, y0, w, h, pano, &bad_x, &bad_y)
+                         : DecodeGraphRows<3>(image, x0, y0, w, h, pano, &bad_x, &bad_y);
+    if (!ok)
+      return InvalidData("graph image: reserved flag bits set at pixel " + PixelName(bad_x, bad_y));
+    return Status::Ok();
+  }
+  // Bands of rows write disjoint nodes. Colour (like the graph above) is a
+  // plain byte shuffle, faster than handing a tile to other threads; depth
+  // and normals go through look-up tables.
+  const int threads = kind == TileImageKind::kColor ? 1 : ResolveThreads(num_threads);
   const int bands = std::min(h, threads > 1 ? 4 * threads : 1);
-  std::vector<uint8_t> band_ok(static_cast<size_t>(bands), 1);
-  std::vector<int> band_bad(2 * static_cast<size_t>(bands), 0);
+  std::atomic<bool> ok(true);
   ParallelFor(0, bands, threads, [&](int64_t b) {
     int64_t r0, r1;
     ChunkRange(h, bands, b, &r0, &r1);
     const int row_begin = static_cast<int>(r0), row_end = static_cast<int>(r1);
-    bool ok;
-    if (kind == TileImageKind::kGraph) {
-      int* bad = &band_bad[2 * b];
-      ok = rgba ? DecodeGraphRows<4>(image, x0, y0, w, row_begin, row_end, pano, bad, bad + 1)
-                : DecodeGraphRows<3>(image, x0, y0, w, row_begin, row_end, pano, bad, bad + 1);
-    } else {
-      ok = rgba ? DecodeLayerRows<4>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano)
-                : DecodeLayerRows<3>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano);
-    }
-    band_ok[b] = ok ? 1 : 0;
+    const bool band_ok =
+        rgba ? DecodeLayerRows<4>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano)
+             : DecodeLayerRows<3>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano);
+    if (!band_ok) ok.store(false, std::memory_order_relaxed);
   });
-  for (int b = 0; b < bands; ++b) {
-    if (band_ok[b]) continue;
-    if (kind == TileImageKind::kGraph)
-      return InvalidData("graph image: reserved flag bits set at pixel " +
-                         PixelName(band_bad[2 * b], band_bad[2 * b + 1]));
-    return DecodeError(image, kind, x0, y0, w, h, decoder);
-  }
-  return Status::Ok();
+  return ok.load() ? Status::Ok() : DecodeError(image, kind, x0, y0, w, h, decoder);
 }
 
 Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads) {

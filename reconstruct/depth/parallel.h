@@ -1,6 +1,8 @@
 #pragma once
 
-// A minimal fork-join loop over an index range for the dense stage. Work is
+// A minimal fork-join loop over an index range for the dense stage, which
+// starts its threads per call (it nests loops: photos in flight, rows within;
+// format/parallel.h's pool would run the inner ones on one thread). Work is
 // split into contiguous chunks handed out dynamically, so uneven rows or
 // planes still keep every thread busy. Deterministic results only require that
 // the body writes disjoint outputs per index.
@@ -11,14 +13,12 @@
 #include <thread>
 #include <vector>
 
+#include "format/parallel.h"
+
 namespace casual3d::depth {
 
 // Number of worker threads for `requested` (0 = all hardware threads).
-inline int ResolveThreads(int requested) {
-  if (requested > 0) return requested;
-  const unsigned hw = std::thread::hardware_concurrency();
-  return hw == 0 ? 1 : static_cast<int>(hw);
-}
+using casual3d::ResolveThreads;
 
 // Calls body(i) for every i in [begin, end) on up to `num_threads` threads.
 // `grain` indices are claimed at a time. Exceptions must not escape `body`.

@@ -74,6 +74,8 @@ export class FormatModule {
     if (useThreads) {
       try {
         const { default: factory } = await import('./casual3d-format-mt.js');
+        // A copy: the factory writes its module into the object it is given,
+        // which the fallback below must not inherit.
         module = await factory({ ...options });
       } catch (err) {
         // Shared memory reserves its 4 GB maximum up front, which a device
