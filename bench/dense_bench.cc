@@ -1,7 +1,9 @@
 // Dense stage benchmarks (docs/PERFORMANCE.md, "Dense"): the plane sweep
 // (220 hypotheses, 4 neighbours), the WTA, the near-envelope filters and
 // solver, TRW-S and the upsampling, on a ray-cast toy scene at the working
-// resolution of a 1152x864 photo (576x432 at the default working scale 0.5).
+// resolution of a 1152x864 photo (576x432 at the default working scale 0.5);
+// the boundary relabelling and the full-resolution search at the photo's
+// resolution.
 // Counters: seconds per megapixel of the photo (4x the working pixels); for
 // the sweep and TRW-S, CPU time of the whole process (all threads) per unit
 // of work: per pixel x label x neighbour (sweep) and per pixel x label x pass
@@ -16,6 +18,7 @@
 #include <cmath>
 #include <map>
 
+#include "reconstruct/depth/fullres_refine.h"
 #include "reconstruct/depth/gc_filter.h"
 #include "reconstruct/depth/median_prune.h"
 #include "reconstruct/depth/mrf_trws.h"
@@ -195,6 +198,65 @@ void BM_Upsample(benchmark::State& state) {
   SetPerMegapixel(state, width);
 }
 BENCHMARK(BM_Upsample)->Arg(576)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The full-resolution steps on the photo-sized rig, 4 neighbours, starting
+// from the true depth with the near side of every depth edge spread 6 pixels
+// outwards (the fattening the relabelling removes).
+struct FullResInput {
+  ImageF depth;
+  std::vector<RefineNeighbor> neighbors;
+};
+
+const FullResInput& GetFullResInput(int width) {
+  static std::map<int, FullResInput> inputs;
+  auto it = inputs.find(width);
+  if (it != inputs.end()) return it->second;
+  const Rig& rig = GetRig(width);
+  FullResInput in;
+  const ImageF& truth = rig.depth[0];
+  const int w = truth.width(), h = truth.height(), r = 6;
+  in.depth = ImageF(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float d = truth.at(x, y);
+      for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v)
+        for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) d = std::min(d, truth.at(u, v));
+      in.depth.at(x, y) = std::isfinite(d) ? d : 50.0f;
+    }
+  for (size_t i = 1; i < rig.views.size(); ++i) in.neighbors.push_back({&rig.views[i].gray, rig.views[i].camera});
+  return inputs.emplace(width, std::move(in)).first->second;
+}
+
+void BM_Relabel(benchmark::State& state) {
+  const int width = static_cast<int>(state.range(0));
+  const Rig& rig = GetRig(2 * width);
+  const FullResInput& in = GetFullResInput(2 * width);
+  const LabelGrid grid{2.0, 0.02, 220};
+  long long changed = 0;
+  for (auto _ : state) {
+    changed = 0;
+    ImageF out = RelabelBoundaries(rig.views[0].color, rig.views[0].gray, rig.views[0].camera, in.depth,
+                                   in.neighbors, grid.InvStep(), BoundaryRelabelOptions(), 1, &changed);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["changed"] = static_cast<double>(changed);
+  SetPerMegapixel(state, width);
+}
+BENCHMARK(BM_Relabel)->Arg(576)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_FullResRefine(benchmark::State& state) {
+  const int width = static_cast<int>(state.range(0));
+  const Rig& rig = GetRig(2 * width);
+  const FullResInput& in = GetFullResInput(2 * width);
+  const LabelGrid grid{2.0, 0.02, 220};
+  for (auto _ : state) {
+    ImageF out = RefineFullResolution(rig.views[0].gray, rig.views[0].camera, in.depth, in.neighbors,
+                                      grid.InvStep(), FullResRefineOptions(), 1);
+    benchmark::DoNotOptimize(out.data());
+  }
+  SetPerMegapixel(state, width);
+}
+BENCHMARK(BM_FullResRefine)->Arg(576)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace casual3d::depth

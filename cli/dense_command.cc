@@ -18,6 +18,9 @@ struct DenseCommandOptions {
   bool no_near_envelope = false;
   bool no_gc_filter = false;
   bool refine = false;
+  bool no_flat_regions = false;
+  bool no_relabel = false;
+  bool no_fullres_refine = false;
   depth::DenseOptions dense;
 };
 
@@ -26,6 +29,9 @@ void RunDense(const DenseCommandOptions& o) {
   opt.use_near_envelope = !o.no_near_envelope;
   opt.use_gc_filter = !o.no_gc_filter;
   opt.refine.enabled = o.refine;
+  opt.flat.enabled = !o.no_flat_regions;
+  opt.relabel.enabled = !o.no_relabel;
+  opt.fullres.enabled = !o.no_fullres_refine;
   const Status st = opt.Check();
   if (!st.ok()) throw std::invalid_argument("dense: " + st.message());
   const depth::DenseReport report = depth::RunDenseStage(o.workspace, o.out, opt);
@@ -63,6 +69,18 @@ void AddDenseCommand(CLI::App& app) {
   cmd->add_flag("--no-near-envelope", opts->no_near_envelope,
                 "Ablation: MRF without the near envelope term (Eq. 4)");
   cmd->add_flag("--no-gc-filter", opts->no_gc_filter, "Ablation: build anchors without the GC filter");
+  cmd->add_flag("--no-flat-regions", opts->no_flat_regions,
+                "Ablation: no depth priors for textureless regions from their silhouettes");
+  cmd->add_flag("--no-relabel", opts->no_relabel,
+                "Ablation: keep fattened depth edges (no full-resolution boundary relabelling)");
+  cmd->add_flag("--no-fullres-refine", opts->no_fullres_refine,
+                "Ablation: no full-resolution depth search after upsampling");
+  cmd->add_option("--lambda-flat", opts->dense.mrf.lambda_flat,
+                  "Weight of the textureless-region prior in the MRF data term")
+      ->capture_default_str();
+  cmd->add_option("--relabel-neighbors", opts->dense.relabel.max_neighbors,
+                  "Neighbours the boundary relabelling tests (the sweep's first ones)")
+      ->capture_default_str();
   cmd->add_flag("--refine", opts->refine,
                 "Continuous depth search within one label of the MRF's (slower; helps wide baselines)");
   cmd->add_option("--threads", opts->dense.num_threads, "Worker threads (0 = all cores)")

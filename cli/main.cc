@@ -1,8 +1,14 @@
 // casual3d: casual 3D photography from the command line.
 
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <string>
+
+#if defined(__linux__) && defined(__GLIBC__)
+#include <unistd.h>
+#endif
 
 #include <CLI/CLI.hpp>
 
@@ -16,9 +22,40 @@ GlobalOptions g_options;
 
 const GlobalOptions& Globals() { return g_options; }
 
+namespace {
+
+// The reconstruction allocates and frees buffers of tens to hundreds of
+// megabytes per photo; faulting their pages in 4 KiB at a time took about a
+// third of the dense stage's time on a virtual machine, and glibc's
+// allocator asks for transparent huge pages (2 MiB) only when its
+// glibc.malloc.hugetlb tunable is set before the process starts
+// (docs/PERFORMANCE.md, "Huge pages"). So the command restarts itself once
+// with the tunable added, unless the environment already sets it (which also
+// stops a second restart). Nothing changes when the restart fails.
+void RestartWithHugePages(char** argv) {
+#if defined(__linux__) && defined(__GLIBC__)
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (tunables && std::strstr(tunables, "glibc.malloc.hugetlb")) return;
+  std::string value = tunables && *tunables ? std::string(tunables) + ":" : std::string();
+  value += "glibc.malloc.hugetlb=1";
+  if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  // Still here: run as we are, without leaving the variable to children.
+  if (tunables) {
+    setenv("GLIBC_TUNABLES", tunables, 1);
+  } else {
+    unsetenv("GLIBC_TUNABLES");
+  }
+#else
+  (void)argv;
+#endif
+}
+
+}  // namespace
 }  // namespace casual3d::cli
 
 int main(int argc, char** argv) {
+  casual3d::cli::RestartWithHugePages(argv);
   using casual3d::cli::g_options;
   CLI::App app{"casual3d: turns a few dozen hand-held photos into a 3D photo"};
   app.set_version_flag("--version", std::string("casual3d 0.1.0"));

@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "reconstruct/depth/depth_metrics.h"
+#include "reconstruct/depth/huge_pages.h"
 #include "reconstruct/depth/mrf_trws.h"
 #include "reconstruct/depth/parallel.h"
 #include "reconstruct/depth/workspace.h"
@@ -111,13 +112,14 @@ void WriteCostCache(const std::string& path, const CostVolume& vol) {
 
 void ReadCostCache(const std::string& path, CostVolume* vol) {
   const size_t n = static_cast<size_t>(vol->width) * vol->height;
-  std::vector<uint16_t> q(n * vol->num_labels);
+  std::vector<uint16_t> q;
+  AssignHuge(&q, n * vol->num_labels);
   vol->photo_weight = ImageF(vol->width, vol->height, 1);
   std::ifstream f(path, std::ios::binary);
   f.read(reinterpret_cast<char*>(q.data()), static_cast<std::streamsize>(q.size() * 2));
   f.read(reinterpret_cast<char*>(vol->photo_weight.data()), static_cast<std::streamsize>(n * sizeof(float)));
   if (!f) throw io::IoError(path + ": cost cache truncated");
-  vol->cost.resize(q.size());
+  AssignHuge(&vol->cost, q.size());
   for (size_t i = 0; i < q.size(); ++i) vol->cost[i] = q[i] * (1.0f / 65535.0f);
 }
 
@@ -163,6 +165,9 @@ Status MrfTermOptions::Check() const {
   if (truncation_labels < 1 || truncation_labels > 4096)
     return InvalidArgument("truncation_labels outside [1, 4096]");
   if (max_iterations < 1 || max_iterations > 1000) return InvalidArgument("mrf max_iterations outside [1, 1000]");
+  if (!(lambda_flat >= 0 && lambda_flat <= 100)) return InvalidArgument("lambda_flat outside [0, 100]");
+  if (!(flat_truncation_labels >= 1 && flat_truncation_labels <= 100))
+    return InvalidArgument("flat_truncation_labels outside [1, 100]");
   return Status::Ok();
 }
 
@@ -175,7 +180,8 @@ Status DenseOptions::Check() const {
     return InvalidArgument("min_far_over_near outside [1, 1e6]");
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   for (const Status& s : {neighbors.Check(), sweep.Check(), gc.Check(), prune.Check(), envelope.Check(),
-                          mrf.Check(), edge_median.Check(), sublabel.Check(), refine.Check(), upsample.Check()})
+                          mrf.Check(), edge_median.Check(), sublabel.Check(), refine.Check(), upsample.Check(),
+                          fullres.Check(), relabel.Check(), flat.Check()})
     if (!s.ok()) return s;
   return Status::Ok();
 }
@@ -333,14 +339,34 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     mrf.height = h;
     mrf.num_labels = L;
     mrf.truncation = options.mrf.truncation_labels;
-    mrf.unary.resize(np * L);
+    AssignHuge(&mrf.unary, np * L);
+    // Priors for textureless regions from their silhouettes (flat_regions.h).
+    std::vector<float> flat_prior;
+    FlatRegionStats flat_stats;
+    if (options.flat.enabled) {
+      const auto tf = Clock::now();
+      std::vector<FlatRegionNeighbor> fn;
+      for (const DenseView* nb : swept[i]) fn.push_back({&nb->color, nb->camera});
+      flat_prior = FlatRegionPriors(v.color, vol.photo_weight, v.camera, wta[i], fn, vol, options.flat, &flat_stats);
+      pr.t_flat = Since(tf);
+      pr.flat_groups = flat_stats.groups;
+      pr.flat_fitted = flat_stats.fitted;
+      pr.flat_pixels = flat_stats.pixels;
+    }
     const bool near_term = options.use_near_envelope && !envelope.empty() && options.mrf.lambda_near > 0;
     for (size_t p = 0; p < np; ++p) {
       const float wp = vol.photo_weight.data()[p];
       const float* c = vol.cost.data() + p * L;
       float* u = mrf.unary.data() + p * L;
-      const float bias = static_cast<float>(options.mrf.far_bias) * (1.0f - wp) / (L - 1);
+      const bool has_prior = !flat_prior.empty() && !std::isnan(flat_prior[p]);
+      const float bias = has_prior ? 0.0f : static_cast<float>(options.mrf.far_bias) * (1.0f - wp) / (L - 1);
       for (int k = 0; k < L; ++k) u[k] = wp * c[k] + bias * static_cast<float>(L - 1 - k);
+      if (has_prior) {
+        // Linear in the label distance up to flat_truncation labels.
+        const float tf = static_cast<float>(options.mrf.flat_truncation_labels);
+        const float lp = static_cast<float>(options.mrf.lambda_flat) * (1.0f - wp) / tf;
+        for (int k = 0; k < L; ++k) u[k] += lp * std::min(tf, std::abs(k - flat_prior[p]));
+      }
       if (near_term) {
         // Eq. 4: labels nearer than the envelope (k < label of n_i) pay lambda_near.
         const double kn = grid.LabelOf(envelope.data()[p]);
@@ -388,6 +414,11 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     if (options.refine.enabled)
       fl = RefineContinuous(v, swept[i], vol, labels, fl, options.sweep, options.refine, inner);
     fl = SmoothSubLabel(vol, std::move(fl), v.color, options.sublabel, inner);
+    // Within a fitted flat region the plane is the estimate: the photos carry
+    // no evidence there to refine it by.
+    if (!flat_prior.empty())
+      for (size_t p = 0; p < np; ++p)
+        if (!std::isnan(flat_prior[p])) fl[p] = flat_prior[p];
     ImageF low_depth(w, h, 1), low_conf(w, h, 1);
     for (size_t p = 0; p < np; ++p) {
       const float* c = vol.cost.data() + p * L;
@@ -404,7 +435,25 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     const ImageF full_color = ReadPhotoFloat((fs::path(ws.images_dir) / v.name).string());
     UpsampleOptions up = options.upsample;
     up.num_threads = inner;
-    const ImageF depth = JointBilateralMedianUpsample(low_depth, v.color, full_color, up);
+    ImageF depth = JointBilateralMedianUpsample(low_depth, v.color, full_color, up);
+    // At full resolution: the farther side's depth back onto fattened edge
+    // bands, then a search within a label around every textured pixel
+    // (fullres_refine.h).
+    if (options.relabel.enabled || options.fullres.enabled) {
+      const auto tf = Clock::now();
+      std::vector<RefineNeighbor> rn;
+      for (const DenseView* nb : swept[i]) rn.push_back({&nb->gray_full, nb->camera_full});
+      if (options.relabel.enabled)
+        depth = RelabelBoundaries(full_color, v.gray_full, v.camera_full, depth, rn, grid.InvStep(),
+                                  options.relabel, inner, &pr.relabelled);
+      if (options.fullres.enabled) {
+        FullResRefineStats rs;
+        depth = RefineFullResolution(v.gray_full, v.camera_full, depth, rn, grid.InvStep(), options.fullres,
+                                     inner, &rs);
+        pr.refined = rs.refined;
+      }
+      pr.t_fullres = Since(tf);
+    }
     const ImageF conf = ResizeLinear(low_conf, v.full_width, v.full_height);
     ImageF env_full;
     if (!envelope.empty()) {
@@ -412,7 +461,8 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     } else {
       env_full = ImageF(v.full_width, v.full_height, 1, static_cast<float>(v.range.near_m));
     }
-    io::WriteExr((fs::path(out_dir) / "depth" / (stem + ".exr")).string(), depth.view(), {"Z"});
+    io::WriteExr((fs::path(out_dir) / "depth" / (stem + ".exr")).string(),
+                 static_cast<const ImageF&>(depth).view(), {"Z"});
     io::WriteExr((fs::path(out_dir) / "confidence" / (stem + ".exr")).string(), conf.view(), {"Y"});
     io::WriteExr((fs::path(out_dir) / "envelope" / (stem + ".exr")).string(),
                  static_cast<const ImageF&>(env_full).view(), {"Z"});
@@ -428,6 +478,12 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       if (!propagated.empty()) png("propagated", propagated);
       if (!envelope.empty()) png("envelope", envelope);
       png("trws", trws_depth);
+      if (!flat_prior.empty()) {
+        ImageF fp(w, h, 1, 0.0f);
+        for (size_t p = 0; p < np; ++p)
+          if (!std::isnan(flat_prior[p])) fp.data()[p] = static_cast<float>(vol.DepthOfLabel(flat_prior[p]));
+        png("flat", fp);
+      }
       png("mrf", low_depth);
       Image8 texture(w, h, 1);
       for (size_t p = 0; p < np; ++p)
@@ -574,8 +630,13 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     p["mrf_energy"] = pr.mrf_energy;
     p["mrf_iterations"] = pr.mrf_iterations;
     p["cross_view_consistency"] = pr.cross_view_consistency;
-    p["seconds"] = {{"sweep", pr.t_sweep}, {"envelope", pr.t_envelope}, {"mrf", pr.t_mrf}, {"refine", pr.t_refine},
-                    {"upsample_write", pr.t_upsample}};
+    // "flat" is part of "mrf", "fullres" of "upsample_write".
+    p["seconds"] = {{"sweep", pr.t_sweep},     {"envelope", pr.t_envelope}, {"mrf", pr.t_mrf},
+                    {"flat", pr.t_flat},       {"refine", pr.t_refine},     {"upsample_write", pr.t_upsample},
+                    {"fullres", pr.t_fullres}};
+    p["flat_regions"] = {{"groups", pr.flat_groups}, {"fitted", pr.flat_fitted}, {"pixels", pr.flat_pixels}};
+    p["relabelled_pixels"] = pr.relabelled;
+    p["refined_pixels"] = pr.refined;
     if (pr.evaluated) {
       p["accuracy"] = {{"median_rel_error", pr.median_rel_error}, {"within_3pct", pr.within_3pct},
                        {"near_floaters", pr.near_floaters}, {"sky_near", pr.sky_near},

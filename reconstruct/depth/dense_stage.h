@@ -28,6 +28,8 @@
 #include "format/status.h"
 #include "reconstruct/depth/continuous_refine.h"
 #include "reconstruct/depth/edge_median.h"
+#include "reconstruct/depth/flat_regions.h"
+#include "reconstruct/depth/fullres_refine.h"
 #include "reconstruct/depth/gc_filter.h"
 #include "reconstruct/depth/median_prune.h"
 #include "reconstruct/depth/near_envelope.h"
@@ -57,17 +59,23 @@ struct MrfTermOptions {
   // 8 passes' and the accuracy figures within 0.6% (docs/PERFORMANCE.md);
   // 4-5 passes leave measurably more near floaters. [1, 1000].
   int max_iterations = 6;
+  // Our addition: pixels with a flat-region prior (flat_regions.h) pay
+  // lambda_flat * (1 - w_photo) * min(|k - prior|, T_flat) / T_flat, and the
+  // far bias does not apply to them. [0, 100], [1, 100].
+  double lambda_flat = 0.3;
+  double flat_truncation_labels = 4.0;
 
   Status Check() const;
 };
 
 struct DenseOptions {
   double working_scale = 0.5;  // Sweep, envelope and MRF resolution relative to the photos. (0, 1].
-  // Neighbours per sweep. [1, 16]. 6 rather than 4: on the default synthetic
-  // capture median error 1.62 -> 1.37%, within 3% 64.1 -> 69.8%, near
-  // floaters 5.55 -> 5.08% for 8% more time (the sweep's share grows by half);
-  // fern's held-out views +0.09 dB (docs/PERFORMANCE.md, "Neighbours").
-  int num_neighbors = 6;
+  // Neighbours per sweep. [1, 16]. 12: on the default synthetic capture
+  // (a partial rig, where a photo's content is seen by few of the others)
+  // 4 / 6 / 12 neighbours gave within 3% 74.1 / 80.7 / 86.8%, near floaters
+  // 3.71 / 2.72 / 0.99% and 16-photo wall times of 1.0 / 1.3 / 1.8 times
+  // 4's (docs/PERFORMANCE.md, "Neighbours"); 15 gained nothing over 12.
+  int num_neighbors = 12;
   // Filter sizes below are given for a 900x1350 image (Sec. 4.3.2) and scaled
   // with the working image's diagonal.
   double reference_diagonal = 1622.5;  // sqrt(900^2 + 1350^2), pixels.
@@ -91,6 +99,9 @@ struct DenseOptions {
   SubLabelOptions sublabel;
   ContinuousRefineOptions refine;  // Between the sub-label fit and its smoothing.
   UpsampleOptions upsample;
+  BoundaryRelabelOptions relabel;  // After upsampling, before fullres.
+  FullResRefineOptions fullres;    // After upsampling.
+  FlatRegionOptions flat;          // Priors for textureless regions (MRF data term, sub-label step).
   bool use_near_envelope = true;  // false: the "MRF without near envelope" baseline (Fig. 5).
   bool use_gc_filter = true;      // false: skip the GC filter when building anchors.
   bool debug = false;             // Colour-mapped PNGs of every intermediate.
@@ -124,6 +135,10 @@ struct PhotoReport {
   int mrf_iterations = 0;
   // Seconds per step.
   double t_sweep = 0, t_envelope = 0, t_mrf = 0, t_refine = 0, t_upsample = 0;
+  double t_flat = 0, t_fullres = 0;  // Parts of t_mrf and t_upsample.
+  int flat_groups = 0, flat_fitted = 0;  // Flat regions found and given a plane.
+  long long flat_pixels = 0;             // Working pixels with a flat-region prior.
+  long long relabelled = 0, refined = 0; // Full-resolution pixels changed by relabel / fullres.
   // Filled when ground truth is available.
   bool evaluated = false;
   double median_rel_error = 0, within_3pct = 0, near_floaters = 0, sky_near = 0;

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "reconstruct/depth/huge_pages.h"
+
 #if defined(__SSE2__)
 #include <xmmintrin.h>
 #endif
@@ -195,7 +197,9 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options) {
   // (x, y)-(x+1, y), vertical[p] the edge (x, y)-(x, y+1). Half the memory of
   // storing both directions, and the same results.
   const int S = PaddedLabels(L);
-  std::vector<float> horizontal(n * S, 0.0f), vertical(n * S, 0.0f);
+  std::vector<float> horizontal, vertical;
+  AssignHuge(&horizontal, n * S);
+  AssignHuge(&vertical, n * S);
   const std::vector<float> zeros(S, 0.0f);
   std::vector<float> belief(S, 0.0f), cost(S, kInf);
   std::vector<float> label_f(S);

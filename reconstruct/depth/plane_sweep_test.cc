@@ -279,6 +279,64 @@ TEST(PlaneSweep, SlotMeanCapsCostsAboveTheBestPlusTheTruncation) {
   EXPECT_FALSE(opt.Check().ok());
 }
 
+TEST(SweepKernels, PerPixelWarpMatchesThePlaneWarp) {
+  // A 40x30 source with a smooth pattern; a row whose homography moves and
+  // scales the pixels, part of it falling outside the source.
+  const int sw = 40, sh = 30, width = 64;
+  std::vector<float> src(static_cast<size_t>(sw) * sh);
+  for (int y = 0; y < sh; ++y)
+    for (int x = 0; x < sw; ++x) src[static_cast<size_t>(y) * sw + x] = std::sin(0.3f * x) + 0.1f * y;
+  const float b[3] = {12.0f, -3.0f, 0.05f};
+  const float p0[3] = {-5.0f, 14.0f, 1.0f}, step[3] = {0.8f, 0.02f, 0.001f};
+  // With the same inverse depth everywhere, the per-pixel warp is the plane
+  // warp of that plane: p0 + inv * b.
+  for (float inv : {0.0f, 0.25f, 1.5f}) {
+    sweep::HomographyRow plane;
+    for (int c = 0; c < 3; ++c) {
+      plane.p0[c] = p0[c] + inv * b[c];
+      plane.step[c] = step[c];
+    }
+    sweep::HomographyRow base;
+    for (int c = 0; c < 3; ++c) {
+      base.p0[c] = p0[c];
+      base.step[c] = step[c];
+    }
+    const std::vector<float> invs(width, inv);
+    std::vector<float> v1(width), i1(width), v2(width), i2(width);
+    sweep::WarpRow(src.data(), sw, sh, plane, width, v1.data(), i1.data());
+    sweep::WarpRowPerPixel(src.data(), sw, sh, base, invs.data(), b, width, v2.data(), i2.data());
+    int inside = 0;
+    for (int x = 0; x < width; ++x) {
+      EXPECT_NEAR(v2[x], v1[x], 1e-4f) << "inv " << inv << " x " << x;
+      EXPECT_EQ(i2[x], i1[x]) << "inv " << inv << " x " << x;
+      inside += i1[x] == 0.0f;
+    }
+    EXPECT_GT(inside, 10);
+    EXPECT_LT(inside, width);
+  }
+  // A different inverse depth per pixel: each pixel as the plane warp of its own plane.
+  std::vector<float> invs(width);
+  for (int x = 0; x < width; ++x) invs[x] = 0.02f * (x % 13);
+  std::vector<float> v(width), iv(width);
+  sweep::HomographyRow base;
+  for (int c = 0; c < 3; ++c) {
+    base.p0[c] = p0[c];
+    base.step[c] = step[c];
+  }
+  sweep::WarpRowPerPixel(src.data(), sw, sh, base, invs.data(), b, width, v.data(), iv.data());
+  for (int x = 0; x < width; ++x) {
+    sweep::HomographyRow plane;
+    for (int c = 0; c < 3; ++c) {
+      plane.p0[c] = p0[c] + invs[x] * b[c];
+      plane.step[c] = step[c];
+    }
+    std::vector<float> v1(width), i1(width);
+    sweep::WarpRow(src.data(), sw, sh, plane, width, v1.data(), i1.data());
+    EXPECT_NEAR(v[x], v1[x], 1e-4f) << x;
+    EXPECT_EQ(iv[x], i1[x]) << x;
+  }
+}
+
 TEST(PlaneSweep, RejectsInvalidOptionsAndInputs) {
   SweepOptions opt;
   opt.num_depths = 1;

@@ -29,12 +29,19 @@ inline float Bilinear(const float* img, int w, int h, float x, float y) {
   return top + fy * (bot - top);
 }
 
-inline void WarpPixel(const float* src, int sw, int sh, const HomographyRow& row, int x,
-                      float* value, float* invalid) {
+// With `inv` set, the pixel's own inverse depth adds inv[x] * b (a
+// per-pixel plane); otherwise b is not read.
+inline void WarpPixel(const float* src, int sw, int sh, const HomographyRow& row, const float* inv,
+                      const float* b, int x, float* value, float* invalid) {
   const float xf = static_cast<float>(x);
-  const float px = row.p0[0] + row.step[0] * xf;
-  const float py = row.p0[1] + row.step[1] * xf;
-  const float pz = row.p0[2] + row.step[2] * xf;
+  float px = row.p0[0] + row.step[0] * xf;
+  float py = row.p0[1] + row.step[1] * xf;
+  float pz = row.p0[2] + row.step[2] * xf;
+  if (inv) {
+    px += b[0] * inv[x];
+    py += b[1] * inv[x];
+    pz += b[2] * inv[x];
+  }
   float val = 0.0f;
   bool inside = false;
   if (pz > 1e-9f) {
@@ -57,8 +64,13 @@ inline __m128 LoadPairs(const float* a, const float* b) {
 
 }  // namespace
 
-void WarpRow(const float* src, int sw, int sh, const HomographyRow& row, int width, float* values,
-             float* invalid) {
+namespace {
+
+// WarpRow and WarpRowPerPixel: kPerPixel adds inv[x] * b to each pixel's
+// homogeneous coordinates.
+template <bool kPerPixel>
+void WarpRowImpl(const float* src, int sw, int sh, const HomographyRow& row, const float* inv,
+                 const float* b, int width, float* values, float* invalid) {
   int x = 0;
 #if defined(__SSE2__)
   // Four pixels at a time: coordinates, the inside test, clamping and the
@@ -85,9 +97,15 @@ void WarpRow(const float* src, int sw, int sh, const HomographyRow& row, int wid
   alignas(16) int32_t ix[4], iy[4];
   for (; x + 4 <= width; x += 4) {
     const __m128 xf = _mm_cvtepi32_ps(_mm_setr_epi32(x, x + 1, x + 2, x + 3));
-    const __m128 px = _mm_add_ps(ox, _mm_mul_ps(sx, xf));
-    const __m128 py = _mm_add_ps(oy, _mm_mul_ps(sy, xf));
-    const __m128 pz = _mm_add_ps(oz, _mm_mul_ps(sz, xf));
+    __m128 px = _mm_add_ps(ox, _mm_mul_ps(sx, xf));
+    __m128 py = _mm_add_ps(oy, _mm_mul_ps(sy, xf));
+    __m128 pz = _mm_add_ps(oz, _mm_mul_ps(sz, xf));
+    if constexpr (kPerPixel) {
+      const __m128 d = _mm_loadu_ps(inv + x);
+      px = _mm_add_ps(px, _mm_mul_ps(_mm_set1_ps(b[0]), d));
+      py = _mm_add_ps(py, _mm_mul_ps(_mm_set1_ps(b[1]), d));
+      pz = _mm_add_ps(pz, _mm_mul_ps(_mm_set1_ps(b[2]), d));
+    }
     const __m128 front = _mm_cmpgt_ps(pz, zmin);
     const __m128 iz = _mm_div_ps(one, pz);
     const __m128 u = _mm_sub_ps(_mm_mul_ps(px, iz), half);
@@ -134,7 +152,19 @@ void WarpRow(const float* src, int sw, int sh, const HomographyRow& row, int wid
     _mm_storeu_ps(invalid + x, _mm_andnot_ps(inside, invalid_cost));
   }
 #endif
-  for (; x < width; ++x) WarpPixel(src, sw, sh, row, x, values + x, invalid + x);
+  for (; x < width; ++x) WarpPixel(src, sw, sh, row, kPerPixel ? inv : nullptr, b, x, values + x, invalid + x);
+}
+
+}  // namespace
+
+void WarpRow(const float* src, int sw, int sh, const HomographyRow& row, int width, float* values,
+             float* invalid) {
+  WarpRowImpl<false>(src, sw, sh, row, nullptr, nullptr, width, values, invalid);
+}
+
+void WarpRowPerPixel(const float* src, int sw, int sh, const HomographyRow& row, const float* inv,
+                     const float b[3], int width, float* values, float* invalid) {
+  WarpRowImpl<true>(src, sw, sh, row, inv, b, width, values, invalid);
 }
 
 namespace {

@@ -34,6 +34,13 @@ struct HomographyRow {
 void WarpRow(const float* src, int src_width, int src_height, const HomographyRow& row, int width,
              float* values, float* invalid);
 
+// WarpRow with a plane per pixel: pixel x's homogeneous neighbour coordinates
+// are p0 + x * step + inv[x] * b (the homography of the fronto-parallel plane
+// at inverse depth inv[x], view.h's x_n ~ a x_ref + (1/d) b), otherwise the
+// same inside test, sampling and outputs.
+void WarpRowPerPixel(const float* src, int src_width, int src_height, const HomographyRow& row,
+                     const float* inv, const float b[3], int width, float* values, float* invalid);
+
 // Sums of a (2r+1)-wide window, added to a running total: out[x] = in[x] +
 // ... + in[x + 2r] and acc[x] += out[x] for x in [0, width). `in` holds
 // width + 2r elements (the row padded with r zeros on each side gives the

@@ -70,6 +70,8 @@ struct DenseView {
   DepthRange range;
   ImageF gray;            // Working resolution, 1 channel, linear in [0, 1].
   ImageF color;           // Working resolution, 3 channels (RGB) in [0, 1].
+  PinholeCamera camera_full;  // At the photo's full resolution.
+  ImageF gray_full;       // Full resolution, 1 channel, in [0, 1] (the refinement's input).
   int full_width = 0;     // Size of the photo as stored in the workspace.
   int full_height = 0;
 };

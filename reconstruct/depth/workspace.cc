@@ -31,6 +31,15 @@ ImageF ResizeArea(const ImageF& image, int width, int height) {
   return out;
 }
 
+ImageF GrayOf(const ImageF& rgb) {
+  ImageF gray(rgb.width(), rgb.height(), 1);
+  for (size_t i = 0; i < static_cast<size_t>(rgb.width()) * rgb.height(); ++i) {
+    const float* c = rgb.data() + 3 * i;
+    gray.data()[i] = 0.299f * c[0] + 0.587f * c[1] + 0.114f * c[2];
+  }
+  return gray;
+}
+
 std::string OutputStem(const std::string& image_name) {
   std::string stem = image_name;
   const size_t slash = stem.find_last_of('/');
@@ -112,14 +121,12 @@ LoadedWorkspace LoadWorkspace(const std::string& workspace_dir, double working_s
     const int ww = std::max(8, static_cast<int>(std::lround(cam.width * working_scale)));
     const int wh = std::max(8, static_cast<int>(std::lround(cam.height * working_scale)));
     v.camera = pc.Resized(ww, wh);
+    v.camera_full = pc;
+    v.gray_full = GrayOf(full);
     v.range.near_m = range_it->second.near_m;
     v.range.far_m = range_it->second.far_m;
     v.color = ResizeArea(full, ww, wh);
-    v.gray = ImageF(ww, wh, 1);
-    for (size_t i = 0; i < static_cast<size_t>(ww) * wh; ++i) {
-      const float* c = v.color.data() + 3 * i;
-      v.gray.data()[i] = 0.299f * c[0] + 0.587f * c[1] + 0.114f * c[2];
-    }
+    v.gray = GrayOf(v.color);
     ws.views.push_back(std::move(v));
 
     NeighborInput in;

@@ -33,6 +33,9 @@ ImageF ReadPhotoFloat(const std::string& path);
 // Resizes an RGB or grey float image with area averaging (OpenCV INTER_AREA).
 ImageF ResizeArea(const ImageF& image, int width, int height);
 
+// Luma (0.299 R + 0.587 G + 0.114 B) of an RGB float image.
+ImageF GrayOf(const ImageF& rgb);
+
 // File stem used for a photo's outputs: the image name without its
 // extension, with path separators replaced by '_'.
 std::string OutputStem(const std::string& image_name);

@@ -73,7 +73,10 @@ std::string DenseOptionsText(const depth::DenseOptions& o) {
     << " min_far_over_near=" << o.min_far_over_near
     << " texture_color_sigma=" << o.sweep.texture_color_sigma << " far_bias=" << o.mrf.far_bias
     << " neighbor_coverage=" << o.neighbors.coverage_k
-    << " occlusion_truncation=" << o.sweep.occlusion_truncation;
+    << " occlusion_truncation=" << o.sweep.occlusion_truncation
+    << " flat_regions=" << o.flat.enabled << " lambda_flat=" << o.mrf.lambda_flat
+    << " relabel=" << o.relabel.enabled << " relabel_radius=" << o.relabel.radius
+    << " relabel_neighbors=" << o.relabel.max_neighbors << " fullres_refine=" << o.fullres.enabled;
   return s.str();
 }
 

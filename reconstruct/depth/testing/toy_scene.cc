@@ -32,6 +32,10 @@ float ValueNoise(double x, double y, unsigned seed) {
 }
 
 void Texture(const ToyRect& r, double x, double y, float* rgb) {
+  if (r.cells_per_m <= 0) {
+    for (int k = 0; k < 3; ++k) rgb[k] = r.color[k];
+    return;
+  }
   const double s = r.cells_per_m;
   const float n = 0.55f * ValueNoise(x * s, y * s, r.seed) + 0.3f * ValueNoise(x * s * 2.7, y * s * 2.7, r.seed + 7) +
                   0.15f * ValueNoise(x * s * 0.3, y * s * 0.3, r.seed + 13);

@@ -1,9 +1,11 @@
 #pragma once
 
 // A tiny ray-cast scene with exact depth for the dense stage's tests: textured
-// fronto-parallel rectangles (a far wall, a near board, a thin pole) in front
-// of a textureless sky, seen by pinhole cameras looking along +Z. Test-only.
+// (or uniformly coloured) fronto-parallel rectangles (a far wall, a near
+// board, a thin pole) in front of a textureless sky, seen by pinhole cameras
+// looking along +Z. Test-only.
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -17,8 +19,9 @@ namespace casual3d::depth::testing {
 struct ToyRect {
   double z = 1.0;                      // Plane Z = z (world), metres.
   double x0 = -1, x1 = 1, y0 = -1, y1 = 1;  // Extent, metres.
-  double cells_per_m = 20.0;           // Texture frequency.
+  double cells_per_m = 20.0;           // Texture frequency; 0 = uniform `color`.
   unsigned seed = 1;
+  std::array<float, 3> color = {0.5f, 0.5f, 0.5f};  // RGB of an untextured rectangle.
 };
 
 struct ToyScene {

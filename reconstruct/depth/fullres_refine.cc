@@ -1,0 +1,379 @@
+#include "reconstruct/depth/fullres_refine.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "reconstruct/depth/parallel.h"
+#include "reconstruct/depth/plane_sweep.h"
+#include "reconstruct/depth/zncc_stream.h"
+
+namespace casual3d::depth {
+
+Status FullResRefineOptions::Check() const {
+  if (window_radius < 1 || window_radius > 15) return InvalidArgument("refine window_radius outside [1, 15]");
+  if (!(search_labels > 0 && search_labels <= 8)) return InvalidArgument("refine search_labels outside (0, 8]");
+  if (steps < 3 || steps > 65 || steps % 2 == 0) return InvalidArgument("refine steps must be odd, in [3, 65]");
+  if (best_k < 1 || best_k > 16) return InvalidArgument("refine best_k outside [1, 16]");
+  if (!(occlusion_truncation >= 0 && occlusion_truncation <= 1))
+    return InvalidArgument("refine occlusion_truncation outside [0, 1]");
+  if (!(ncc_epsilon >= 0 && ncc_epsilon <= 1)) return InvalidArgument("refine ncc_epsilon outside [0, 1]");
+  if (!(texture_sigma > 0 && texture_sigma <= 1)) return InvalidArgument("refine texture_sigma outside (0, 1]");
+  if (!(min_texture >= 0 && min_texture <= 1)) return InvalidArgument("refine min_texture outside [0, 1]");
+  return Status::Ok();
+}
+
+ImageF RefineFullResolution(const ImageF& gray, const PinholeCamera& camera, const ImageF& depth,
+                            const std::vector<RefineNeighbor>& neighbors, double inv_step,
+                            const FullResRefineOptions& options, int num_threads, FullResRefineStats* stats) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument("full-resolution refinement: " + st.message());
+  const int w = gray.width(), h = gray.height();
+  if (gray.channels() != 1 || depth.width() != w || depth.height() != h || depth.channels() != 1 ||
+      camera.width != w || camera.height != h)
+    throw std::invalid_argument("full-resolution refinement: grey image, depth map and camera differ in size");
+  if (!(inv_step > 0)) throw std::invalid_argument("full-resolution refinement: inv_step must be > 0");
+  for (const RefineNeighbor& nb : neighbors)
+    if (!nb.gray || nb.gray->channels() != 1 || nb.gray->width() != nb.camera.width ||
+        nb.gray->height() != nb.camera.height)
+      throw std::invalid_argument("full-resolution refinement: a neighbour's image and camera differ in size");
+  if (stats) *stats = FullResRefineStats();
+  if (!options.enabled || neighbors.empty()) return depth;
+
+  const size_t n = static_cast<size_t>(w) * h;
+  const int r = options.window_radius;
+  const int steps = options.steps;
+  const float eps = static_cast<float>(options.ncc_epsilon);
+  const ReferenceWindows windows = ComputeReferenceWindows(gray.data(), w, h, r, eps);
+  std::vector<float> inv0(n);
+  for (size_t i = 0; i < n; ++i) inv0[i] = 1.0f / depth.data()[i];
+
+  struct Warp {
+    const ImageF* gray;
+    PlaneHomography hom;
+  };
+  std::vector<Warp> warps;
+  for (const RefineNeighbor& nb : neighbors) warps.push_back({nb.gray, ComputePlaneHomography(camera, nb.camera)});
+  const int num_nb = static_cast<int>(warps.size());
+  auto offset = [&](int j) {
+    return options.search_labels * (2.0 * j / (steps - 1) - 1.0);
+  };
+
+  // Costs of every offset, plane-major.
+  std::vector<float> costs(static_cast<size_t>(steps) * n);
+  std::atomic<int> next(0);
+  auto worker = [&]() {
+    ZnccStream stream(w, h, r, num_nb, options.best_k, static_cast<float>(options.occlusion_truncation), eps,
+                      gray.data(), &windows);
+    std::vector<float> inv_row(w);
+    int last_row = -1;
+    for (;;) {
+      const int j = next.fetch_add(1);
+      if (j >= steps) break;
+      const float shift = static_cast<float>(offset(j) * inv_step);
+      float* plane = costs.data() + static_cast<size_t>(j) * n;
+      last_row = -1;
+      stream.Run(
+          [&](int k, int y, float* values, float* invalid) {
+            if (y != last_row) {
+              const float* src = inv0.data() + static_cast<size_t>(y) * w;
+              for (int x = 0; x < w; ++x) inv_row[x] = std::max(0.0f, src[x] + shift);
+              last_row = y;
+            }
+            const PlaneHomography& hm = warps[k].hom;
+            sweep::HomographyRow row;
+            const float v = y + 0.5f;
+            for (int c = 0; c < 3; ++c) {
+              row.p0[c] = hm.a[c][1] * v + hm.a[c][2] + hm.a[c][0] * 0.5f;
+              row.step[c] = hm.a[c][0];
+            }
+            sweep::WarpRowPerPixel(warps[k].gray->data(), warps[k].gray->width(), warps[k].gray->height(), row,
+                                   inv_row.data(), hm.b, w, values, invalid);
+          },
+          [&](int y) { return plane + static_cast<size_t>(y) * w; });
+    }
+  };
+  {
+    const int threads = std::max(1, std::min(num_threads, steps));
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& th : pool) th.join();
+  }
+
+  // Per pixel: the offset of least cost, a parabola through it and its two
+  // neighbours; interior minima of textured pixels move the depth.
+  const float tsig2 = static_cast<float>(options.texture_sigma * options.texture_sigma);
+  const float step_labels = static_cast<float>(2.0 * options.search_labels / (steps - 1));
+  ImageF out = depth;
+  long long refined = 0, textured = 0;
+  for (size_t p = 0; p < n; ++p) {
+    const float var = windows.variance[p];
+    if (var / (var + tsig2) < options.min_texture) continue;
+    ++textured;
+    int best = 0;
+    for (int j = 1; j < steps; ++j)
+      if (costs[static_cast<size_t>(j) * n + p] < costs[static_cast<size_t>(best) * n + p]) best = j;
+    if (best == 0 || best == steps - 1) continue;
+    const float c0 = costs[static_cast<size_t>(best - 1) * n + p];
+    const float c1 = costs[static_cast<size_t>(best) * n + p];
+    const float c2 = costs[static_cast<size_t>(best + 1) * n + p];
+    if (c1 >= 1.0f) continue;  // No neighbour sees the pixel.
+    const float den = c0 - 2.0f * c1 + c2;
+    float frac = den > 1e-9f ? 0.5f * (c0 - c2) / den : 0.0f;
+    frac = std::min(0.5f, std::max(-0.5f, frac));
+    const double labels = offset(best) + frac * step_labels;
+    const double inv = inv0[p] + labels * inv_step;
+    if (!(inv > 0)) continue;
+    out.data()[p] = static_cast<float>(1.0 / inv);
+    ++refined;
+  }
+  if (stats) {
+    stats->refined = refined;
+    stats->textured = textured;
+  }
+  return out;
+}
+
+}  // namespace casual3d::depth
+
+namespace casual3d::depth {
+
+Status BoundaryRelabelOptions::Check() const {
+  if (radius < 1 || radius > 32) return InvalidArgument("relabel radius outside [1, 32]");
+  if (window_radius < 1 || window_radius > 15) return InvalidArgument("relabel window_radius outside [1, 15]");
+  if (!(min_jump_labels >= 0 && min_jump_labels <= 1000)) return InvalidArgument("relabel min_jump_labels outside [0, 1000]");
+  if (!(sigma_color > 0 && sigma_color <= 10)) return InvalidArgument("relabel sigma_color outside (0, 10]");
+  if (!(min_gain >= 0 && min_gain <= 1)) return InvalidArgument("relabel min_gain outside [0, 1]");
+  if (best_k < 1 || best_k > 16) return InvalidArgument("relabel best_k outside [1, 16]");
+  if (!(occlusion_truncation >= 0 && occlusion_truncation <= 1))
+    return InvalidArgument("relabel occlusion_truncation outside [0, 1]");
+  if (!(ncc_epsilon >= 0 && ncc_epsilon <= 1)) return InvalidArgument("relabel ncc_epsilon outside [0, 1]");
+  if (!(texture_sigma > 0 && texture_sigma <= 1)) return InvalidArgument("relabel texture_sigma outside (0, 1]");
+  if (!(min_texture >= 0 && min_texture <= 1)) return InvalidArgument("relabel min_texture outside [0, 1]");
+  if (max_neighbors < 1 || max_neighbors > 16) return InvalidArgument("relabel max_neighbors outside [1, 16]");
+  if (window_step < 1 || window_step > window_radius)
+    return InvalidArgument("relabel window_step outside [1, window_radius]");
+  return Status::Ok();
+}
+
+namespace {
+
+// Separable running minimum and maximum over (2r+1)^2 windows clipped to the image.
+void WindowMinMax(const std::vector<float>& in, int w, int h, int r, std::vector<float>* mn, std::vector<float>* mx) {
+  const size_t n = static_cast<size_t>(w) * h;
+  std::vector<float> tmin(n), tmax(n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float a = in[static_cast<size_t>(y) * w + x], b = a;
+      for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) {
+        const float v = in[static_cast<size_t>(y) * w + u];
+        a = std::min(a, v);
+        b = std::max(b, v);
+      }
+      tmin[static_cast<size_t>(y) * w + x] = a;
+      tmax[static_cast<size_t>(y) * w + x] = b;
+    }
+  mn->assign(n, 0.0f);
+  mx->assign(n, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float a = tmin[static_cast<size_t>(y) * w + x], b = tmax[static_cast<size_t>(y) * w + x];
+      for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
+        a = std::min(a, tmin[static_cast<size_t>(v) * w + x]);
+        b = std::max(b, tmax[static_cast<size_t>(v) * w + x]);
+      }
+      (*mn)[static_cast<size_t>(y) * w + x] = a;
+      (*mx)[static_cast<size_t>(y) * w + x] = b;
+    }
+}
+
+}  // namespace
+
+ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeCamera& camera,
+                         const ImageF& depth, const std::vector<RefineNeighbor>& neighbors, double inv_step,
+                         const BoundaryRelabelOptions& options, int num_threads, long long* changed) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument("boundary relabelling: " + st.message());
+  const int w = gray.width(), h = gray.height();
+  if (color.width() != w || color.height() != h || color.channels() != 3 || depth.width() != w ||
+      depth.height() != h || camera.width != w || camera.height != h)
+    throw std::invalid_argument("boundary relabelling: images, depth map and camera differ in size");
+  if (gray.channels() != 1 || depth.channels() != 1)
+    throw std::invalid_argument("boundary relabelling: grey image and depth map need one channel");
+  if (!(inv_step > 0)) throw std::invalid_argument("boundary relabelling: inv_step must be > 0");
+  for (const RefineNeighbor& nb : neighbors)
+    if (!nb.gray || nb.gray->channels() != 1 || nb.gray->width() != nb.camera.width ||
+        nb.gray->height() != nb.camera.height)
+      throw std::invalid_argument("boundary relabelling: a neighbour's image and camera differ in size");
+  if (changed) *changed = 0;
+  if (!options.enabled || neighbors.empty()) return depth;
+  const size_t n = static_cast<size_t>(w) * h;
+  std::vector<float> inv(n);
+  for (size_t i = 0; i < n; ++i) inv[i] = 1.0f / depth.data()[i];
+  std::vector<float> inv_min, inv_max;
+  WindowMinMax(inv, w, h, options.radius, &inv_min, &inv_max);
+  const float jump = static_cast<float>(options.min_jump_labels * inv_step);
+  const float same = static_cast<float>(inv_step);
+
+  // The first max_neighbors neighbours.
+  const int K = std::min(static_cast<int>(neighbors.size()), options.max_neighbors);
+  std::vector<PlaneHomography> homs;
+  for (int k = 0; k < K; ++k) homs.push_back(ComputePlaneHomography(camera, neighbors[k].camera));
+  const int r = options.window_radius;
+  const int step = options.window_step;
+  const int side = 2 * (r / step) + 1;
+  const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
+  const float eps = static_cast<float>(options.ncc_epsilon);
+  const int best_k = std::min(options.best_k, K);
+  const float trunc = static_cast<float>(options.occlusion_truncation);
+  const double tex_s2 = options.texture_sigma * options.texture_sigma;
+
+  ImageF out = depth;
+  std::vector<long long> changed_rows(h, 0);
+  ParallelFor(0, h, std::max(1, num_threads), [&](int64_t yy) {
+    const int y = static_cast<int>(yy);
+    std::vector<float> wgt(side * side), ival(side * side);
+    std::vector<int> qx(side * side), qy(side * side);
+    std::vector<float> costs(K);
+    std::vector<std::pair<float, float>> samples;
+    for (int x = 0; x < w; ++x) {
+      const size_t p = static_cast<size_t>(y) * w + x;
+      if (inv_max[p] - inv_min[p] <= jump) continue;
+      // Only candidates at least a label away count (by default only the
+      // farther one): most pixels of a band are already on that side.
+      const float cur = inv[p];
+      const bool far_differs = cur - inv_min[p] >= same;
+      const bool near_differs = options.test_nearer && inv_max[p] - cur >= same;
+      if (!far_differs && !near_differs) continue;
+      // The colour-weighted window of the reference.
+      const float* c0 = &color.at(x, y, 0);
+      int m = 0;
+      double sw = 0, si = 0, sii = 0;
+      for (int dv = -r; dv <= r; dv += step) {
+        const int v = y + dv;
+        if (v < 0 || v >= h) continue;
+        for (int du = -r; du <= r; du += step) {
+          const int u = x + du;
+          if (u < 0 || u >= w) continue;
+          const float* c = &color.at(u, v, 0);
+          const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
+                           (c[2] - c0[2]) * (c[2] - c0[2]);
+          const float wq = std::exp(-d2 * inv2s2);
+          const float iv = gray.at(u, v);
+          wgt[m] = wq;
+          ival[m] = iv;
+          qx[m] = u;
+          qy[m] = v;
+          sw += wq;
+          si += wq * iv;
+          sii += wq * iv * iv;
+          ++m;
+        }
+      }
+      const double mi = si / sw;
+      const double vi = std::max(0.0, sii / sw - mi * mi);
+      if (vi / (vi + tex_s2) < options.min_texture) continue;
+      auto cost_of = [&](float inv_c) {
+        int valid = 0;
+        for (int k = 0; k < K; ++k) {
+          const PlaneHomography& H = homs[k];
+          const ImageF& J = *neighbors[k].gray;
+          double sj = 0, sjj = 0, sij = 0, swk = 0;
+          bool centre_seen = false;
+          for (int i = 0; i < m; ++i) {
+            const float px = qx[i] + 0.5f, py = qy[i] + 0.5f;
+            const float qz = H.a[2][0] * px + H.a[2][1] * py + H.a[2][2] + H.b[2] * inv_c;
+            if (!(qz > 1e-9f)) continue;
+            const float u = (H.a[0][0] * px + H.a[0][1] * py + H.a[0][2] + H.b[0] * inv_c) / qz - 0.5f;
+            const float v = (H.a[1][0] * px + H.a[1][1] * py + H.a[1][2] + H.b[1] * inv_c) / qz - 0.5f;
+            if (!(u >= 0.0f && v >= 0.0f && u <= J.width() - 1.001f && v <= J.height() - 1.001f)) continue;
+            if (qx[i] == x && qy[i] == y) centre_seen = true;
+            const int iu = static_cast<int>(u), iv = static_cast<int>(v);
+            const float fu = u - iu, fv = v - iv;
+            const float* row0 = J.data() + static_cast<size_t>(iv) * J.width() + iu;
+            const float* row1 = row0 + J.width();
+            const float jv = (1 - fv) * (row0[0] + fu * (row0[1] - row0[0])) + fv * (row1[0] + fu * (row1[1] - row1[0]));
+            const double wq = wgt[i];
+            swk += wq;
+            sj += wq * jv;
+            sjj += wq * jv * jv;
+            sij += wq * jv * ival[i];
+          }
+          if (!centre_seen || swk < 0.5 * sw) continue;
+          // Weighted ZNCC over the pixels the neighbour sees.
+          const double mj = sj / swk;
+          const double vj = std::max(0.0, sjj / swk - mj * mj);
+          const double cov = sij / swk - mi * mj;
+          const double z = cov / std::sqrt((vi + eps) * (vj + eps));
+          costs[valid++] = static_cast<float>(std::min(1.0, std::max(0.0, 1.0 - z)));
+        }
+        if (valid == 0) return 1.0f;
+        std::sort(costs.begin(), costs.begin() + valid);
+        const int kk = std::min(best_k, valid);
+        float s = 0;
+        for (int i = 0; i < kk; ++i) s += std::min(costs[i], costs[0] + trunc);
+        return s / kk;
+      };
+      // Candidates: the colour-weighted median of the farther depths in the
+      // band window (the surface of the pixel's own colour beyond the edge),
+      // the farthest depth, and with test_nearer the nearest.
+      float cands[3];
+      int num_cands = 0;
+      if (far_differs) {
+        samples.clear();
+        double total = 0;
+        const int R = options.radius, cs = 4;  // Every 4th pixel of the band window.
+        for (int v = std::max(0, y - R); v <= std::min(h - 1, y + R); v += cs)
+          for (int u = std::max(0, x - R); u <= std::min(w - 1, x + R); u += cs) {
+            const size_t q = static_cast<size_t>(v) * w + u;
+            if (cur - inv[q] < same) continue;
+            const float* c = &color.at(u, v, 0);
+            const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
+                             (c[2] - c0[2]) * (c[2] - c0[2]);
+            const float wq = std::exp(-d2 * inv2s2);
+            samples.push_back({inv[q], wq});
+            total += wq;
+          }
+        if (total > 0.5) {
+          std::sort(samples.begin(), samples.end());
+          double acc = 0;
+          for (const auto& sm : samples) {
+            acc += sm.second;
+            if (acc >= 0.5 * total) {
+              cands[num_cands++] = sm.first;
+              break;
+            }
+          }
+        }
+      }
+      if (far_differs) cands[num_cands++] = inv_min[p];
+      if (near_differs) cands[num_cands++] = inv_max[p];
+      const float base = cost_of(cur);
+      float best_inv = cur, best_cost = base;
+      for (int ci = 0; ci < num_cands; ++ci) {
+        const float cand = cands[ci];
+        if (std::abs(cand - cur) < same) continue;
+        if (ci > 0 && std::abs(cand - cands[0]) < 0.5f * same) continue;
+        const float c = cost_of(cand);
+        if (c < best_cost) {
+          best_cost = c;
+          best_inv = cand;
+        }
+      }
+      if (best_inv != cur && base - best_cost >= options.min_gain && best_inv > 0) {
+        out.data()[p] = 1.0f / best_inv;
+        ++changed_rows[y];
+      }
+    }
+  });
+  if (changed)
+    for (long long c : changed_rows) *changed += c;
+  return out;
+}
+
+}  // namespace casual3d::depth

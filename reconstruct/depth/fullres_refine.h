@@ -1,0 +1,125 @@
+#pragma once
+
+// Full-resolution depth refinement (ours; the paper upsamples its MRF result
+// and stops there). The sweep and the MRF run at the working resolution
+// (half the photo's by default), where one pixel of disparity is two at full
+// resolution; with a casual capture's baselines a label step is a fraction of
+// a working pixel and far content needs a fraction of a label to be within a
+// few percent of its depth. This step re-measures photo-consistency on the
+// full-resolution photos around the upsampled depth map.
+//
+// For each of `steps` offsets delta spread evenly over [-search_labels,
+// +search_labels] (in the sweep's label steps of inverse depth), every
+// window pixel q is warped into each neighbour at its own current inverse
+// depth plus delta: the window follows the current surface (slanted ground,
+// a facade seen at an angle) instead of a fronto-parallel plane, and a window
+// that straddles a depth edge samples each side at its own depth. The cost is
+// the sweep's: 1 - ZNCC of the grey images over the (2r+1)^2 window, the mean
+// of the best `best_k` neighbours that see the pixel, each capped at the best
+// one's plus `occlusion_truncation`. Per pixel the offset of least cost,
+// refined by a parabola through it and its two neighbours, moves the depth
+// when it is an interior minimum and the pixel is textured (window variance
+// weight var / (var + texture_sigma^2) at least `min_texture`); elsewhere the
+// depth stays. The search never leaves +-search_labels: the MRF decides which
+// surface a pixel shows, this step only locates it.
+//
+// Cost: steps x neighbours x pixels warps and window sums (the window sums
+// run along rows and down columns, so the radius adds no cost per pixel);
+// rows are streamed through cache-resident buffers as in the sweep.
+
+#include <vector>
+
+#include "format/image.h"
+#include "format/status.h"
+#include "reconstruct/depth/view.h"
+
+namespace casual3d::depth {
+
+struct FullResRefineOptions {
+  bool enabled = true;
+  int window_radius = 5;             // Full-resolution pixels. [1, 15].
+  double search_labels = 1.0;        // Half-width of the search, sweep label steps. (0, 8].
+  int steps = 9;                     // Offsets over the search range (odd). [3, 65].
+  int best_k = 3;                    // Neighbours averaged per pixel. [1, 16].
+  double occlusion_truncation = 0.4; // As the sweep's. [0, 1].
+  double ncc_epsilon = 2.5e-5;       // Variance added to both windows. [0, 1].
+  double texture_sigma = 0.02;       // Texture weight var / (var + sigma^2). (0, 1].
+  double min_texture = 0.3;          // Pixels with a lower texture weight keep their depth. [0, 1].
+
+  Status Check() const;
+};
+
+// Boundary relabelling (before the search above): near depth edges the
+// upsampled map inherits the working resolution's window fattening (a pole's
+// depth spread over the wall beside it, a tree's over the facade behind).
+// Each textured pixel (colour-weighted window variance weight at least
+// `min_texture`) within `radius` of a depth edge (inverse depths in its
+// (2 radius + 1)^2 band window spanning more than `min_jump_labels`) whose
+// depth is at least a label nearer than the band window's farthest tests
+// its own depth against two farther candidates: the colour-weighted median
+// of the band window's farther depths (every 4th pixel both ways, weights
+// exp(-|c_q - c_p|^2 / (2 sigma_color^2)): the surface of the pixel's own
+// colour beyond the edge) and the farthest depth; with `test_nearer` also
+// the nearest. The test is a colour-weighted ZNCC (adaptive support
+// weights, Yoon and Kweon 2006) over the matching window, with the same
+// weights, so that the pole's pixels hardly count in the wall pixel's
+// window. The candidate of least cost (mean of the best best_k of the first
+// `max_neighbors` neighbours, each capped at the best one's plus
+// occlusion_truncation) wins when it beats the current depth's cost by
+// `min_gain`. Only farther candidates by default: fattening moves the near
+// side's depth outwards.
+struct BoundaryRelabelOptions {
+  bool enabled = true;
+  // Full-resolution pixels. 20: the working resolution's fattening (the
+  // sweep's 5x5 window and the edge median's radius, doubled) plus the
+  // upsampling's. [1, 32].
+  int radius = 20;
+  // The window: every window_step-th pixel (both ways) within window_radius
+  // of the centre. 6 and 2 (49 samples over 13x13 pixels) against 5 and 1
+  // (121 over 11x11): 2.5 times fewer samples.
+  int window_radius = 6;          // Full-resolution pixels. [1, 15].
+  int window_step = 2;            // [1, window_radius].
+  double min_jump_labels = 3.0;   // [0, 1000].
+  double sigma_color = 0.06;      // RGB distance. (0, 10].
+  double min_gain = 0.05;         // Cost improvement needed to switch. [0, 1].
+  int best_k = 2;                 // [1, 16].
+  int max_neighbors = 12;         // Neighbours tested (the sweep's first ones). [1, 16].
+  double occlusion_truncation = 0.4;  // [0, 1].
+  double ncc_epsilon = 2.5e-5;    // [0, 1].
+  double texture_sigma = 0.02;    // Texture weight var / (var + sigma^2). (0, 1].
+  double min_texture = 0.1;       // [0, 1].
+  bool test_nearer = false;
+
+  Status Check() const;
+};
+
+// One neighbour: its full-resolution grey image and camera.
+struct RefineNeighbor {
+  const ImageF* gray = nullptr;
+  PinholeCamera camera;
+};
+
+struct FullResRefineStats {
+  long long refined = 0;   // Pixels whose depth moved.
+  long long textured = 0;  // Pixels with texture weight >= min_texture.
+};
+
+// `gray` is the reference photo's grey image at full resolution, `camera`
+// its camera at that size, `depth` the depth map to refine (same size,
+// metres, > 0). `inv_step` is the sweep's label step of inverse depth (1/m).
+// Returns the refined depth. Throws std::invalid_argument on bad options or
+// sizes.
+ImageF RefineFullResolution(const ImageF& gray, const PinholeCamera& camera, const ImageF& depth,
+                            const std::vector<RefineNeighbor>& neighbors, double inv_step,
+                            const FullResRefineOptions& options, int num_threads = 1,
+                            FullResRefineStats* stats = nullptr);
+
+// `color` is the reference photo at full resolution (RGB in [0, 1]), `gray`
+// its grey image, `depth` the map to relabel. Returns the relabelled map;
+// `changed` (optional) receives the number of pixels that switched.
+ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeCamera& camera,
+                         const ImageF& depth, const std::vector<RefineNeighbor>& neighbors, double inv_step,
+                         const BoundaryRelabelOptions& options, int num_threads = 1,
+                         long long* changed = nullptr);
+
+}  // namespace casual3d::depth
