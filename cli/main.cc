@@ -29,9 +29,10 @@ namespace {
 // third of the dense stage's time on a virtual machine, and glibc's
 // allocator asks for transparent huge pages (2 MiB) only when its
 // glibc.malloc.hugetlb tunable is set before the process starts
-// (docs/PERFORMANCE.md, "Huge pages"). So the command restarts itself once
-// with the tunable added, unless the environment already sets it (which also
-// stops a second restart). Nothing changes when the restart fails.
+// (docs/PERFORMANCE.md, the dense stage's huge-page figures). So the command
+// restarts itself once with the tunable added, unless the environment
+// already sets it (which also stops a second restart). Nothing changes when
+// the restart fails.
 void RestartWithHugePages(char** argv) {
 #if defined(__linux__) && defined(__GLIBC__)
   const char* tunables = std::getenv("GLIBC_TUNABLES");

@@ -58,17 +58,7 @@ struct Neighbor {
   PlaneHomography hom;
   float gain[3] = {1.0f, 1.0f, 1.0f};
 
-  // Continuous pixel-index coordinates of reference pixel centre (x, y) on
-  // the plane of inverse depth inv; false behind the camera.
-  bool Project(float x, float y, float inv, float* u, float* v) const {
-    float q[3];
-    for (int c = 0; c < 3; ++c)
-      q[c] = hom.a[c][0] * (x + 0.5f) + hom.a[c][1] * (y + 0.5f) + hom.a[c][2] + hom.b[c] * inv;
-    if (!(q[2] > 1e-9f)) return false;
-    *u = q[0] / q[2] - 0.5f;
-    *v = q[1] / q[2] - 0.5f;
-    return true;
-  }
+  bool Project(float x, float y, float inv, float* u, float* v) const { return hom.Project(x, y, inv, u, v); }
 };
 
 void EstimateGain(const ImageF& color, const ImageF& photo_weight, const ImageF& anchors, Neighbor* nb) {
@@ -222,21 +212,18 @@ EdgePoint::Kind Classify(const EdgePoint& e, int g, const std::vector<int>& grou
 // at the surface beyond once, thin occluders' not at all) and violations
 // (points farther than the plane by more than `touch`: the plane would lie
 // in front of an edge).
-void Score(const Plane& pl, const std::vector<EdgePoint>& pts, double touch, int* touching, int* violations,
-           int* owned) {
-  int t = 0, v = 0, o = 0;
+void Score(const Plane& pl, const std::vector<EdgePoint>& pts, double touch, int* touching, int* violations) {
+  int t = 0, v = 0;
   for (const EdgePoint& e : pts) {
     const double r = pl.At(e.x, e.y) - e.label;
     if (std::abs(r) <= touch) {
       t += e.owned() ? 2 : e.kind == EdgePoint::Kind::kThin ? 0 : 1;
-      o += e.owned();
     } else if (r < -touch) {
       ++v;
     }
   }
   *touching = t;
   *violations = v;
-  if (owned) *owned = o;
 }
 
 struct GroupShape {
@@ -247,10 +234,7 @@ struct GroupShape {
 
 struct PlaneFit {
   bool ok = false;
-  bool adopted = false;
   Plane plane;
-  int touching = 0, owned = 0;
-  const char* basis = "";
 };
 
 // The plane fitting of FitPlane over the points `use` accepts (violations
@@ -429,24 +413,14 @@ PlaneFit FitPlane(const std::vector<EdgePoint>& pts, const GroupShape& shape, co
                    num_labels, seed, &pl)) {
     stats(pl, &t, &o, &up, &down, &lr);
     if (o >= options.min_owned || (!sky_like && up >= side && down >= side && lr >= side)) {
-      fit.ok = true;
+      fit.ok = true;  // Silhouette or enclosed.
       fit.plane = pl;
-      fit.touching = t;
-      fit.owned = o;
-      fit.basis = o >= options.min_owned ? "silhouette" : "enclosed";
       return fit;
     }
   }
   if (sky_like) return fit;
-  if (FitPlaneOver(pts, [](const EdgePoint& e) { return e.kind == EdgePoint::Kind::kAtBeyond && e.ny > 0.5f; },
-                   shape, options, num_labels, seed + 1, &pl)) {
-    stats(pl, &t, &o, &up, &down, &lr);
-    fit.ok = true;
-    fit.plane = pl;
-    fit.touching = t;
-    fit.owned = o;
-    fit.basis = "contact";
-  }
+  fit.ok = FitPlaneOver(pts, [](const EdgePoint& e) { return e.kind == EdgePoint::Kind::kAtBeyond && e.ny > 0.5f; },
+                        shape, options, num_labels, seed + 1, &fit.plane);  // Contact.
   return fit;
 }
 
@@ -598,6 +572,10 @@ std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_wei
     ++group_area[g];
     for (int c = 0; c < 3; ++c) group_sum[g][c] += color.data()[3 * p + c];
   }
+  std::vector<std::array<float, 3>> group_colour(num_regions, {0, 0, 0});  // Mean colour.
+  for (int g = 0; g < num_regions; ++g)
+    if (group_area[g] > 0)
+      for (int c = 0; c < 3; ++c) group_colour[g][c] = static_cast<float>(group_sum[g][c] / group_area[g]);
 
   // Outward normals from the smoothed group masks, and boundary points.
   std::vector<std::vector<EdgePoint>> points(num_regions);
@@ -632,9 +610,7 @@ std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_wei
       // reaches half of its value 1.5 pixels further out (an error of half a
       // pixel there is an error of half a pixel of disparity).
       constexpr float kMaxMarch = 6.0f, kStep = 0.25f;
-      const float region_colour[3] = {static_cast<float>(group_sum[g][0] / group_area[g]),
-                                      static_cast<float>(group_sum[g][1] / group_area[g]),
-                                      static_cast<float>(group_sum[g][2] / group_area[g])};
+      const float* region_colour = group_colour[g].data();
       auto diff_at = [&](float t, float* d) {
         float s[3];
         if (!SampleRgb(color, x + t * e.nx, y + t * e.ny, s)) return false;
@@ -699,12 +675,10 @@ std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_wei
 
   // 2. Edge depths and ownership, per group.
   std::vector<std::vector<EdgePoint>> measured(num_regions);
-  std::vector<std::array<float, 3>> group_colour(num_regions);
   std::vector<int> fitted_groups, unfitted_groups;
   for (int g = 0; g < num_regions; ++g) {
     if (group_area[g] < min_area) continue;
     ++local.groups;
-    for (int c = 0; c < 3; ++c) group_colour[g][c] = static_cast<float>(group_sum[g][c] / group_area[g]);
     std::vector<EdgePoint>& pts = points[g];
     if (pts.size() > static_cast<size_t>(options.max_edge_points)) {
       std::vector<EdgePoint> kept;
@@ -756,7 +730,7 @@ std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_wei
                                   box[g][1] - box[f][3], 0});
         if (gap > options.adopt_distance) continue;
         int touching, violations;
-        Score(fits[f].plane, measured[g], options.touch_labels, &touching, &violations, nullptr);
+        Score(fits[f].plane, measured[g], options.touch_labels, &touching, &violations);
         const int np = static_cast<int>(measured[g].size());
         if (violations > static_cast<int>(std::floor((1.0 - options.behind_fraction) * np))) continue;
         if (touching > best_touching) {
@@ -764,10 +738,7 @@ std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_wei
           best = f;
         }
       }
-      if (best >= 0) {
-        fits[g] = fits[best];
-        fits[g].adopted = true;
-      }
+      if (best >= 0) fits[g] = fits[best];
     }
   }
 

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
 #include <stdexcept>
 #include <thread>
 #include <utility>
 
+#include "reconstruct/depth/near_envelope.h"
 #include "reconstruct/depth/parallel.h"
 #include "reconstruct/depth/plane_sweep.h"
 #include "reconstruct/depth/zncc_stream.h"
@@ -84,15 +84,10 @@ ImageF RefineFullResolution(const ImageF& gray, const PinholeCamera& camera, con
               for (int x = 0; x < w; ++x) inv_row[x] = std::max(0.0f, src[x] + shift);
               last_row = y;
             }
+            // The plane part at inverse depth 0; each pixel adds its own inv * b.
             const PlaneHomography& hm = warps[k].hom;
-            sweep::HomographyRow row;
-            const float v = y + 0.5f;
-            for (int c = 0; c < 3; ++c) {
-              row.p0[c] = hm.a[c][1] * v + hm.a[c][2] + hm.a[c][0] * 0.5f;
-              row.step[c] = hm.a[c][0];
-            }
-            sweep::WarpRowPerPixel(warps[k].gray->data(), warps[k].gray->width(), warps[k].gray->height(), row,
-                                   inv_row.data(), hm.b, w, values, invalid);
+            sweep::WarpRowPerPixel(warps[k].gray->data(), warps[k].gray->width(), warps[k].gray->height(),
+                                   hm.Row(y, 0.0f), inv_row.data(), hm.b, w, values, invalid);
           },
           [&](int y) { return plane + static_cast<size_t>(y) * w; });
     }
@@ -161,38 +156,6 @@ Status BoundaryRelabelOptions::Check() const {
   return Status::Ok();
 }
 
-namespace {
-
-// Separable running minimum and maximum over (2r+1)^2 windows clipped to the image.
-void WindowMinMax(const std::vector<float>& in, int w, int h, int r, std::vector<float>* mn, std::vector<float>* mx) {
-  const size_t n = static_cast<size_t>(w) * h;
-  std::vector<float> tmin(n), tmax(n);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      float a = in[static_cast<size_t>(y) * w + x], b = a;
-      for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) {
-        const float v = in[static_cast<size_t>(y) * w + u];
-        a = std::min(a, v);
-        b = std::max(b, v);
-      }
-      tmin[static_cast<size_t>(y) * w + x] = a;
-      tmax[static_cast<size_t>(y) * w + x] = b;
-    }
-  mn->assign(n, 0.0f);
-  mx->assign(n, 0.0f);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      float a = tmin[static_cast<size_t>(y) * w + x], b = tmax[static_cast<size_t>(y) * w + x];
-      for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
-        a = std::min(a, tmin[static_cast<size_t>(v) * w + x]);
-        b = std::max(b, tmax[static_cast<size_t>(v) * w + x]);
-      }
-      (*mn)[static_cast<size_t>(y) * w + x] = a;
-      (*mx)[static_cast<size_t>(y) * w + x] = b;
-    }
-}
-
-}  // namespace
 
 ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeCamera& camera,
                          const ImageF& depth, const std::vector<RefineNeighbor>& neighbors, double inv_step,
@@ -213,10 +176,19 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
   if (changed) *changed = 0;
   if (!options.enabled || neighbors.empty()) return depth;
   const size_t n = static_cast<size_t>(w) * h;
-  std::vector<float> inv(n);
-  for (size_t i = 0; i < n; ++i) inv[i] = 1.0f / depth.data()[i];
-  std::vector<float> inv_min, inv_max;
-  WindowMinMax(inv, w, h, options.radius, &inv_min, &inv_max);
+  // Inverse depth and its minimum and maximum over the band window.
+  ImageF inv_image(w, h, 1), neg_inv(w, h, 1);
+  for (size_t i = 0; i < n; ++i) {
+    inv_image.data()[i] = 1.0f / depth.data()[i];
+    neg_inv.data()[i] = -inv_image.data()[i];
+  }
+  const int diameter = 2 * options.radius + 1;
+  const ImageF min_image = MinFilter(inv_image, diameter);
+  ImageF max_image = MinFilter(neg_inv, diameter);
+  for (size_t i = 0; i < n; ++i) max_image.data()[i] = -max_image.data()[i];
+  const float* inv = inv_image.data();
+  const float* inv_min = min_image.data();
+  const float* inv_max = max_image.data();
   const float jump = static_cast<float>(options.min_jump_labels * inv_step);
   const float same = static_cast<float>(inv_step);
 
@@ -226,6 +198,9 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
   for (int k = 0; k < K; ++k) homs.push_back(ComputePlaneHomography(camera, neighbors[k].camera));
   const int r = options.window_radius;
   const int step = options.window_step;
+  // Window samples at multiples of step within r of the centre (the centre
+  // included): `side` per row and column.
+  const int reach = (r / step) * step;
   const int side = 2 * (r / step) + 1;
   const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
   const float eps = static_cast<float>(options.ncc_epsilon);
@@ -254,10 +229,10 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       const float* c0 = &color.at(x, y, 0);
       int m = 0;
       double sw = 0, si = 0, sii = 0;
-      for (int dv = -r; dv <= r; dv += step) {
+      for (int dv = -reach; dv <= reach; dv += step) {
         const int v = y + dv;
         if (v < 0 || v >= h) continue;
-        for (int du = -r; du <= r; du += step) {
+        for (int du = -reach; du <= reach; du += step) {
           const int u = x + du;
           if (u < 0 || u >= w) continue;
           const float* c = &color.at(u, v, 0);
@@ -286,11 +261,8 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
           double sj = 0, sjj = 0, sij = 0, swk = 0;
           bool centre_seen = false;
           for (int i = 0; i < m; ++i) {
-            const float px = qx[i] + 0.5f, py = qy[i] + 0.5f;
-            const float qz = H.a[2][0] * px + H.a[2][1] * py + H.a[2][2] + H.b[2] * inv_c;
-            if (!(qz > 1e-9f)) continue;
-            const float u = (H.a[0][0] * px + H.a[0][1] * py + H.a[0][2] + H.b[0] * inv_c) / qz - 0.5f;
-            const float v = (H.a[1][0] * px + H.a[1][1] * py + H.a[1][2] + H.b[1] * inv_c) / qz - 0.5f;
+            float u, v;
+            if (!H.Project(static_cast<float>(qx[i]), static_cast<float>(qy[i]), inv_c, &u, &v)) continue;
             if (!(u >= 0.0f && v >= 0.0f && u <= J.width() - 1.001f && v <= J.height() - 1.001f)) continue;
             if (qx[i] == x && qy[i] == y) centre_seen = true;
             const int iu = static_cast<int>(u), iv = static_cast<int>(v);

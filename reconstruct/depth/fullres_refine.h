@@ -74,9 +74,10 @@ struct BoundaryRelabelOptions {
   // sweep's 5x5 window and the edge median's radius, doubled) plus the
   // upsampling's. [1, 32].
   int radius = 20;
-  // The window: every window_step-th pixel (both ways) within window_radius
-  // of the centre. 6 and 2 (49 samples over 13x13 pixels) against 5 and 1
-  // (121 over 11x11): 2.5 times fewer samples.
+  // The window: the pixels at multiples of window_step from the centre (both
+  // ways, the centre included) within window_radius of it. 6 and 2 (49
+  // samples over 13x13 pixels) against 5 and 1 (121 over 11x11): 2.5 times
+  // fewer samples.
   int window_radius = 6;          // Full-resolution pixels. [1, 15].
   int window_step = 2;            // [1, window_radius].
   double min_jump_labels = 3.0;   // [0, 1000].

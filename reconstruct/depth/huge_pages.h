@@ -3,10 +3,13 @@
 // Large per-photo buffers (cost volumes, MRF unaries and messages: 50-400 MB
 // each) backed by transparent huge pages where the kernel offers them only on
 // request (/sys/kernel/mm/transparent_hugepage/enabled = madvise, Debian's
-// default). Every photo allocates these afresh, and faulting them in 4 KiB at
-// a time cost about half of the dense stage's time on a virtual machine
-// (docs/PERFORMANCE.md, "Huge pages"); 2 MiB pages need 512 times fewer
-// faults. Elsewhere (or when the kernel refuses) these are plain resizes.
+// default). Every photo allocates these afresh, and zero-filling them through
+// 4 KiB page faults took about 30% of the dense stage's CPU time on a virtual
+// machine (docs/PERFORMANCE.md, "Textureless regions, full-resolution
+// refinement, huge pages"); 2 MiB pages need 512 times fewer faults. This
+// holds for any caller of the library; the casual3d program also sets
+// glibc's malloc.hugetlb tunable (cli/main.cc), which covers the smaller
+// buffers too. Elsewhere (or when the kernel refuses) these are plain resizes.
 
 #include <cstddef>
 #include <cstdint>

@@ -15,25 +15,10 @@
 namespace casual3d::depth {
 namespace {
 
-// Per neighbour, precomputed parts of the plane-induced homography: for the
-// fronto-parallel plane Z_ref = d, x_n ~ A x_ref + (1/d) b with
-// A = K_n R_rel K_ref^-1 and b = K_n t_rel (Hartley & Zisserman, Sec. 13.1).
+// Per neighbour: its view and the plane-induced homography.
 struct NeighborWarp {
   const DenseView* view = nullptr;
-  float a[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  float b[3] = {0, 0, 0};
-
-  // Row y of the homography of the plane with inverse depth inv_d, with the
-  // pixel-centre offsets (x + 0.5, y + 0.5) folded in.
-  sweep::HomographyRow Row(int y, float inv_d) const {
-    sweep::HomographyRow row;
-    const float v = y + 0.5f;
-    for (int c = 0; c < 3; ++c) {
-      row.p0[c] = a[c][1] * v + a[c][2] + b[c] * inv_d + a[c][0] * 0.5f;
-      row.step[c] = a[c][0];
-    }
-    return row;
-  }
+  PlaneHomography hom;
 };
 
 }  // namespace
@@ -129,10 +114,8 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
 
   std::vector<NeighborWarp> warps(neighbors.size());
   for (size_t j = 0; j < neighbors.size(); ++j) {
-    const PlaneHomography hom = ComputePlaneHomography(ref.camera, neighbors[j]->camera);
     warps[j].view = neighbors[j];
-    std::copy(&hom.a[0][0], &hom.a[0][0] + 9, &warps[j].a[0][0]);
-    std::copy(hom.b, hom.b + 3, warps[j].b);
+    warps[j].hom = ComputePlaneHomography(ref.camera, neighbors[j]->camera);
   }
 
   // Planes are handed out in groups of kGroup. A thread sweeps each plane of
@@ -160,7 +143,7 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
             [&](int j, int y, float* values, float* invalid) {
               const NeighborWarp& wp = warps[j];
               sweep::WarpRow(wp.view->gray.data(), wp.view->gray.width(), wp.view->gray.height(),
-                             wp.Row(y, inv_d), w, values, invalid);
+                             wp.hom.Row(y, inv_d), w, values, invalid);
             },
             [&](int y) { return plane + static_cast<size_t>(y) * w; });
       }

@@ -30,6 +30,7 @@
 
 #include "format/image.h"
 #include "format/status.h"
+#include "reconstruct/depth/sweep_kernels.h"
 #include "reconstruct/depth/view.h"
 
 namespace casual3d::depth {
@@ -100,6 +101,29 @@ struct CostVolume {
 struct PlaneHomography {
   float a[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   float b[3] = {0, 0, 0};
+
+  // Row y of the homography of the plane with inverse depth inv_d, with the
+  // pixel-centre offsets (x + 0.5, y + 0.5) folded in (sweep::WarpRow's input).
+  sweep::HomographyRow Row(int y, float inv_d) const {
+    sweep::HomographyRow row;
+    const float v = y + 0.5f;
+    for (int c = 0; c < 3; ++c) {
+      row.p0[c] = a[c][1] * v + a[c][2] + b[c] * inv_d + a[c][0] * 0.5f;
+      row.step[c] = a[c][0];
+    }
+    return row;
+  }
+
+  // Neighbour pixel-index position (u, v) of the reference pixel (x, y)'s
+  // centre on the plane of inverse depth inv_d; false behind the neighbour.
+  bool Project(float x, float y, float inv_d, float* u, float* v) const {
+    float q[3];
+    for (int c = 0; c < 3; ++c) q[c] = a[c][0] * (x + 0.5f) + a[c][1] * (y + 0.5f) + a[c][2] + b[c] * inv_d;
+    if (!(q[2] > 1e-9f)) return false;
+    *u = q[0] / q[2] - 0.5f;
+    *v = q[1] / q[2] - 0.5f;
+    return true;
+  }
 };
 PlaneHomography ComputePlaneHomography(const PinholeCamera& ref, const PinholeCamera& neighbor);
 
