@@ -95,14 +95,22 @@ int CountValid(const ImageF& depth) {
 
 // The cost volume between the two passes, on disk as 16-bit fixed point
 // (E_photo in [0, 1]; 1/65535 resolution is far below the costs' noise).
+// The cache holds costs quantised to 16 bits, converted in chunks (no
+// second copy of the volume in memory).
+constexpr size_t kCacheChunk = size_t{1} << 20;  // Costs per chunk.
+
 void WriteCostCache(const std::string& path, const CostVolume& vol) {
-  std::vector<uint16_t> q(vol.cost.size());
-  for (size_t i = 0; i < q.size(); ++i)
-    q[i] = static_cast<uint16_t>(std::lround(std::min(1.0f, std::max(0.0f, vol.cost[i])) * 65535.0f));
   const std::string tmp = io::TemporaryPathFor(path);
   {
     std::ofstream f(tmp, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(q.data()), static_cast<std::streamsize>(q.size() * 2));
+    std::vector<uint16_t> q(std::min(kCacheChunk, vol.cost.size()));
+    for (size_t begin = 0; begin < vol.cost.size(); begin += kCacheChunk) {
+      const size_t count = std::min(kCacheChunk, vol.cost.size() - begin);
+      for (size_t i = 0; i < count; ++i)
+        q[i] = static_cast<uint16_t>(
+            std::lround(std::min(1.0f, std::max(0.0f, vol.cost[begin + i])) * 65535.0f));
+      f.write(reinterpret_cast<const char*>(q.data()), static_cast<std::streamsize>(count * 2));
+    }
     f.write(reinterpret_cast<const char*>(vol.photo_weight.data()),
             static_cast<std::streamsize>(vol.photo_weight.size() * sizeof(float)));
     if (!f) throw io::IoError(path + ": cannot write the cost cache (disk full?)");
@@ -110,17 +118,20 @@ void WriteCostCache(const std::string& path, const CostVolume& vol) {
   io::CommitTemporary(tmp, path);
 }
 
-void ReadCostCache(const std::string& path, CostVolume* vol) {
+void ReadCostCache(const std::string& path, CostVolume* vol, BufferPool* pool) {
   const size_t n = static_cast<size_t>(vol->width) * vol->height;
-  std::vector<uint16_t> q;
-  AssignHuge(&q, n * vol->num_labels);
+  const size_t total = n * vol->num_labels;
+  pool->Take(&vol->cost, total);
   vol->photo_weight = ImageF(vol->width, vol->height, 1);
   std::ifstream f(path, std::ios::binary);
-  f.read(reinterpret_cast<char*>(q.data()), static_cast<std::streamsize>(q.size() * 2));
+  std::vector<uint16_t> q(std::min(kCacheChunk, total));
+  for (size_t begin = 0; begin < total && f; begin += kCacheChunk) {
+    const size_t count = std::min(kCacheChunk, total - begin);
+    f.read(reinterpret_cast<char*>(q.data()), static_cast<std::streamsize>(count * 2));
+    for (size_t i = 0; i < count; ++i) vol->cost[begin + i] = q[i] * (1.0f / 65535.0f);
+  }
   f.read(reinterpret_cast<char*>(vol->photo_weight.data()), static_cast<std::streamsize>(n * sizeof(float)));
   if (!f) throw io::IoError(path + ": cost cache truncated");
-  AssignHuge(&vol->cost, q.size());
-  for (size_t i = 0; i < q.size(); ++i) vol->cost[i] = q[i] * (1.0f / 65535.0f);
 }
 
 ImageF ReadGroundTruth(const std::string& dir, const std::string& stem) {
@@ -236,6 +247,12 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   // Photos run `outer` at a time in both passes, `inner` threads each.
   const int outer = std::min(threads, n);
   const int inner = std::max(1, threads / outer);
+  // The big buffers (cost volume, unary, two message arrays: 200-450 MB
+  // each at the default resolution) pass from one photo to the next
+  // (huge_pages.h). `outer` idle buffers at most: on the synthetic capture
+  // at 4 neighbours, 0 / 2 / 4 kept took 57.5 / 54.2 / 53.1 s with peaks of
+  // 2.04 / 1.98 / 2.30 GB (docs/PERFORMANCE.md).
+  BufferPool pool(static_cast<size_t>(outer));
 
   // Pass 1: cost volumes and WTA depth maps of every photo (the GC filter
   // needs all WTA maps before any envelope can be built). Photos run
@@ -268,9 +285,10 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       const auto t0 = Clock::now();
       SweepOptions photo_sweep = sweep;
       photo_sweep.num_depths = num_labels[i];
-      CostVolume vol = ComputeCostVolume(ws.views[i], swept[i], photo_sweep);
+      CostVolume vol = ComputeCostVolume(ws.views[i], swept[i], photo_sweep, &pool);
       wta[i] = WinnerTakesAll(vol, photo_sweep.num_threads);
       WriteCostCache(cache_path(i), vol);
+      pool.Give(&vol.cost);
       shells[i].width = vol.width;
       shells[i].height = vol.height;
       shells[i].num_labels = vol.num_labels;
@@ -331,7 +349,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     // MRF (Eq. 1-4).
     t0 = Clock::now();
     CostVolume vol = shells[i];
-    ReadCostCache(cache_path(i), &vol);
+    ReadCostCache(cache_path(i), &vol, &pool);
     const int w = vol.width, h = vol.height, L = vol.num_labels;
     const size_t np = static_cast<size_t>(w) * h;
     GridMrf mrf;
@@ -339,7 +357,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     mrf.height = h;
     mrf.num_labels = L;
     mrf.truncation = options.mrf.truncation_labels;
-    AssignHuge(&mrf.unary, np * L);
+    pool.Take(&mrf.unary, np * L);
     // Priors for textureless regions from their silhouettes (flat_regions.h).
     std::vector<float> flat_prior;
     FlatRegionStats flat_stats;
@@ -394,9 +412,8 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       }
     TrwsOptions trws;
     trws.max_iterations = options.mrf.max_iterations;
-    const TrwsResult res = SolveTrws(mrf, trws);
-    mrf.unary.clear();
-    mrf.unary.shrink_to_fit();
+    const TrwsResult res = SolveTrws(mrf, trws, &pool);
+    pool.Give(&mrf.unary);
     pr.mrf_energy = res.energy;
     pr.mrf_iterations = res.iterations;
 
@@ -425,8 +442,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       low_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(fl[p]));
       low_conf.data()[p] = vol.photo_weight.data()[p] * std::max(0.0f, 1.0f - c[labels[p]]);
     }
-    vol.cost.clear();
-    vol.cost.shrink_to_fit();
+    pool.Give(&vol.cost);
     final_low[i] = low_depth;
     pr.t_refine = Since(t0);
 

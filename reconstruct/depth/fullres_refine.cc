@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <thread>
 #include <utility>
@@ -191,6 +192,24 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
   const float* inv_max = max_image.data();
   const float jump = static_cast<float>(options.min_jump_labels * inv_step);
   const float same = static_cast<float>(inv_step);
+  // The band: pixels within `radius` of a depth edge, two 4-neighbours
+  // whose inverse depths differ by more than `jump` (the upsampling's
+  // weighted median leaves steps there). A slope spans as much over the band
+  // window but has no such step, and is left alone.
+  std::vector<uint8_t> near_edge(n, 0);
+  {
+    ImageF neg_edge(w, h, 1, 0.0f);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t p = static_cast<size_t>(y) * w + x;
+        const float a = inv_image.data()[p];
+        if ((x + 1 < w && std::abs(a - inv_image.data()[p + 1]) > jump) ||
+            (y + 1 < h && std::abs(a - inv_image.data()[p + w]) > jump))
+          neg_edge.data()[p] = -1.0f;
+      }
+    const ImageF band = MinFilter(neg_edge, diameter);
+    for (size_t i = 0; i < n; ++i) near_edge[i] = band.data()[i] < -0.5f;
+  }
 
   // The first max_neighbors neighbours.
   const int K = std::min(static_cast<int>(neighbors.size()), options.max_neighbors);
@@ -212,13 +231,16 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
   std::vector<long long> changed_rows(h, 0);
   ParallelFor(0, h, std::max(1, num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
-    std::vector<float> wgt(side * side), ival(side * side);
-    std::vector<int> qx(side * side), qy(side * side);
+    // The window's samples, padded to a multiple of 8 with zero weights:
+    // the cost's loops run on eight samples at a time.
+    const int padded = (side * side + 7) & ~7;
+    std::vector<float> wgt(padded, 0.0f), ival(padded, 0.0f), sx(padded, 0.0f), sy(padded, 0.0f);
+    std::vector<float> us(padded), vs(padded), wk(padded), jv(padded);
     std::vector<float> costs(K);
     std::vector<std::pair<float, float>> samples;
     for (int x = 0; x < w; ++x) {
       const size_t p = static_cast<size_t>(y) * w + x;
-      if (inv_max[p] - inv_min[p] <= jump) continue;
+      if (!near_edge[p]) continue;
       // Only candidates at least a label away count (by default only the
       // farther one): most pixels of a band are already on that side.
       const float cur = inv[p];
@@ -227,7 +249,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       if (!far_differs && !near_differs) continue;
       // The colour-weighted window of the reference.
       const float* c0 = &color.at(x, y, 0);
-      int m = 0;
+      int m = 0, centre = 0;
       double sw = 0, si = 0, sii = 0;
       for (int dv = -reach; dv <= reach; dv += step) {
         const int v = y + dv;
@@ -240,16 +262,19 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
                            (c[2] - c0[2]) * (c[2] - c0[2]);
           const float wq = std::exp(-d2 * inv2s2);
           const float iv = gray.at(u, v);
+          if (du == 0 && dv == 0) centre = m;
           wgt[m] = wq;
           ival[m] = iv;
-          qx[m] = u;
-          qy[m] = v;
+          sx[m] = static_cast<float>(u) + 0.5f;  // Pixel centres.
+          sy[m] = static_cast<float>(v) + 0.5f;
           sw += wq;
           si += wq * iv;
           sii += wq * iv * iv;
           ++m;
         }
       }
+      for (int i = m; i < padded; ++i) wgt[i] = ival[i] = sx[i] = sy[i] = 0.0f;
+      const int m8 = (m + 7) & ~7;
       const double mi = si / sw;
       const double vi = std::max(0.0, sii / sw - mi * mi);
       if (vi / (vi + tex_s2) < options.min_texture) continue;
@@ -258,25 +283,56 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
         for (int k = 0; k < K; ++k) {
           const PlaneHomography& H = homs[k];
           const ImageF& J = *neighbors[k].gray;
-          double sj = 0, sjj = 0, sij = 0, swk = 0;
-          bool centre_seen = false;
-          for (int i = 0; i < m; ++i) {
-            float u, v;
-            if (!H.Project(static_cast<float>(qx[i]), static_cast<float>(qy[i]), inv_c, &u, &v)) continue;
-            if (!(u >= 0.0f && v >= 0.0f && u <= J.width() - 1.001f && v <= J.height() - 1.001f)) continue;
-            if (qx[i] == x && qy[i] == y) centre_seen = true;
-            const int iu = static_cast<int>(u), iv = static_cast<int>(v);
-            const float fu = u - iu, fv = v - iv;
-            const float* row0 = J.data() + static_cast<size_t>(iv) * J.width() + iu;
-            const float* row1 = row0 + J.width();
-            const float jv = (1 - fv) * (row0[0] + fu * (row0[1] - row0[0])) + fv * (row1[0] + fu * (row1[1] - row1[0]));
-            const double wq = wgt[i];
-            swk += wq;
-            sj += wq * jv;
-            sjj += wq * jv * jv;
-            sij += wq * jv * ival[i];
+          // Positions in the neighbour (as PlaneHomography::Project), and the
+          // weight of each sample it sees (0 outside it).
+          float r0[3], r1[3], r2[3];
+          for (int c = 0; c < 3; ++c) {
+            r0[c] = H.a[c][0];
+            r1[c] = H.a[c][1];
+            r2[c] = H.a[c][2] + H.b[c] * inv_c;
           }
-          if (!centre_seen || swk < 0.5 * sw) continue;
+          const float umax = J.width() - 1.001f, vmax = J.height() - 1.001f;
+          for (int i = 0; i < m8; ++i) {
+            const float q0 = r0[0] * sx[i] + r1[0] * sy[i] + r2[0];
+            const float q1 = r0[1] * sx[i] + r1[1] * sy[i] + r2[1];
+            const float q2 = r0[2] * sx[i] + r1[2] * sy[i] + r2[2];
+            const bool front = q2 > 1e-9f;
+            const float den = front ? q2 : 1.0f;
+            const float u = q0 / den - 0.5f, v = q1 / den - 0.5f;
+            const bool in = front && u >= 0.0f && v >= 0.0f && u <= umax && v <= vmax;
+            us[i] = in ? u : 0.0f;
+            vs[i] = in ? v : 0.0f;
+            wk[i] = in ? wgt[i] : 0.0f;
+          }
+          if (!(wk[centre] > 0.0f)) continue;
+          const float* jd = J.data();
+          const size_t jw = J.width();
+          for (int i = 0; i < m8; ++i) {
+            const int iu = static_cast<int>(us[i]), iv = static_cast<int>(vs[i]);
+            const float fu = us[i] - iu, fv = vs[i] - iv;
+            const float* row0 = jd + static_cast<size_t>(iv) * jw + iu;
+            const float* row1 = row0 + jw;
+            jv[i] = (1 - fv) * (row0[0] + fu * (row0[1] - row0[0])) + fv * (row1[0] + fu * (row1[1] - row1[0]));
+          }
+          // Weighted sums over the samples the neighbour sees, eight
+          // partial sums at a time.
+          float a_w[8] = {}, a_j[8] = {}, a_jj[8] = {}, a_ij[8] = {};
+          for (int i = 0; i < m8; i += 8)
+            for (int l = 0; l < 8; ++l) {
+              const float wq = wk[i + l], jq = jv[i + l];
+              a_w[l] += wq;
+              a_j[l] += wq * jq;
+              a_jj[l] += wq * jq * jq;
+              a_ij[l] += wq * jq * ival[i + l];
+            }
+          double swk = 0, sj = 0, sjj = 0, sij = 0;
+          for (int l = 0; l < 8; ++l) {
+            swk += a_w[l];
+            sj += a_j[l];
+            sjj += a_jj[l];
+            sij += a_ij[l];
+          }
+          if (swk < 0.5 * sw) continue;
           // Weighted ZNCC over the pixels the neighbour sees.
           const double mj = sj / swk;
           const double vj = std::max(0.0, sjj / swk - mj * mj);
@@ -326,6 +382,9 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       if (far_differs) cands[num_cands++] = inv_min[p];
       if (near_differs) cands[num_cands++] = inv_max[p];
       const float base = cost_of(cur);
+      // No candidate can beat a cost below min_gain by min_gain (costs are
+      // >= 0): skip the candidates.
+      if (base < options.min_gain) continue;
       float best_inv = cur, best_cost = base;
       for (int ci = 0; ci < num_cands; ++ci) {
         const float cand = cands[ci];

@@ -53,9 +53,10 @@ struct FullResRefineOptions {
 // upsampled map inherits the working resolution's window fattening (a pole's
 // depth spread over the wall beside it, a tree's over the facade behind).
 // Each textured pixel (colour-weighted window variance weight at least
-// `min_texture`) within `radius` of a depth edge (inverse depths in its
-// (2 radius + 1)^2 band window spanning more than `min_jump_labels`) whose
-// depth is at least a label nearer than the band window's farthest tests
+// `min_texture`) within `radius` of a depth edge (two 4-neighbours whose
+// inverse depths differ by more than `min_jump_labels`; a slope has no such
+// step) whose depth is at least a label nearer than its (2 radius + 1)^2
+// band window's farthest tests
 // its own depth against two farther candidates: the colour-weighted median
 // of the band window's farther depths (every 4th pixel both ways, weights
 // exp(-|c_q - c_p|^2 / (2 sigma_color^2)): the surface of the pixel's own
@@ -66,7 +67,8 @@ struct FullResRefineOptions {
 // window. The candidate of least cost (mean of the best best_k of the first
 // `max_neighbors` neighbours, each capped at the best one's plus
 // occlusion_truncation) wins when it beats the current depth's cost by
-// `min_gain`. Only farther candidates by default: fattening moves the near
+// `min_gain` (a current cost below min_gain skips the candidates: none can
+// win). Only farther candidates by default: fattening moves the near
 // side's depth outwards.
 struct BoundaryRelabelOptions {
   bool enabled = true;

@@ -412,6 +412,40 @@ TEST(RelabelBoundaries, RemovesFatteningWithOtherWindowSamplings) {
   CheckRemovesFattening(full);
 }
 
+// A slope is no depth edge: a depth map ramping from 2.5 m to 8 m across a
+// textured plane at 4 m spans more than min_jump_labels over every band
+// window but steps by a tenth of a label between pixels. Nothing in it is
+// tested or changed, even where the wall's depth would match better.
+TEST(RelabelBoundaries, LeavesSlopesAlone) {
+  const CostVolume grid = LabelGrid();
+  const Rig rig = MakePlaneRig(4.0);
+  ImageF ramp(kWidth, kHeight, 1);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const double inv = 1.0 / 2.5 + (1.0 / 8.0 - 1.0 / 2.5) * x / (kWidth - 1);
+      ramp.at(x, y) = static_cast<float>(1.0 / inv);
+    }
+  const BoundaryRelabelOptions opt;
+  // The ramp's span over a band window, in labels: well above min_jump_labels.
+  const double span = (1.0 / 2.5 - 1.0 / 8.0) * (2 * opt.radius) / (kWidth - 1) / InvStep(grid);
+  ASSERT_GT(span, opt.min_jump_labels);
+  long long changed = -1;
+  const ImageF out = RelabelBoundaries(rig.ref.color, rig.ref.gray, rig.ref.camera, ramp,
+                                       rig.Neighbors(), InvStep(grid), opt, 2, &changed);
+  EXPECT_EQ(changed, 0);
+  EXPECT_TRUE(SameImage(out, ramp));
+  // The same ramp with a step of 6 labels in the middle is an edge: pixels
+  // on its near side within the radius are tested, and some move to the
+  // wall (the plane at 4 m lies between the ramp's two sides there).
+  ImageF stepped = ramp;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = kWidth / 2; x < kWidth; ++x)
+      stepped.at(x, y) = static_cast<float>(1.0 / (1.0 / ramp.at(x, y) - 6 * InvStep(grid)));
+  const ImageF out2 = RelabelBoundaries(rig.ref.color, rig.ref.gray, rig.ref.camera, stepped,
+                                        rig.Neighbors(), InvStep(grid), opt, 2, &changed);
+  EXPECT_GT(changed, 0);
+}
+
 // max_neighbors: only the first neighbours count, as if the others were not given.
 TEST(RelabelBoundaries, TestsOnlyTheFirstMaxNeighbors) {
   const CostVolume grid = LabelGrid();

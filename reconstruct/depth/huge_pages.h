@@ -11,8 +11,11 @@
 // glibc's malloc.hugetlb tunable (cli/main.cc), which covers the smaller
 // buffers too. Elsewhere (or when the kernel refuses) these are plain resizes.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -48,5 +51,61 @@ void AssignHuge(std::vector<T>* v, size_t n, const T& value = T()) {
   AdviseHugePages(v->data(), n * sizeof(T));
   v->assign(n, value);
 }
+
+// Large float buffers handed back and forth between photos. Zero-filling
+// fresh pages is the kernel's work on every first touch (even with huge
+// pages: about a tenth of the dense stage's CPU time, 1.1 GB per photo);
+// a buffer that a finished photo gives back is taken by the next one with
+// its pages already in place. Holds at most `max_buffers` (the largest
+// kept); frees them on destruction. Thread-safe.
+class BufferPool {
+ public:
+  explicit BufferPool(size_t max_buffers) : max_buffers_(max_buffers) {}
+  BufferPool(const BufferPool&) = delete;
+  BufferPool& operator=(const BufferPool&) = delete;
+
+  // `*v` becomes n copies of `value`, in the smallest kept buffer that holds
+  // n floats, otherwise in a fresh allocation (AssignHuge).
+  void Take(std::vector<float>* v, size_t n, float value = 0.0f) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      size_t best = buffers_.size();
+      for (size_t i = 0; i < buffers_.size(); ++i)
+        if (buffers_[i].capacity() >= n &&
+            (best == buffers_.size() || buffers_[i].capacity() < buffers_[best].capacity()))
+          best = i;
+      if (best < buffers_.size()) {
+        v->swap(buffers_[best]);
+        buffers_.erase(buffers_.begin() + static_cast<std::ptrdiff_t>(best));
+      }
+    }
+    if (v->capacity() >= n) {
+      v->assign(n, value);
+    } else {
+      AssignHuge(v, n, value);
+    }
+  }
+
+  // Keeps `*v`'s allocation for a later Take (when it is large: 8 MiB or
+  // more); `*v` is left empty.
+  void Give(std::vector<float>* v) {
+    std::vector<float> b;
+    b.swap(*v);
+    if (b.capacity() * sizeof(float) < (size_t{8} << 20) || max_buffers_ == 0) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    buffers_.push_back(std::move(b));
+    if (buffers_.size() > max_buffers_) {
+      auto smallest = std::min_element(buffers_.begin(), buffers_.end(), [](const auto& a, const auto& c) {
+        return a.capacity() < c.capacity();
+      });
+      buffers_.erase(smallest);
+    }
+  }
+
+ private:
+  std::mutex mutex_;
+  size_t max_buffers_;
+  std::vector<std::vector<float>> buffers_;
+};
 
 }  // namespace casual3d::depth

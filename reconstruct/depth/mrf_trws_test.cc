@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <random>
 
@@ -167,6 +168,33 @@ TEST(Trws, ExactOnChains) {
     }
   }
   EXPECT_EQ(cases, 48);
+}
+
+// The AVX2 messages (where the CPU has them) and the SSE2 ones are the same
+// to the bit: labellings and every pass's energy agree exactly.
+TEST(Trws, Avx2AndSse2MessagesAgreeExactly) {
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2";
+#else
+  GTEST_SKIP() << "the AVX2 path is built with GCC on x86-64 only";
+#endif
+  TrwsOptions opt;
+  opt.max_iterations = 5;
+  opt.relative_tolerance = 0.0;
+  opt.patience = 1000;
+  int cases = 0;
+  for (int labels : {1, 3, 8, 9, 21, 64, 220})
+    for (int truncation : {1, 3, 8, 100}) {
+      const GridMrf m = RandomMrf(23, 17, labels, truncation, 77 + labels * 13 + truncation, 0.3f);
+      const TrwsResult avx2 = SolveTrws(m, opt);
+      setenv("CASUAL3D_TRWS_NO_AVX2", "1", 1);
+      const TrwsResult sse2 = SolveTrws(m, opt);
+      unsetenv("CASUAL3D_TRWS_NO_AVX2");
+      EXPECT_EQ(avx2.labels, sse2.labels) << labels << " labels, truncation " << truncation;
+      EXPECT_EQ(avx2.pass_energies, sse2.pass_energies) << labels << " labels, truncation " << truncation;
+      ++cases;
+    }
+  EXPECT_EQ(cases, 28);
 }
 
 TEST(Trws, ReportsTheEnergyOfEveryPass) {

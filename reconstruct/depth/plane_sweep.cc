@@ -56,7 +56,7 @@ PlaneHomography ComputePlaneHomography(const PinholeCamera& ref, const PinholeCa
 }
 
 CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const DenseView*>& neighbors,
-                             const SweepOptions& options) {
+                             const SweepOptions& options, BufferPool* pool) {
   const Status st = options.Check();
   if (!st.ok()) throw std::invalid_argument("plane sweep: " + st.message());
   if (neighbors.empty())
@@ -127,7 +127,11 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
   const int best_k = std::min(options.best_k, num_nb);
   const float truncation = static_cast<float>(options.occlusion_truncation);
   const int num_groups = (num_labels + kGroup - 1) / kGroup;
-  AssignHuge(&vol.cost, n * num_labels);
+  if (pool) {
+    pool->Take(&vol.cost, n * num_labels);
+  } else {
+    AssignHuge(&vol.cost, n * num_labels);
+  }
   std::atomic<int> next_group(0);
   auto worker = [&]() {
     ZnccStream stream(w, h, r, num_nb, best_k, truncation, eps, gi, &windows);

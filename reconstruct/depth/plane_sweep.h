@@ -127,11 +127,15 @@ struct PlaneHomography {
 };
 PlaneHomography ComputePlaneHomography(const PinholeCamera& ref, const PinholeCamera& neighbor);
 
+class BufferPool;  // huge_pages.h
+
 // Builds the cost volume of `ref` against `neighbors` (all at the working
 // resolution, same size or not). Requires ref.range with 0 < near < far and at
 // least one neighbour. Throws std::invalid_argument on bad options or input.
+// With a `pool`, the volume's storage comes from it (give it back with
+// BufferPool::Give when done).
 CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const DenseView*>& neighbors,
-                             const SweepOptions& options);
+                             const SweepOptions& options, BufferPool* pool = nullptr);
 
 // Winner-takes-all (Sec. 4.3.2): per pixel, the depth (metres) of the label
 // minimising E_photo, ignoring smoothness. Pixels where every label costs 1
