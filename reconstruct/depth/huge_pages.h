@@ -3,9 +3,9 @@
 // Large per-photo buffers (cost volumes, MRF unaries and messages: 50-400 MB
 // each) backed by transparent huge pages where the kernel offers them only on
 // request (/sys/kernel/mm/transparent_hugepage/enabled = madvise, Debian's
-// default). Every photo allocates these afresh, and zero-filling them through
-// 4 KiB page faults took about 30% of the dense stage's CPU time on a virtual
-// machine (docs/PERFORMANCE.md, "Textureless regions, full-resolution
+// default). A fresh allocation is zero-filled by the kernel on first touch,
+// and doing that through 4 KiB page faults took about 30% of the dense
+// stage's CPU time on a virtual machine (docs/PERFORMANCE.md, "Textureless regions, full-resolution
 // refinement, huge pages"); 2 MiB pages need 512 times fewer faults. This
 // holds for any caller of the library; the casual3d program also sets
 // glibc's malloc.hugetlb tunable (cli/main.cc), which covers the smaller
