@@ -124,11 +124,13 @@ const GridMrf& GetMrf(int width) {
   return mrfs.emplace(width, std::move(m)).first->second;
 }
 
-// Args: working width, passes (0: the default stopping rule).
+// Args: working width, passes (0: the default stopping rule), AVX2
+// messages where the CPU has them (1) or SSE2 (0).
 void BM_Trws(benchmark::State& state) {
   const int width = static_cast<int>(state.range(0));
   const GridMrf& m = GetMrf(width);
   TrwsOptions opt;
+  opt.avx2_messages = state.range(2) != 0;
   if (state.range(1) > 0) {
     opt.max_iterations = static_cast<int>(state.range(1));
     opt.relative_tolerance = 0.0;
@@ -150,9 +152,10 @@ void BM_Trws(benchmark::State& state) {
   SetCpuPerUnit(state, "cpu_s_per_photo_MP", 4.0 * pixels / 1e6);
 }
 BENCHMARK(BM_Trws)
-    ->Args({288, 8})
-    ->Args({576, 8})
-    ->Args({576, 0})
+    ->Args({288, 8, 1})
+    ->Args({576, 8, 1})
+    ->Args({576, 0, 1})
+    ->Args({576, 0, 0})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime();
 

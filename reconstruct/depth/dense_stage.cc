@@ -94,9 +94,8 @@ int CountValid(const ImageF& depth) {
 }
 
 // The cost volume between the two passes, on disk as 16-bit fixed point
-// (E_photo in [0, 1]; 1/65535 resolution is far below the costs' noise).
-// The cache holds costs quantised to 16 bits, converted in chunks (no
-// second copy of the volume in memory).
+// (E_photo in [0, 1]; 1/65535 resolution is far below the costs' noise),
+// converted in chunks (no second copy of the volume in memory).
 constexpr size_t kCacheChunk = size_t{1} << 20;  // Costs per chunk.
 
 void WriteCostCache(const std::string& path, const CostVolume& vol) {

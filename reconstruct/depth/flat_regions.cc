@@ -57,8 +57,6 @@ struct Neighbor {
   const ImageF* color = nullptr;
   PlaneHomography hom;
   float gain[3] = {1.0f, 1.0f, 1.0f};
-
-  bool Project(float x, float y, float inv, float* u, float* v) const { return hom.Project(x, y, inv, u, v); }
 };
 
 void EstimateGain(const ImageF& color, const ImageF& photo_weight, const ImageF& anchors, Neighbor* nb) {
@@ -68,7 +66,7 @@ void EstimateGain(const ImageF& color, const ImageF& photo_weight, const ImageF&
       const float d = anchors.at(x, y);
       if (!(d > 0) || photo_weight.at(x, y) < 0.5f) continue;
       float u, v, s[3];
-      if (!nb->Project(static_cast<float>(x), static_cast<float>(y), 1.0f / d, &u, &v)) continue;
+      if (!nb->hom.Project(static_cast<float>(x), static_cast<float>(y), 1.0f / d, &u, &v)) continue;
       if (!SampleRgb(*nb->color, u, v, s)) continue;
       for (int c = 0; c < 3; ++c)
         if (s[c] > 0.02f && color.at(x, y, c) > 0.02f) ratio[c].push_back(color.at(x, y, c) / s[c]);
@@ -117,8 +115,8 @@ bool MeasureEdge(const std::vector<Neighbor>& nbs, const float* region_colour, c
   std::vector<float> cost(L, 0.0f), weight(L, 0.0f);
   for (const Neighbor& nb : nbs) {
     float u0, v0, u1, v1, un, vn;
-    if (!nb.Project(e->x, e->y, inv_of[0], &u0, &v0) || !nb.Project(e->x, e->y, inv_of[L - 1], &u1, &v1) ||
-        !nb.Project(e->x + e->nx, e->y + e->ny, inv_of[L - 1], &un, &vn))
+    if (!nb.hom.Project(e->x, e->y, inv_of[0], &u0, &v0) || !nb.hom.Project(e->x, e->y, inv_of[L - 1], &u1, &v1) ||
+        !nb.hom.Project(e->x + e->nx, e->y + e->ny, inv_of[L - 1], &un, &vn))
       continue;
     float dx = un - u1, dy = vn - v1;
     const float dl = std::hypot(dx, dy);
@@ -133,7 +131,7 @@ bool MeasureEdge(const std::vector<Neighbor>& nbs, const float* region_colour, c
     const float inv_scale = 1.0f / e->scale;
     for (int k = 0; k < L; ++k) {
       float u, v;
-      if (!nb.Project(e->x, e->y, inv_of[k], &u, &v)) continue;
+      if (!nb.hom.Project(e->x, e->y, inv_of[k], &u, &v)) continue;
       float sad = 0, s[3];
       bool ok = true;
       for (int i = 0; i < kProfile && ok; ++i) {

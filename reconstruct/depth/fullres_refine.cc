@@ -178,15 +178,18 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
   if (!options.enabled || neighbors.empty()) return depth;
   const size_t n = static_cast<size_t>(w) * h;
   // Inverse depth and its minimum and maximum over the band window.
-  ImageF inv_image(w, h, 1), neg_inv(w, h, 1);
-  for (size_t i = 0; i < n; ++i) {
-    inv_image.data()[i] = 1.0f / depth.data()[i];
-    neg_inv.data()[i] = -inv_image.data()[i];
-  }
+  ImageF inv_image(w, h, 1);
+  for (size_t i = 0; i < n; ++i) inv_image.data()[i] = 1.0f / depth.data()[i];
   const int diameter = 2 * options.radius + 1;
   const ImageF min_image = MinFilter(inv_image, diameter);
-  ImageF max_image = MinFilter(neg_inv, diameter);
-  for (size_t i = 0; i < n; ++i) max_image.data()[i] = -max_image.data()[i];
+  // The maximum only serves the nearer candidate.
+  ImageF max_image;
+  if (options.test_nearer) {
+    ImageF neg_inv(w, h, 1);
+    for (size_t i = 0; i < n; ++i) neg_inv.data()[i] = -inv_image.data()[i];
+    max_image = MinFilter(neg_inv, diameter);
+    for (size_t i = 0; i < n; ++i) max_image.data()[i] = -max_image.data()[i];
+  }
   const float* inv = inv_image.data();
   const float* inv_min = min_image.data();
   const float* inv_max = max_image.data();
@@ -265,8 +268,8 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
           if (du == 0 && dv == 0) centre = m;
           wgt[m] = wq;
           ival[m] = iv;
-          sx[m] = static_cast<float>(u) + 0.5f;  // Pixel centres.
-          sy[m] = static_cast<float>(v) + 0.5f;
+          sx[m] = static_cast<float>(u);
+          sy[m] = static_cast<float>(v);
           sw += wq;
           si += wq * iv;
           sii += wq * iv * iv;
@@ -283,25 +286,14 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
         for (int k = 0; k < K; ++k) {
           const PlaneHomography& H = homs[k];
           const ImageF& J = *neighbors[k].gray;
-          // Positions in the neighbour (as PlaneHomography::Project), and the
-          // weight of each sample it sees (0 outside it).
-          float r0[3], r1[3], r2[3];
-          for (int c = 0; c < 3; ++c) {
-            r0[c] = H.a[c][0];
-            r1[c] = H.a[c][1];
-            r2[c] = H.a[c][2] + H.b[c] * inv_c;
-          }
+          // Positions in the neighbour, and the weight of each sample it
+          // sees (0 outside it or behind it: NaN fails every comparison).
+          H.ProjectMany(sx.data(), sy.data(), m8, inv_c, us.data(), vs.data());
           const float umax = J.width() - 1.001f, vmax = J.height() - 1.001f;
           for (int i = 0; i < m8; ++i) {
-            const float q0 = r0[0] * sx[i] + r1[0] * sy[i] + r2[0];
-            const float q1 = r0[1] * sx[i] + r1[1] * sy[i] + r2[1];
-            const float q2 = r0[2] * sx[i] + r1[2] * sy[i] + r2[2];
-            const bool front = q2 > 1e-9f;
-            const float den = front ? q2 : 1.0f;
-            const float u = q0 / den - 0.5f, v = q1 / den - 0.5f;
-            const bool in = front && u >= 0.0f && v >= 0.0f && u <= umax && v <= vmax;
-            us[i] = in ? u : 0.0f;
-            vs[i] = in ? v : 0.0f;
+            const bool in = us[i] >= 0.0f && vs[i] >= 0.0f && us[i] <= umax && vs[i] <= vmax;
+            us[i] = in ? us[i] : 0.0f;
+            vs[i] = in ? vs[i] : 0.0f;
             wk[i] = in ? wgt[i] : 0.0f;
           }
           if (!(wk[centre] > 0.0f)) continue;

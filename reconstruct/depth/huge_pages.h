@@ -108,4 +108,14 @@ class BufferPool {
   std::vector<std::vector<float>> buffers_;
 };
 
+// `*v` becomes n zeros, from `pool` when there is one (BufferPool::Take),
+// otherwise in a fresh allocation (AssignHuge).
+inline void TakeBuffer(BufferPool* pool, std::vector<float>* v, size_t n) {
+  if (pool) {
+    pool->Take(v, n);
+  } else {
+    AssignHuge(v, n);
+  }
+}
+
 }  // namespace casual3d::depth

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -251,14 +250,6 @@ int ArgMin(const float* c, int n) {
 #endif
 }
 
-#if defined(CASUAL3D_AVX2_MESSAGES)
-// Whether SolveTrws sends messages with AVX2 (the CPU has it, and
-// CASUAL3D_TRWS_NO_AVX2 is not set: the tests compare the two paths).
-bool UseAvx2Messages() {
-  return __builtin_cpu_supports("avx2") && std::getenv("CASUAL3D_TRWS_NO_AVX2") == nullptr;
-}
-#endif
-
 }  // namespace
 
 double MrfEnergy(const GridMrf& mrf, const std::vector<uint16_t>& labels) {
@@ -298,13 +289,8 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
   // storing both directions, and the same results.
   const int S = PaddedLabels(L);
   std::vector<float> horizontal, vertical;
-  if (pool) {
-    pool->Take(&horizontal, n * S);
-    pool->Take(&vertical, n * S);
-  } else {
-    AssignHuge(&horizontal, n * S);
-    AssignHuge(&vertical, n * S);
-  }
+  TakeBuffer(pool, &horizontal, n * S);
+  TakeBuffer(pool, &vertical, n * S);
   const std::vector<float> zeros(S, 0.0f);
   std::vector<float> belief(S, 0.0f), cost(S, kInf);
   std::vector<float> label_f(S);
@@ -328,7 +314,7 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
   // Messages from the node whose belief is in `belief` along one or two
   // edges (each holding the message towards the node; overwritten).
 #if defined(CASUAL3D_AVX2_MESSAGES)
-  const bool avx2 = UseAvx2Messages();
+  const bool avx2 = options.avx2_messages && __builtin_cpu_supports("avx2");
 #endif
   auto send = [&](float gamma, float* e0, float w0, float* e1, float w1) {
     if (e0 && e1) {
@@ -348,7 +334,15 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
     }
   };
 
-  const size_t kAhead = 2;  // Nodes ahead whose data is prefetched.
+  // Prefetching: node q's unary and the messages a pass reads at q (its own
+  // edges, and the edge from the node above when q has one).
+  const size_t kAhead = 2;  // Nodes ahead.
+  auto prefetch_node = [&](size_t q) {
+    PrefetchFloats(&mrf.unary[q * L], L);
+    PrefetchFloats(&horizontal[q * S], S);
+    PrefetchFloats(&vertical[q * S], S);
+    if (q >= static_cast<size_t>(w)) PrefetchFloats(&vertical[(q - w) * S], S);
+  };
   for (int iter = 0; iter < options.max_iterations; ++iter) {
     // Forward pass (raster order): messages to the right and down neighbours,
     // and the labelling conditioned on the already labelled left/up nodes.
@@ -359,12 +353,7 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
         float* md = &vertical[p * S];
         const float* ml = x > 0 ? &horizontal[(p - 1) * S] : zeros.data();
         const float* mu = y > 0 ? &vertical[(p - w) * S] : zeros.data();
-        if (p + kAhead < n) {
-          PrefetchFloats(&mrf.unary[(p + kAhead) * L], L);
-          PrefetchFloats(&horizontal[(p + kAhead) * S], S);
-          PrefetchFloats(&vertical[(p + kAhead) * S], S);
-          if (p + kAhead >= static_cast<size_t>(w)) PrefetchFloats(&vertical[(p + kAhead - w) * S], S);
-        }
+        if (p + kAhead < n) prefetch_node(p + kAhead);
         // Belief, and the labelling cost (Kolmogorov 2006, Sec. 5): unary,
         // messages from the nodes not yet labelled in this pass, and the
         // pairwise terms to the labelled left and up neighbours.
@@ -409,12 +398,7 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
         float* mu = y > 0 ? &vertical[(p - w) * S] : nullptr;
         const float* mr = x + 1 < w ? &horizontal[p * S] : zeros.data();
         const float* md = y + 1 < h ? &vertical[p * S] : zeros.data();
-        if (p >= kAhead) {
-          PrefetchFloats(&mrf.unary[(p - kAhead) * L], L);
-          PrefetchFloats(&horizontal[(p - kAhead) * S], S);
-          PrefetchFloats(&vertical[(p - kAhead) * S], S);
-          if (p >= kAhead + w) PrefetchFloats(&vertical[(p - kAhead - w) * S], S);
-        }
+        if (p >= kAhead) prefetch_node(p - kAhead);
         compute_belief(p, ml ? ml : zeros.data(), mr, mu ? mu : zeros.data(), md);
         const int before = (x > 0) + (y > 0), after = (x + 1 < w) + (y + 1 < h);
         const float gamma = 1.0f / static_cast<float>(std::max(1, std::max(before, after)));

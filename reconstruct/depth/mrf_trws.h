@@ -40,6 +40,9 @@ struct TrwsOptions {
   double relative_tolerance =
       1e-4;          // A pass "improves" when the best energy drops by more. [0, 1].
   int patience = 3;  // Stop after this many passes without improvement. [1, 1000].
+  // Send messages with AVX2 where the CPU has it. The results are the same to
+  // the bit either way (the tests compare the two).
+  bool avx2_messages = true;
 };
 
 struct TrwsResult {

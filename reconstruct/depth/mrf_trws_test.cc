@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <random>
 
@@ -187,9 +186,9 @@ TEST(Trws, Avx2AndSse2MessagesAgreeExactly) {
     for (int truncation : {1, 3, 8, 100}) {
       const GridMrf m = RandomMrf(23, 17, labels, truncation, 77 + labels * 13 + truncation, 0.3f);
       const TrwsResult avx2 = SolveTrws(m, opt);
-      setenv("CASUAL3D_TRWS_NO_AVX2", "1", 1);
-      const TrwsResult sse2 = SolveTrws(m, opt);
-      unsetenv("CASUAL3D_TRWS_NO_AVX2");
+      TrwsOptions sse2_opt = opt;
+      sse2_opt.avx2_messages = false;
+      const TrwsResult sse2 = SolveTrws(m, sse2_opt);
       EXPECT_EQ(avx2.labels, sse2.labels) << labels << " labels, truncation " << truncation;
       EXPECT_EQ(avx2.pass_energies, sse2.pass_energies) << labels << " labels, truncation " << truncation;
       ++cases;

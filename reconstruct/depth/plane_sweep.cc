@@ -127,11 +127,7 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
   const int best_k = std::min(options.best_k, num_nb);
   const float truncation = static_cast<float>(options.occlusion_truncation);
   const int num_groups = (num_labels + kGroup - 1) / kGroup;
-  if (pool) {
-    pool->Take(&vol.cost, n * num_labels);
-  } else {
-    AssignHuge(&vol.cost, n * num_labels);
-  }
+  TakeBuffer(pool, &vol.cost, n * num_labels);
   std::atomic<int> next_group(0);
   auto worker = [&]() {
     ZnccStream stream(w, h, r, num_nb, best_k, truncation, eps, gi, &windows);

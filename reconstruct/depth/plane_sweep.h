@@ -28,6 +28,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <limits>
+
 #include "format/image.h"
 #include "format/status.h"
 #include "reconstruct/depth/sweep_kernels.h"
@@ -114,15 +116,33 @@ struct PlaneHomography {
     return row;
   }
 
+  // Homogeneous coordinate c of the reference pixel (x, y)'s centre on the
+  // plane of inverse depth inv_d.
+  float Homogeneous(int c, float x, float y, float inv_d) const {
+    return a[c][0] * (x + 0.5f) + a[c][1] * (y + 0.5f) + a[c][2] + b[c] * inv_d;
+  }
+
   // Neighbour pixel-index position (u, v) of the reference pixel (x, y)'s
   // centre on the plane of inverse depth inv_d; false behind the neighbour.
   bool Project(float x, float y, float inv_d, float* u, float* v) const {
-    float q[3];
-    for (int c = 0; c < 3; ++c) q[c] = a[c][0] * (x + 0.5f) + a[c][1] * (y + 0.5f) + a[c][2] + b[c] * inv_d;
-    if (!(q[2] > 1e-9f)) return false;
-    *u = q[0] / q[2] - 0.5f;
-    *v = q[1] / q[2] - 0.5f;
+    const float qz = Homogeneous(2, x, y, inv_d);
+    if (!(qz > 1e-9f)) return false;
+    *u = Homogeneous(0, x, y, inv_d) / qz - 0.5f;
+    *v = Homogeneous(1, x, y, inv_d) / qz - 0.5f;
     return true;
+  }
+
+  // Project for n pixels at once, in a loop the compiler vectorises: NaN
+  // in u and v for those behind the neighbour.
+  void ProjectMany(const float* x, const float* y, int n, float inv_d, float* u, float* v) const {
+    for (int i = 0; i < n; ++i) {
+      const float qz = Homogeneous(2, x[i], y[i], inv_d);
+      const bool front = qz > 1e-9f;
+      const float den = front ? qz : 1.0f;
+      const float nan = std::numeric_limits<float>::quiet_NaN();
+      u[i] = front ? Homogeneous(0, x[i], y[i], inv_d) / den - 0.5f : nan;
+      v[i] = front ? Homogeneous(1, x[i], y[i], inv_d) / den - 0.5f : nan;
+    }
   }
 };
 PlaneHomography ComputePlaneHomography(const PinholeCamera& ref, const PinholeCamera& neighbor);
