@@ -105,9 +105,14 @@ void WriteCostCache(const std::string& path, const CostVolume& vol) {
     std::vector<uint16_t> q(std::min(kCacheChunk, vol.cost.size()));
     for (size_t begin = 0; begin < vol.cost.size(); begin += kCacheChunk) {
       const size_t count = std::min(kCacheChunk, vol.cost.size() - begin);
-      for (size_t i = 0; i < count; ++i)
-        q[i] = static_cast<uint16_t>(
-            std::lround(std::min(1.0f, std::max(0.0f, vol.cost[begin + i])) * 65535.0f));
+      // Rounded half away from zero as std::lround, in a loop that vectorises
+      // (the fraction of a float below 2^23 is exact).
+      const float* c = vol.cost.data() + begin;
+      for (size_t i = 0; i < count; ++i) {
+        const float x = std::min(1.0f, std::max(0.0f, c[i])) * 65535.0f;
+        const int t = static_cast<int>(x);
+        q[i] = static_cast<uint16_t>(t + (x - static_cast<float>(t) >= 0.5f ? 1 : 0));
+      }
       f.write(reinterpret_cast<const char*>(q.data()), static_cast<std::streamsize>(count * 2));
     }
     f.write(reinterpret_cast<const char*>(vol.photo_weight.data()),
@@ -117,19 +122,22 @@ void WriteCostCache(const std::string& path, const CostVolume& vol) {
   io::CommitTemporary(tmp, path);
 }
 
-void ReadCostCache(const std::string& path, CostVolume* vol, BufferPool* pool) {
-  const size_t n = static_cast<size_t>(vol->width) * vol->height;
-  const size_t total = n * vol->num_labels;
-  pool->Take(&vol->cost, total);
-  vol->photo_weight = ImageF(vol->width, vol->height, 1);
+// Reads a cache's costs into `*cost` (resized to `total` floats, its old
+// contents overwritten) and, when `photo_weight` is given (allocated to the
+// volume's size), its photo weights.
+void ReadCostCache(const std::string& path, size_t total, std::vector<float>* cost, ImageF* photo_weight) {
+  cost->resize(total);
   std::ifstream f(path, std::ios::binary);
   std::vector<uint16_t> q(std::min(kCacheChunk, total));
   for (size_t begin = 0; begin < total && f; begin += kCacheChunk) {
     const size_t count = std::min(kCacheChunk, total - begin);
     f.read(reinterpret_cast<char*>(q.data()), static_cast<std::streamsize>(count * 2));
-    for (size_t i = 0; i < count; ++i) vol->cost[begin + i] = q[i] * (1.0f / 65535.0f);
+    float* c = cost->data() + begin;
+    for (size_t i = 0; i < count; ++i) c[i] = q[i] * (1.0f / 65535.0f);
   }
-  f.read(reinterpret_cast<char*>(vol->photo_weight.data()), static_cast<std::streamsize>(n * sizeof(float)));
+  if (photo_weight)
+    f.read(reinterpret_cast<char*>(photo_weight->data()),
+           static_cast<std::streamsize>(photo_weight->width() * photo_weight->height() * sizeof(float)));
   if (!f) throw io::IoError(path + ": cost cache truncated");
 }
 
@@ -246,12 +254,13 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   // Photos run `outer` at a time in both passes, `inner` threads each.
   const int outer = std::min(threads, n);
   const int inner = std::max(1, threads / outer);
-  // The big buffers (cost volume, unary, two message arrays: 200-450 MB
-  // each at the default resolution) pass from one photo to the next
-  // (huge_pages.h). `outer` idle buffers at most: on the synthetic capture
-  // at 4 neighbours, 0 / 2 / 4 kept took 57.5 / 54.2 / 53.1 s with peaks of
-  // 2.04 / 1.98 / 2.30 GB (docs/PERFORMANCE.md).
-  BufferPool pool(static_cast<size_t>(outer));
+  // The big buffers (the cost volume, which the MRF's unary then takes
+  // over, and TRW-S's two message arrays: 220 MB each at the default
+  // resolution) pass from one photo to the next (huge_pages.h). Three idle
+  // buffers at most, one photo's set: on the synthetic capture at 4
+  // neighbours, 2 / 3 / 4 kept took 54.3 / 52.2 / 53.1 s with peaks of 1.56
+  // / 1.62 / 2.04 GB (docs/PERFORMANCE.md).
+  BufferPool pool(3);
 
   // Pass 1: cost volumes and WTA depth maps of every photo (the GC filter
   // needs all WTA maps before any envelope can be built). Photos run
@@ -348,15 +357,16 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     // MRF (Eq. 1-4).
     t0 = Clock::now();
     CostVolume vol = shells[i];
-    ReadCostCache(cache_path(i), &vol, &pool);
     const int w = vol.width, h = vol.height, L = vol.num_labels;
     const size_t np = static_cast<size_t>(w) * h;
+    pool.TakeForOverwrite(&vol.cost, np * L);
+    vol.photo_weight = ImageF(w, h, 1);
+    ReadCostCache(cache_path(i), np * L, &vol.cost, &vol.photo_weight);
     GridMrf mrf;
     mrf.width = w;
     mrf.height = h;
     mrf.num_labels = L;
     mrf.truncation = options.mrf.truncation_labels;
-    pool.Take(&mrf.unary, np * L);
     // Priors for textureless regions from their silhouettes (flat_regions.h).
     std::vector<float> flat_prior;
     FlatRegionStats flat_stats;
@@ -371,13 +381,16 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       pr.flat_pixels = flat_stats.pixels;
     }
     const bool near_term = options.use_near_envelope && !envelope.empty() && options.mrf.lambda_near > 0;
+    // The unary takes the costs' buffer (one buffer of 220 MB less per photo
+    // in flight, so the pool can keep them all and no page is zeroed
+    // afresh); the costs are read back from the cache after the solve.
+    mrf.unary.swap(vol.cost);
     for (size_t p = 0; p < np; ++p) {
       const float wp = vol.photo_weight.data()[p];
-      const float* c = vol.cost.data() + p * L;
       float* u = mrf.unary.data() + p * L;
       const bool has_prior = !flat_prior.empty() && !std::isnan(flat_prior[p]);
       const float bias = has_prior ? 0.0f : static_cast<float>(options.mrf.far_bias) * (1.0f - wp) / (L - 1);
-      for (int k = 0; k < L; ++k) u[k] = wp * c[k] + bias * static_cast<float>(L - 1 - k);
+      for (int k = 0; k < L; ++k) u[k] = wp * u[k] + bias * static_cast<float>(L - 1 - k);
       if (has_prior) {
         // Linear in the label distance up to flat_truncation labels.
         const float tf = static_cast<float>(options.mrf.flat_truncation_labels);
@@ -412,7 +425,8 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     TrwsOptions trws;
     trws.max_iterations = options.mrf.max_iterations;
     const TrwsResult res = SolveTrws(mrf, trws, &pool);
-    pool.Give(&mrf.unary);
+    vol.cost.swap(mrf.unary);
+    ReadCostCache(cache_path(i), np * L, &vol.cost, nullptr);
     pr.mrf_energy = res.energy;
     pr.mrf_iterations = res.iterations;
 

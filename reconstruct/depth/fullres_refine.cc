@@ -8,6 +8,7 @@
 #include <thread>
 #include <utility>
 
+#include "reconstruct/depth/avx2_clones.h"
 #include "reconstruct/depth/near_envelope.h"
 #include "reconstruct/depth/parallel.h"
 #include "reconstruct/depth/plane_sweep.h"
@@ -158,6 +159,60 @@ Status BoundaryRelabelOptions::Check() const {
 }
 
 
+namespace {
+
+// The relabelling window's m8 samples (a multiple of 8; padding has zero
+// weight) against one neighbour J at inverse depth inv_d: positions (sx, sy)
+// projected through H, each sample weighted by wgt where J sees it (0
+// outside it or behind it: NaN fails every comparison). False when J does
+// not see the centre sample; otherwise sums = {sum w, sum w j, sum w j^2,
+// sum w i j} over the samples (i: ival, the reference's grey values; j: J's,
+// bilinear). us, vs, wk, jv: scratch of m8 floats.
+CASUAL3D_AVX2_CLONES
+bool WindowSums(const PlaneHomography& H, const ImageF& J, int m8, int centre, const float* __restrict sx,
+                const float* __restrict sy, const float* __restrict wgt, const float* __restrict ival,
+                float inv_d, float* __restrict us, float* __restrict vs, float* __restrict wk,
+                float* __restrict jv, double sums[4]) {
+  H.ProjectMany(sx, sy, m8, inv_d, us, vs);
+  const float umax = J.width() - 1.001f, vmax = J.height() - 1.001f;
+  for (int i = 0; i < m8; ++i) {
+    const bool in = (us[i] >= 0.0f) & (vs[i] >= 0.0f) & (us[i] <= umax) & (vs[i] <= vmax);
+    us[i] = in ? us[i] : 0.0f;
+    vs[i] = in ? vs[i] : 0.0f;
+    wk[i] = in ? wgt[i] : 0.0f;
+  }
+  if (!(wk[centre] > 0.0f)) return false;
+  const float* jd = J.data();
+  const size_t jw = J.width();
+  for (int i = 0; i < m8; ++i) {
+    const int iu = static_cast<int>(us[i]), iv = static_cast<int>(vs[i]);
+    const float fu = us[i] - iu, fv = vs[i] - iv;
+    const float* row0 = jd + static_cast<size_t>(iv) * jw + iu;
+    const float* row1 = row0 + jw;
+    jv[i] = (1 - fv) * (row0[0] + fu * (row0[1] - row0[0])) + fv * (row1[0] + fu * (row1[1] - row1[0]));
+  }
+  // Eight partial sums at a time.
+  float a_w[8] = {}, a_j[8] = {}, a_jj[8] = {}, a_ij[8] = {};
+  for (int i = 0; i < m8; i += 8)
+    for (int l = 0; l < 8; ++l) {
+      const float wq = wk[i + l], jq = jv[i + l];
+      a_w[l] += wq;
+      a_j[l] += wq * jq;
+      a_jj[l] += wq * jq * jq;
+      a_ij[l] += wq * jq * ival[i + l];
+    }
+  sums[0] = sums[1] = sums[2] = sums[3] = 0;
+  for (int l = 0; l < 8; ++l) {
+    sums[0] += a_w[l];
+    sums[1] += a_j[l];
+    sums[2] += a_jj[l];
+    sums[3] += a_ij[l];
+  }
+  return true;
+}
+
+}  // namespace
+
 ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeCamera& camera,
                          const ImageF& depth, const std::vector<RefineNeighbor>& neighbors, double inv_step,
                          const BoundaryRelabelOptions& options, int num_threads, long long* changed) {
@@ -284,46 +339,11 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       auto cost_of = [&](float inv_c) {
         int valid = 0;
         for (int k = 0; k < K; ++k) {
-          const PlaneHomography& H = homs[k];
-          const ImageF& J = *neighbors[k].gray;
-          // Positions in the neighbour, and the weight of each sample it
-          // sees (0 outside it or behind it: NaN fails every comparison).
-          H.ProjectMany(sx.data(), sy.data(), m8, inv_c, us.data(), vs.data());
-          const float umax = J.width() - 1.001f, vmax = J.height() - 1.001f;
-          for (int i = 0; i < m8; ++i) {
-            const bool in = us[i] >= 0.0f && vs[i] >= 0.0f && us[i] <= umax && vs[i] <= vmax;
-            us[i] = in ? us[i] : 0.0f;
-            vs[i] = in ? vs[i] : 0.0f;
-            wk[i] = in ? wgt[i] : 0.0f;
-          }
-          if (!(wk[centre] > 0.0f)) continue;
-          const float* jd = J.data();
-          const size_t jw = J.width();
-          for (int i = 0; i < m8; ++i) {
-            const int iu = static_cast<int>(us[i]), iv = static_cast<int>(vs[i]);
-            const float fu = us[i] - iu, fv = vs[i] - iv;
-            const float* row0 = jd + static_cast<size_t>(iv) * jw + iu;
-            const float* row1 = row0 + jw;
-            jv[i] = (1 - fv) * (row0[0] + fu * (row0[1] - row0[0])) + fv * (row1[0] + fu * (row1[1] - row1[0]));
-          }
-          // Weighted sums over the samples the neighbour sees, eight
-          // partial sums at a time.
-          float a_w[8] = {}, a_j[8] = {}, a_jj[8] = {}, a_ij[8] = {};
-          for (int i = 0; i < m8; i += 8)
-            for (int l = 0; l < 8; ++l) {
-              const float wq = wk[i + l], jq = jv[i + l];
-              a_w[l] += wq;
-              a_j[l] += wq * jq;
-              a_jj[l] += wq * jq * jq;
-              a_ij[l] += wq * jq * ival[i + l];
-            }
-          double swk = 0, sj = 0, sjj = 0, sij = 0;
-          for (int l = 0; l < 8; ++l) {
-            swk += a_w[l];
-            sj += a_j[l];
-            sjj += a_jj[l];
-            sij += a_ij[l];
-          }
+          double sums[4];
+          if (!WindowSums(homs[k], *neighbors[k].gray, m8, centre, sx.data(), sy.data(), wgt.data(),
+                          ival.data(), inv_c, us.data(), vs.data(), wk.data(), jv.data(), sums))
+            continue;
+          const double swk = sums[0], sj = sums[1], sjj = sums[2], sij = sums[3];
           if (swk < 0.5 * sw) continue;
           // Weighted ZNCC over the pixels the neighbour sees.
           const double mj = sj / swk;
@@ -339,6 +359,10 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
         for (int i = 0; i < kk; ++i) s += std::min(costs[i], costs[0] + trunc);
         return s / kk;
       };
+      const float base = cost_of(cur);
+      // No candidate can beat a cost below min_gain by min_gain (costs are
+      // >= 0): skip the candidates.
+      if (base < options.min_gain) continue;
       // Candidates: the colour-weighted median of the farther depths in the
       // band window (the surface of the pixel's own colour beyond the edge),
       // the farthest depth, and with test_nearer the nearest.
@@ -373,10 +397,6 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       }
       if (far_differs) cands[num_cands++] = inv_min[p];
       if (near_differs) cands[num_cands++] = inv_max[p];
-      const float base = cost_of(cur);
-      // No candidate can beat a cost below min_gain by min_gain (costs are
-      // >= 0): skip the candidates.
-      if (base < options.min_gain) continue;
       float best_inv = cur, best_cost = base;
       for (int ci = 0; ci < num_cands; ++ci) {
         const float cand = cands[ci];

@@ -67,22 +67,23 @@ class BufferPool {
   // `*v` becomes n copies of `value`, in the smallest kept buffer that holds
   // n floats, otherwise in a fresh allocation (AssignHuge).
   void Take(std::vector<float>* v, size_t n, float value = 0.0f) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      size_t best = buffers_.size();
-      for (size_t i = 0; i < buffers_.size(); ++i)
-        if (buffers_[i].capacity() >= n &&
-            (best == buffers_.size() || buffers_[i].capacity() < buffers_[best].capacity()))
-          best = i;
-      if (best < buffers_.size()) {
-        v->swap(buffers_[best]);
-        buffers_.erase(buffers_.begin() + static_cast<std::ptrdiff_t>(best));
-      }
-    }
+    TakeKept(v, n);
     if (v->capacity() >= n) {
       v->assign(n, value);
     } else {
       AssignHuge(v, n, value);
+    }
+  }
+
+  // `*v` becomes n floats for the caller to overwrite: a kept buffer keeps
+  // its old contents (only a part beyond its old size is zeroed), a fresh
+  // one is zero. Saves the fill of a buffer that is written in full anyway.
+  void TakeForOverwrite(std::vector<float>* v, size_t n) {
+    TakeKept(v, n);
+    if (v->capacity() >= n) {
+      v->resize(n);
+    } else {
+      AssignHuge(v, n);
     }
   }
 
@@ -103,6 +104,20 @@ class BufferPool {
   }
 
  private:
+  // Moves the smallest kept buffer that holds n floats into `*v`, if any.
+  void TakeKept(std::vector<float>* v, size_t n) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    size_t best = buffers_.size();
+    for (size_t i = 0; i < buffers_.size(); ++i)
+      if (buffers_[i].capacity() >= n &&
+          (best == buffers_.size() || buffers_[i].capacity() < buffers_[best].capacity()))
+        best = i;
+    if (best < buffers_.size()) {
+      v->swap(buffers_[best]);
+      buffers_.erase(buffers_.begin() + static_cast<std::ptrdiff_t>(best));
+    }
+  }
+
   std::mutex mutex_;
   size_t max_buffers_;
   std::vector<std::vector<float>> buffers_;

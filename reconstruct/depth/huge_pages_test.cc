@@ -71,5 +71,29 @@ TEST(BufferPool, KeepsAtMostItsLimitAndNoSmallBuffers) {
   EXPECT_EQ(d.size(), 10u);
 }
 
+TEST(BufferPool, TakeForOverwriteReusesWithoutFilling) {
+  BufferPool pool(2);
+  std::vector<float> a;
+  pool.Take(&a, kBig, 5.0f);
+  const float* storage = a.data();
+  pool.Give(&a);
+  std::vector<float> b;
+  pool.TakeForOverwrite(&b, kBig - 10);  // Fits: the kept storage, old contents.
+  EXPECT_EQ(b.data(), storage);
+  ASSERT_EQ(b.size(), kBig - 10);
+  EXPECT_EQ(b[0], 5.0f);
+  EXPECT_EQ(b[kBig - 11], 5.0f);
+  pool.Give(&b);
+  std::vector<float> c;
+  pool.TakeForOverwrite(&c, kBig);  // Past the old size, within capacity: the tail is zero.
+  EXPECT_EQ(c.data(), storage);
+  ASSERT_EQ(c.size(), kBig);
+  EXPECT_EQ(c[kBig - 11], 5.0f);
+  EXPECT_EQ(c[kBig - 1], 0.0f);
+  std::vector<float> d;
+  pool.TakeForOverwrite(&d, 100);  // Nothing kept: a fresh, zeroed buffer.
+  EXPECT_EQ(d, std::vector<float>(100, 0.0f));
+}
+
 }  // namespace
 }  // namespace casual3d::depth

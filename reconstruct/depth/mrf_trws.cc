@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "reconstruct/depth/avx2_clones.h"
 #include "reconstruct/depth/huge_pages.h"
 
 #if defined(__SSE2__)
@@ -16,15 +17,8 @@
 #define CASUAL3D_AVX2_MESSAGES 1
 #endif
 
-// On x86-64 the solver is compiled twice, for AVX2 and for the baseline,
-// and the loader picks one (GCC function multi-versioning): the belief and
-// labelling loops run on eight labels at a time where the CPU has AVX2.
-// Without FMA in the AVX2 clone, both give bit-identical results.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__ELF__)
-#define CASUAL3D_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define CASUAL3D_AVX2_CLONES
-#endif
+// The solver has an AVX2 version (avx2_clones.h): the belief and labelling
+// loops run on eight labels at a time where the CPU has AVX2.
 
 namespace casual3d::depth {
 namespace {

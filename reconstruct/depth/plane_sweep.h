@@ -133,15 +133,32 @@ struct PlaneHomography {
   }
 
   // Project for n pixels at once, in a loop the compiler vectorises: NaN
-  // in u and v for those behind the neighbour.
-  void ProjectMany(const float* x, const float* y, int n, float inv_d, float* u, float* v) const {
+  // in u and v for those behind the neighbour. The outputs must not overlap
+  // the inputs.
+  void ProjectMany(const float* __restrict x, const float* __restrict y, int n, float inv_d, float* __restrict u,
+                   float* __restrict v) const {
+    // The coefficients in locals: stores through u and v cannot change them.
+    // The arithmetic is Homogeneous's, in the same order.
+    float c[3][4];
+    for (int r = 0; r < 3; ++r) {
+      c[r][0] = a[r][0];
+      c[r][1] = a[r][1];
+      c[r][2] = a[r][2];
+      c[r][3] = b[r] * inv_d;
+    }
+    const float nan = std::numeric_limits<float>::quiet_NaN();
     for (int i = 0; i < n; ++i) {
-      const float qz = Homogeneous(2, x[i], y[i], inv_d);
+      const float xc = x[i] + 0.5f, yc = y[i] + 0.5f;
+      const float qz = c[2][0] * xc + c[2][1] * yc + c[2][2] + c[2][3];
       const bool front = qz > 1e-9f;
       const float den = front ? qz : 1.0f;
-      const float nan = std::numeric_limits<float>::quiet_NaN();
-      u[i] = front ? Homogeneous(0, x[i], y[i], inv_d) / den - 0.5f : nan;
-      v[i] = front ? Homogeneous(1, x[i], y[i], inv_d) / den - 0.5f : nan;
+      const float qx = c[0][0] * xc + c[0][1] * yc + c[0][2] + c[0][3];
+      const float qy = c[1][0] * xc + c[1][1] * yc + c[1][2] + c[1][3];
+      // Divisions outside the selection (den is never 0), so that the
+      // compiler can vectorise the loop.
+      const float ui = qx / den - 0.5f, vi = qy / den - 0.5f;
+      u[i] = front ? ui : nan;
+      v[i] = front ? vi : nan;
     }
   }
 };

@@ -279,6 +279,53 @@ TEST(PlaneSweep, SlotMeanCapsCostsAboveTheBestPlusTheTruncation) {
   EXPECT_FALSE(opt.Check().ok());
 }
 
+TEST(SweepKernels, ZnccWindowSumsMatchThePlainSums) {
+  // Rows of 37 pixels (vector bodies and a scalar tail), radii 1-5 (fixed and
+  // generic tap counts), with and without an old row leaving the totals:
+  // every output must equal the plain scalar expression to the bit.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  const int width = 37;
+  for (int r = 1; r <= 5; ++r)
+    for (int leaves = 0; leaves <= 1; ++leaves) {
+      const int padded = width + 2 * r;
+      std::vector<float> j(padded, 0.0f), i(padded, 0.0f);
+      for (int x = r; x < r + width; ++x) {
+        j[x] = uni(rng);
+        i[x] = uni(rng);
+      }
+      std::vector<float> out[3], acc[3], old[3], want_acc[3];
+      for (int k = 0; k < 3; ++k) {
+        out[k].assign(width, -1.0f);
+        acc[k].resize(width);
+        old[k].resize(width);
+        for (int x = 0; x < width; ++x) {
+          acc[k][x] = uni(rng);
+          old[k][x] = uni(rng);
+        }
+        want_acc[k] = acc[k];
+      }
+      float* const outs[3] = {out[0].data(), out[1].data(), out[2].data()};
+      float* const accs[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
+      const float* const olds[3] = {old[0].data(), old[1].data(), old[2].data()};
+      sweep::ZnccWindowSums(j.data(), i.data(), width, r, outs, accs, leaves ? olds : nullptr);
+      for (int x = 0; x < width; ++x) {
+        float s[3] = {j[x], j[x] * j[x], j[x] * i[x]};
+        for (int d = 1; d <= 2 * r; ++d) {
+          s[0] += j[x + d];
+          s[1] += j[x + d] * j[x + d];
+          s[2] += j[x + d] * i[x + d];
+        }
+        for (int k = 0; k < 3; ++k) {
+          float a = want_acc[k][x] + s[k];
+          if (leaves) a -= old[k][x];
+          EXPECT_EQ(out[k][x], s[k]) << "r " << r << " x " << x << " sum " << k;
+          EXPECT_EQ(acc[k][x], a) << "r " << r << " x " << x << " sum " << k << " leaves " << leaves;
+        }
+      }
+    }
+}
+
 TEST(SweepKernels, PerPixelWarpMatchesThePlaneWarp) {
   // A 40x30 source with a smooth pattern; a row whose homography moves and
   // scales the pixels, part of it falling outside the source.

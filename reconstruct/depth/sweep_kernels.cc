@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "reconstruct/depth/avx2_clones.h"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #include <xmmintrin.h>
@@ -169,56 +171,71 @@ void WarpRowPerPixel(const float* src, int sw, int sh, const HomographyRow& row,
 
 namespace {
 
-// WindowSumAccumulate with the tap count known at compile time, so that the taps
-// unroll (a loop over 2r+1 taps costs more in loop overhead than in adds).
-template <int kTaps>
-void WindowSumAccumulateFixed(const float* in, int width, float* out, float* acc) {
-  int x = 0;
-#if defined(__SSE2__)
-  for (; x + 4 <= width; x += 4) {
-    __m128 s = _mm_loadu_ps(in + x);
-    for (int d = 1; d < kTaps; ++d) s = _mm_add_ps(s, _mm_loadu_ps(in + x + d));
-    _mm_storeu_ps(out + x, s);
-    _mm_storeu_ps(acc + x, _mm_add_ps(_mm_loadu_ps(acc + x), s));
-  }
-#endif
-  for (; x < width; ++x) {
-    float s = in[x];
-    for (int d = 1; d < kTaps; ++d) s += in[x + d];
-    out[x] = s;
-    acc[x] += s;
+// ZnccWindowSums with kTaps (> 0) known at compile time, so that the taps
+// unroll; 0: `taps` taps. With kSubtract, old rows leave the totals.
+template <int kTaps, bool kSubtract>
+__attribute__((always_inline)) inline void ZnccWindowSumsFixed(
+    const float* __restrict j, const float* __restrict i, int width, int taps_any, float* __restrict oj,
+    float* __restrict ojj, float* __restrict oij, float* __restrict aj, float* __restrict ajj,
+    float* __restrict aij, const float* __restrict pj, const float* __restrict pjj, const float* __restrict pij) {
+  const int taps = kTaps > 0 ? kTaps : taps_any;
+  for (int x = 0; x < width; ++x) {
+    float sj = j[x], sjj = j[x] * j[x], sij = j[x] * i[x];
+    for (int d = 1; d < taps; ++d) {
+      const float v = j[x + d];
+      sj += v;
+      sjj += v * v;
+      sij += v * i[x + d];
+    }
+    oj[x] = sj;
+    ojj[x] = sjj;
+    oij[x] = sij;
+    if constexpr (kSubtract) {
+      aj[x] = (aj[x] + sj) - pj[x];
+      ajj[x] = (ajj[x] + sjj) - pjj[x];
+      aij[x] = (aij[x] + sij) - pij[x];
+    } else {
+      aj[x] += sj;
+      ajj[x] += sjj;
+      aij[x] += sij;
+    }
   }
 }
 
-void WindowSumAccumulateAny(const float* in, int width, int taps, float* out, float* acc) {
-  for (int x = 0; x < width; ++x) {
-    float s = in[x];
-    for (int d = 1; d < taps; ++d) s += in[x + d];
-    out[x] = s;
-    acc[x] += s;
+template <bool kSubtract>
+__attribute__((always_inline)) inline void ZnccWindowSumsTaps(const float* j, const float* i, int width, int r,
+                                                              float* const out[3], float* const acc[3],
+                                                              const float* const old[3]) {
+  const float* pj = kSubtract ? old[0] : nullptr;
+  const float* pjj = kSubtract ? old[1] : nullptr;
+  const float* pij = kSubtract ? old[2] : nullptr;
+#define CASUAL3D_ZNCC_SUMS(T)                                                                                 \
+  ZnccWindowSumsFixed<T, kSubtract>(j, i, width, 2 * r + 1, out[0], out[1], out[2], acc[0], acc[1], acc[2], pj, \
+                                    pjj, pij)
+  switch (r) {
+    case 1:
+      return CASUAL3D_ZNCC_SUMS(3);
+    case 2:
+      return CASUAL3D_ZNCC_SUMS(5);
+    case 3:
+      return CASUAL3D_ZNCC_SUMS(7);
+    case 4:
+      return CASUAL3D_ZNCC_SUMS(9);
+    default:
+      return CASUAL3D_ZNCC_SUMS(0);
   }
+#undef CASUAL3D_ZNCC_SUMS
 }
 
 }  // namespace
 
-void WindowSumAccumulate(const float* in, int width, int r, float* out, float* acc) {
-  switch (r) {
-    case 1:
-      return WindowSumAccumulateFixed<3>(in, width, out, acc);
-    case 2:
-      return WindowSumAccumulateFixed<5>(in, width, out, acc);
-    case 3:
-      return WindowSumAccumulateFixed<7>(in, width, out, acc);
-    case 4:
-      return WindowSumAccumulateFixed<9>(in, width, out, acc);
-    case 5:
-      return WindowSumAccumulateFixed<11>(in, width, out, acc);
-    case 6:
-      return WindowSumAccumulateFixed<13>(in, width, out, acc);
-    case 7:
-      return WindowSumAccumulateFixed<15>(in, width, out, acc);
-    default:
-      return WindowSumAccumulateAny(in, width, 2 * r + 1, out, acc);
+CASUAL3D_AVX2_CLONES
+void ZnccWindowSums(const float* j, const float* i, int width, int r, float* const out[3], float* const acc[3],
+                    const float* const old[3]) {
+  if (old) {
+    ZnccWindowSumsTaps<true>(j, i, width, r, out, acc, old);
+  } else {
+    ZnccWindowSumsTaps<false>(j, i, width, r, out, acc, old);
   }
 }
 

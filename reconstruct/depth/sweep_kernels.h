@@ -3,8 +3,8 @@
 // Row kernels of the plane sweep (plane_sweep.cc): the loops that run once per
 // pixel x plane x neighbour. Each works on one image row held in cache, so the
 // sweep streams through a plane row by row without whole-image temporaries.
-// On x86-64 the warp, the window sums, the best-k mean and the layout change
-// use SSE2 intrinsics (the baseline of every x86-64 CPU); the other loops are
+// On x86-64 the warp, the best-k mean and the layout change use SSE2
+// intrinsics (the baseline of every x86-64 CPU); the other loops are
 // plain loops that GCC and Clang vectorise. Results do not depend on the code
 // path: every lane computes the same IEEE float expression, in the same
 // order, as the scalar fallback.
@@ -41,11 +41,16 @@ void WarpRow(const float* src, int src_width, int src_height, const HomographyRo
 void WarpRowPerPixel(const float* src, int src_width, int src_height, const HomographyRow& row,
                      const float* inv, const float b[3], int width, float* values, float* invalid);
 
-// Sums of a (2r+1)-wide window, added to a running total: out[x] = in[x] +
-// ... + in[x + 2r] and acc[x] += out[x] for x in [0, width). `in` holds
-// width + 2r elements (the row padded with r zeros on each side gives the
-// window centred on x, clipped to the row).
-void WindowSumAccumulate(const float* in, int width, int r, float* out, float* acc);
+// The three window sums of the ZNCC for one warped row at once. `j` is the
+// warped row and `i` the reference's, both padded with r zeros on each side
+// (width + 2r elements). For x in [0, width): out[0][x] is the sum of j over
+// the window [x, x + 2r], out[1][x] that of j*j and out[2][x] that of j*i
+// (each product rounded, then summed in window order), and each is added to its
+// running total acc[k][x]; with `old` (else nullptr), old[k][x] is then
+// subtracted from it: acc = (acc + out) - old. No output may overlap an
+// input.
+void ZnccWindowSums(const float* j, const float* i, int width, int r, float* const out[3], float* const acc[3],
+                    const float* const old[3]);
 
 // acc[x] -= sub[x] for x in [0, width).
 void SubtractRow(const float* sub, int width, float* acc);

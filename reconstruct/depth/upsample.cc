@@ -57,49 +57,68 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
   std::vector<float> exp_table(kTable + 2);
   for (int i = 0; i <= kTable + 1; ++i) exp_table[i] = static_cast<float>(std::exp(-kMaxT * i / kTable));
   const float to_index = kTable / kMaxT;
+  // Pixels of a row that share a low-resolution window (two in a row at
+  // half resolution) share its samples' order by value: the window's valid
+  // samples are sorted once (stably, in scanning order among equal values)
+  // and each pixel only weighs them. The weights are summed in scanning
+  // order and accumulated in sorted order, as a per-pixel insertion sort
+  // would: the result is the same to the bit.
   ParallelFor(0, hh, ResolveThreads(options.num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
-    std::vector<std::pair<float, float>> samples(static_cast<size_t>(taps) * taps);  // (value, weight)
+    const size_t max_samples = static_cast<size_t>(taps) * taps;
+    std::vector<float> value(max_samples), weight(max_samples), spatial(max_samples);
+    std::vector<const float*> colour(max_samples);
+    std::vector<int> column(max_samples), order(max_samples);
     std::vector<float> wrow(taps);
     const double v = (y + 0.5) * sy - 0.5;
     const int vc = static_cast<int>(std::lround(v));
     factors(v, vc, wrow.data());
+    const int q0 = std::max(0, vc - r), q1 = std::min(lh - 1, vc + r);
+    int window_uc = -1, count = 0;
     for (int x = 0; x < hw; ++x) {
       const int uc = ucol[x];
-      const float* wc = &wcol[static_cast<size_t>(x) * taps];
-      const float* c0 = &high_color.at(x, y, 0);
-      int count = 0;
-      float total = 0.0f;
-      for (int q = std::max(0, vc - r); q <= std::min(lh - 1, vc + r); ++q) {
-        const float wq = wrow[q - vc + r];
-        for (int p = std::max(0, uc - r); p <= std::min(lw - 1, uc + r); ++p) {
-          const float val = low.at(p, q);
-          if (!(val > 0)) continue;
-          const float* c = &low_color.at(p, q, 0);
-          const float dc = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
-                           (c[2] - c0[2]) * (c[2] - c0[2]);
-          const float t = std::min(dc * inv_sc * to_index, static_cast<float>(kTable));
-          const int i = static_cast<int>(t);
-          const float f = t - static_cast<float>(i);
-          const float wcolor = exp_table[i] + f * (exp_table[i + 1] - exp_table[i]);
-          const float wgt = wq * wc[p - uc + r] * wcolor + 1e-12f;
-          // Insertion into the samples sorted by value.
-          int k = count++;
-          while (k > 0 && samples[k - 1].first > val) {
-            samples[k] = samples[k - 1];
-            --k;
+      if (uc != window_uc || x == 0) {
+        // The window's valid samples in scanning order, then their order by value.
+        window_uc = uc;
+        count = 0;
+        for (int q = q0; q <= q1; ++q)
+          for (int p = std::max(0, uc - r); p <= std::min(lw - 1, uc + r); ++p) {
+            const float val = low.at(p, q);
+            if (!(val > 0)) continue;
+            value[count] = val;
+            colour[count] = &low_color.at(p, q, 0);
+            spatial[count] = wrow[q - vc + r];
+            column[count] = p - uc + r;
+            int k = count;
+            while (k > 0 && value[order[k - 1]] > val) {
+              order[k] = order[k - 1];
+              --k;
+            }
+            order[k] = count;
+            ++count;
           }
-          samples[k] = {val, wgt};
-          total += wgt;
-        }
       }
       if (count == 0) continue;
+      const float* wc = &wcol[static_cast<size_t>(x) * taps];
+      const float* c0 = &high_color.at(x, y, 0);
+      float total = 0.0f;
+      for (int s = 0; s < count; ++s) {
+        const float* c = colour[s];
+        const float dc = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
+                         (c[2] - c0[2]) * (c[2] - c0[2]);
+        const float t = std::min(dc * inv_sc * to_index, static_cast<float>(kTable));
+        const int i = static_cast<int>(t);
+        const float f = t - static_cast<float>(i);
+        const float wcolor = exp_table[i] + f * (exp_table[i + 1] - exp_table[i]);
+        weight[s] = spatial[s] * wc[column[s]] * wcolor + 1e-12f;
+        total += weight[s];
+      }
       float acc = 0.0f;
-      float med = samples[count - 1].first;
+      float med = value[order[count - 1]];
       for (int k = 0; k < count; ++k) {
-        acc += samples[k].second;
+        acc += weight[order[k]];
         if (acc >= 0.5f * total) {
-          med = samples[k].first;
+          med = value[order[k]];
           break;
         }
       }

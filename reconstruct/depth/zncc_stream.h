@@ -45,8 +45,7 @@ class ZnccStream {
         windows_(windows),
         rows_(num_neighbors, Rows(width, radius)),
         pad_j_(width + 2 * radius, 0.0f),
-        pad_jj_(pad_j_.size(), 0.0f),
-        pad_ij_(pad_j_.size(), 0.0f),
+        pad_i_(pad_j_.size(), 0.0f),
         cost_row_(width),
         slots_(static_cast<size_t>(best_k_) * width) {}
 
@@ -62,32 +61,30 @@ class ZnccStream {
       std::fill(nr.acc_jj.begin(), nr.acc_jj.end(), 0.0f);
       std::fill(nr.acc_ij.begin(), nr.acc_ij.end(), 0.0f);
     }
-    // Row yi enters the window sums; row yo = yi - r leaves complete.
+    // Row yi enters the window sums; row yo = yi - r leaves complete, and
+    // row yo - r - 1 leaves the running sums.
     for (int yi = 0; yi < h_ + r; ++yi) {
       const int yo = yi - r;
       if (yo >= 0) std::fill(slots_.begin(), slots_.end(), sweep::kInvalidCost);
+      if (yi < h_) std::copy(gray_ + static_cast<size_t>(yi) * w, gray_ + static_cast<size_t>(yi + 1) * w,
+                             pad_i_.begin() + r);
       for (size_t j = 0; j < rows_.size(); ++j) {
         Rows& nr = rows_[j];
+        const bool leaves = yo - r - 1 >= 0;
+        const size_t old = leaves ? static_cast<size_t>((yo - r - 1) % nr.ring_rows) * w : 0;
         if (yi < h_) {
           const size_t slot = static_cast<size_t>(yi % nr.ring_rows) * w;
           warp(static_cast<int>(j), yi, pad_j_.data() + r, nr.ring_invalid.data() + slot);
-          const float* gi_row = gray_ + static_cast<size_t>(yi) * w;
-          for (int x = 0; x < w; ++x) {
-            const float jv = pad_j_[r + x];
-            pad_jj_[r + x] = jv * jv;
-            pad_ij_[r + x] = jv * gi_row[x];
-          }
-          sweep::WindowSumAccumulate(pad_j_.data(), w, r, nr.ring_j.data() + slot, nr.acc_j.data());
-          sweep::WindowSumAccumulate(pad_jj_.data(), w, r, nr.ring_jj.data() + slot, nr.acc_jj.data());
-          sweep::WindowSumAccumulate(pad_ij_.data(), w, r, nr.ring_ij.data() + slot, nr.acc_ij.data());
-        }
-        if (yo < 0) continue;
-        if (yo - r - 1 >= 0) {
-          const size_t old = static_cast<size_t>((yo - r - 1) % nr.ring_rows) * w;
+          float* const out[3] = {nr.ring_j.data() + slot, nr.ring_jj.data() + slot, nr.ring_ij.data() + slot};
+          float* const acc[3] = {nr.acc_j.data(), nr.acc_jj.data(), nr.acc_ij.data()};
+          const float* const gone[3] = {nr.ring_j.data() + old, nr.ring_jj.data() + old, nr.ring_ij.data() + old};
+          sweep::ZnccWindowSums(pad_j_.data(), pad_i_.data(), w, r, out, acc, leaves ? gone : nullptr);
+        } else if (leaves) {
           sweep::SubtractRow(nr.ring_j.data() + old, w, nr.acc_j.data());
           sweep::SubtractRow(nr.ring_jj.data() + old, w, nr.acc_jj.data());
           sweep::SubtractRow(nr.ring_ij.data() + old, w, nr.acc_ij.data());
         }
+        if (yo < 0) continue;
         const size_t o = static_cast<size_t>(yo) * w;
         sweep::ZnccRowInputs in;
         in.sum_j = nr.acc_j.data();
@@ -129,8 +126,8 @@ class ZnccStream {
   const float* gray_;
   const ReferenceWindows* windows_;
   std::vector<Rows> rows_;
-  // Rows padded with r zeros on both sides: J, J^2 and I*J.
-  std::vector<float> pad_j_, pad_jj_, pad_ij_;
+  // Rows padded with r zeros on both sides: J and I.
+  std::vector<float> pad_j_, pad_i_;
   std::vector<float> cost_row_, slots_;
 };
 
