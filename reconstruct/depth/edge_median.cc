@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "reconstruct/depth/fast_exp.h"
 #include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
@@ -37,20 +38,27 @@ std::vector<int> EdgeAwareMedian(const std::vector<int>& labels, int num_labels,
   ParallelFor(0, h, ResolveThreads(num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
     std::vector<float> hist(num_labels, 0.0f);
+    std::vector<float> wgt(2 * r + 1);
     for (int x = 0; x < w; ++x) {
       const float* c0 = &color.at(x, y, 0);
       float total = 0.0f;
       int kmin = num_labels, kmax = -1;
+      const int u0 = std::max(0, x - r), u1 = std::min(w - 1, x + r);
       for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
+        // The row's weights in a loop that vectorises, then the histogram.
         const float* srow = spatial.data() + (v - y + r) * (2 * r + 1) + r - x;
-        for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) {
-          const float* c = &color.at(u, v, 0);
+        const float* crow = color.row(v);
+        for (int u = u0; u <= u1; ++u) {
+          const float* c = crow + 3 * u;
           const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
                            (c[2] - c0[2]) * (c[2] - c0[2]);
-          const float wgt = srow[u] * std::exp(-d2 * inv2s2);
-          const int k = labels[static_cast<size_t>(v) * w + u];
-          hist[k] += wgt;
-          total += wgt;
+          wgt[u - u0] = srow[u] * ExpNonPositive(-d2 * inv2s2);
+        }
+        const int* lrow = labels.data() + static_cast<size_t>(v) * w;
+        for (int u = u0; u <= u1; ++u) {
+          const int k = lrow[u];
+          hist[k] += wgt[u - u0];
+          total += wgt[u - u0];
           kmin = std::min(kmin, k);
           kmax = std::max(kmax, k);
         }

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "reconstruct/depth/avx2_clones.h"
+#include "reconstruct/depth/fast_exp.h"
 #include "reconstruct/depth/near_envelope.h"
 #include "reconstruct/depth/parallel.h"
 #include "reconstruct/depth/plane_sweep.h"
@@ -318,7 +319,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
           const float* c = &color.at(u, v, 0);
           const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
                            (c[2] - c0[2]) * (c[2] - c0[2]);
-          const float wq = std::exp(-d2 * inv2s2);
+          const float wq = ExpNonPositive(-d2 * inv2s2);
           const float iv = gray.at(u, v);
           if (du == 0 && dv == 0) centre = m;
           wgt[m] = wq;
@@ -379,7 +380,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
             const float* c = &color.at(u, v, 0);
             const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
                              (c[2] - c0[2]) * (c[2] - c0[2]);
-            const float wq = std::exp(-d2 * inv2s2);
+            const float wq = ExpNonPositive(-d2 * inv2s2);
             samples.push_back({inv[q], wq});
             total += wq;
           }

@@ -239,12 +239,14 @@ void ZnccWindowSums(const float* j, const float* i, int width, int r, float* con
   }
 }
 
+CASUAL3D_AVX2_CLONES
 void SubtractRow(const float* sub, int width, float* acc) {
   const float* __restrict a = sub;
   float* __restrict out = acc;
   for (int x = 0; x < width; ++x) out[x] -= a[x];
 }
 
+CASUAL3D_AVX2_CLONES
 void ZnccCostRow(const ZnccRowInputs& in, float epsilon, int width, float* cost) {
   const float* __restrict sj = in.sum_j;
   const float* __restrict sjj = in.sum_jj;
@@ -264,6 +266,7 @@ void ZnccCostRow(const ZnccRowInputs& in, float epsilon, int width, float* cost)
   }
 }
 
+CASUAL3D_AVX2_CLONES
 void InsertSmallest(const float* cost, int width, int k, float* slots) {
   // A branch-free insertion step per slot (the smaller value stays, the
   // larger moves on to the next slot), so that the loop over pixels
