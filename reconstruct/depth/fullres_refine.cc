@@ -306,8 +306,15 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       const bool far_differs = cur - inv_min[p] >= same;
       const bool near_differs = options.test_nearer && inv_max[p] - cur >= same;
       if (!far_differs && !near_differs) continue;
-      // The colour-weighted window of the reference.
+      // The colour-weighted window of the reference: pixel (u, v) weighs
+      // exp(-|c_uv - c_xy|^2 / (2 sigma_color^2)).
       const float* c0 = &color.at(x, y, 0);
+      auto colour_weight = [&](int u, int v) {
+        const float* c = &color.at(u, v, 0);
+        const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
+                         (c[2] - c0[2]) * (c[2] - c0[2]);
+        return ExpNonPositive(-d2 * inv2s2);
+      };
       int m = 0, centre = 0;
       double sw = 0, si = 0, sii = 0;
       for (int dv = -reach; dv <= reach; dv += step) {
@@ -316,10 +323,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
         for (int du = -reach; du <= reach; du += step) {
           const int u = x + du;
           if (u < 0 || u >= w) continue;
-          const float* c = &color.at(u, v, 0);
-          const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
-                           (c[2] - c0[2]) * (c[2] - c0[2]);
-          const float wq = ExpNonPositive(-d2 * inv2s2);
+          const float wq = colour_weight(u, v);
           const float iv = gray.at(u, v);
           if (du == 0 && dv == 0) centre = m;
           wgt[m] = wq;
@@ -377,10 +381,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
           for (int u = std::max(0, x - R); u <= std::min(w - 1, x + R); u += cs) {
             const size_t q = static_cast<size_t>(v) * w + u;
             if (cur - inv[q] < same) continue;
-            const float* c = &color.at(u, v, 0);
-            const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
-                             (c[2] - c0[2]) * (c[2] - c0[2]);
-            const float wq = ExpNonPositive(-d2 * inv2s2);
+            const float wq = colour_weight(u, v);
             samples.push_back({inv[q], wq});
             total += wq;
           }

@@ -59,9 +59,9 @@ struct FullResRefineOptions {
 // `min_texture`) within `radius` of a depth edge (two 4-neighbours whose
 // inverse depths differ by more than `min_jump_labels`; a slope has no such
 // step) whose depth is at least a label nearer than its (2 radius + 1)^2
-// band window's farthest tests
-// its own depth against two farther candidates: the colour-weighted median
-// of the band window's farther depths (every 4th pixel both ways, weights
+// band window's farthest tests its own depth against two farther
+// candidates: the colour-weighted median of the band window's farther
+// depths (every 4th pixel both ways, weights
 // exp(-|c_q - c_p|^2 / (2 sigma_color^2)): the surface of the pixel's own
 // colour beyond the edge) and the farthest depth; with `test_nearer` also
 // the nearest. The test is a colour-weighted ZNCC (adaptive support

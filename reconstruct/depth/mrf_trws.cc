@@ -37,6 +37,14 @@ int PaddedLabels(int num_labels) { return (num_labels + 7) & ~7; }
 // by the lower-envelope distance transform of Felzenszwalb and Huttenlocher
 // (2006): a forward and a backward min-plus recursion, then the truncation
 // as a cap. Requires w_e >= 0.
+#if defined(__SSE2__)
+// The ramps (1, 2, 3, 4) w and (4, 3, 2, 1) w over a vector's lanes: the
+// terms that reach a block's lanes from the carry before it (forward pass)
+// or after it (backward pass).
+inline __m128 RampUp(float w) { return _mm_set_ps(4.0f * w, 3.0f * w, 2.0f * w, w); }
+inline __m128 RampDown(float w) { return _mm_set_ps(w, 2.0f * w, 3.0f * w, 4.0f * w); }
+#endif
+
 template <int kCount>
 void SendMessages(const float* belief, float gamma, int num_labels, int padded, float* const* edges,
                   const float* weights, int truncation) {
@@ -56,8 +64,8 @@ void SendMessages(const float* belief, float gamma, int num_labels, int padded, 
     const float w = weights[e];
     w1[e] = _mm_set1_ps(w);
     w4[e] = _mm_set1_ps(4.0f * w);
-    up[e] = _mm_set_ps(4.0f * w, 3.0f * w, 2.0f * w, w);
-    down[e] = _mm_set_ps(w, 2.0f * w, 3.0f * w, 4.0f * w);
+    up[e] = RampUp(w);
+    down[e] = RampDown(w);
     carry[e] = inf;
     hmin[e] = inf;
   }
@@ -162,10 +170,11 @@ __attribute__((target("avx2"))) void SendMessagesAvx2(const float* belief, float
     const float w = weights[e];
     w1[e] = _mm256_set1_ps(w);
     w4[e] = _mm_set1_ps(4.0f * w);
-    up[e] = _mm_set_ps(4.0f * w, 3.0f * w, 2.0f * w, w);
-    down[e] = _mm_set_ps(w, 2.0f * w, 3.0f * w, 4.0f * w);
-    up_hi[e] = _mm256_set_ps(4.0f * w, 3.0f * w, 2.0f * w, w, kInf, kInf, kInf, kInf);
-    down_lo[e] = _mm256_set_ps(kInf, kInf, kInf, kInf, w, 2.0f * w, 3.0f * w, 4.0f * w);
+    up[e] = RampUp(w);
+    down[e] = RampDown(w);
+    // The ramps in the upper (lower) half, +inf in the other.
+    up_hi[e] = _mm256_insertf128_ps(inf8, up[e], 1);
+    down_lo[e] = _mm256_insertf128_ps(inf8, down[e], 0);
     carry[e] = _mm_set1_ps(kInf);
     hmin[e] = inf8;
   }

@@ -26,9 +26,8 @@
 // thread.
 
 #include <cstdint>
-#include <vector>
-
 #include <limits>
+#include <vector>
 
 #include "format/image.h"
 #include "format/status.h"

@@ -280,13 +280,13 @@ TEST(PlaneSweep, SlotMeanCapsCostsAboveTheBestPlusTheTruncation) {
 }
 
 TEST(SweepKernels, ZnccWindowSumsMatchThePlainSums) {
-  // Rows of 37 pixels (vector bodies and a scalar tail), radii 1-5 (fixed and
+  // Rows of 37 pixels (vector bodies and a scalar tail), radii 1-9 (fixed and
   // generic tap counts), with and without an old row leaving the totals:
   // every output must equal the plain scalar expression to the bit.
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   const int width = 37;
-  for (int r = 1; r <= 5; ++r)
+  for (int r = 1; r <= 9; ++r)
     for (int leaves = 0; leaves <= 1; ++leaves) {
       const int padded = width + 2 * r;
       std::vector<float> j(padded, 0.0f), i(padded, 0.0f);

@@ -221,6 +221,12 @@ __attribute__((always_inline)) inline void ZnccWindowSumsTaps(const float* j, co
       return CASUAL3D_ZNCC_SUMS(7);
     case 4:
       return CASUAL3D_ZNCC_SUMS(9);
+    case 5:  // The full-resolution search's 11x11 window.
+      return CASUAL3D_ZNCC_SUMS(11);
+    case 6:
+      return CASUAL3D_ZNCC_SUMS(13);
+    case 7:
+      return CASUAL3D_ZNCC_SUMS(15);
     default:
       return CASUAL3D_ZNCC_SUMS(0);
   }

@@ -74,10 +74,10 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
     const int vc = static_cast<int>(std::lround(v));
     factors(v, vc, wrow.data());
     const int q0 = std::max(0, vc - r), q1 = std::min(lh - 1, vc + r);
-    int window_uc = -1, count = 0;
+    int window_uc = -1, count = 0;  // No window yet: every ucol is >= 0.
     for (int x = 0; x < hw; ++x) {
       const int uc = ucol[x];
-      if (uc != window_uc || x == 0) {
+      if (uc != window_uc) {
         // The window's valid samples in scanning order, then their order by value.
         window_uc = uc;
         count = 0;
