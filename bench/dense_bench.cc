@@ -2,8 +2,8 @@
 // (220 hypotheses, 4 neighbours), the WTA, the near-envelope filters and
 // solver, TRW-S and the upsampling, on a ray-cast toy scene at the working
 // resolution of a 1152x864 photo (576x432 at the default working scale 0.5);
-// the boundary relabelling and the full-resolution search at the photo's
-// resolution.
+// the boundary relabelling, the full-resolution search and the free-space
+// check at the photo's resolution.
 // Counters: seconds per megapixel of the photo (4x the working pixels); for
 // the sweep and TRW-S, CPU time of the whole process (all threads) per unit
 // of work: per pixel x label x neighbour (sweep) and per pixel x label x pass
@@ -26,6 +26,7 @@
 #include "reconstruct/depth/plane_sweep.h"
 #include "reconstruct/depth/testing/toy_scene.h"
 #include "reconstruct/depth/upsample.h"
+#include "reconstruct/depth/visibility_filter.h"
 
 namespace casual3d::depth {
 namespace {
@@ -260,6 +261,50 @@ void BM_FullResRefine(benchmark::State& state) {
   SetPerMegapixel(state, width);
 }
 BENCHMARK(BM_FullResRefine)->Arg(576)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The free-space check of one photo-sized map against 12 others (its default
+// number of views): a reference ring of 13 cameras, the reference's map
+// fattened as above (its edge bands are what the check flags), the others
+// exact. Counters: pixels flagged and moved back.
+void BM_FreeSpace(benchmark::State& state) {
+  const int width = 2 * static_cast<int>(state.range(0)), height = width * 3 / 4;
+  static std::map<int, std::pair<std::vector<DenseView>, std::vector<ImageF>>> rings;
+  auto& ring = rings[width];
+  if (ring.first.empty()) {
+    const testing::ToyScene scene = testing::ToyScene::Default();
+    for (int k = 0; k < 13; ++k) {
+      const double a = 2 * M_PI * k / 12;
+      const Eigen::Vector3d c = k == 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.15 * std::cos(a), 0.15 * std::sin(a), 0);
+      ImageF d;
+      ring.first.push_back(testing::MakeView(scene, testing::ToyCamera(c, width, height, 0.785 * width), {0.5, 50.0},
+                                             1.0, 0.0, &d));
+      for (float& z : d.vector())
+        if (!std::isfinite(z)) z = 50.0f;
+      ring.second.push_back(std::move(d));
+    }
+    ring.second[0] = GetFullResInput(width).depth;
+  }
+  std::vector<const PinholeCamera*> cameras;
+  std::vector<const ImageF*> depths, grays;
+  std::vector<int> others;
+  for (int k = 0; k < 13; ++k) {
+    cameras.push_back(&ring.first[k].camera);
+    depths.push_back(&ring.second[k]);
+    grays.push_back(&ring.first[k].gray);
+    if (k > 0) others.push_back(k);
+  }
+  const LabelGrid grid{2.0, 0.02, 220};
+  VisibilityStats stats;
+  for (auto _ : state) {
+    stats = VisibilityStats();
+    auto moves = CheckFreeSpace(0, cameras, depths, grays, others, grid.InvStep(), VisibilityFilterOptions(), &stats);
+    benchmark::DoNotOptimize(moves.data());
+  }
+  state.counters["flagged"] = static_cast<double>(stats.flagged);
+  state.counters["moved"] = static_cast<double>(stats.replaced);
+  SetPerMegapixel(state, static_cast<int>(state.range(0)));
+}
+BENCHMARK(BM_FreeSpace)->Arg(576)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace casual3d::depth

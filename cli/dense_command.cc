@@ -21,6 +21,7 @@ struct DenseCommandOptions {
   bool no_flat_regions = false;
   bool no_relabel = false;
   bool no_fullres_refine = false;
+  bool no_free_space_check = false;
   depth::DenseOptions dense;
 };
 
@@ -32,6 +33,7 @@ void RunDense(const DenseCommandOptions& o) {
   opt.flat.enabled = !o.no_flat_regions;
   opt.relabel.enabled = !o.no_relabel;
   opt.fullres.enabled = !o.no_fullres_refine;
+  opt.visibility.enabled = !o.no_free_space_check;
   const Status st = opt.Check();
   if (!st.ok()) throw std::invalid_argument("dense: " + st.message());
   const depth::DenseReport report = depth::RunDenseStage(o.workspace, o.out, opt);
@@ -75,6 +77,17 @@ void AddDenseCommand(CLI::App& app) {
                 "Ablation: keep fattened depth edges (no full-resolution boundary relabelling)");
   cmd->add_flag("--no-fullres-refine", opts->no_fullres_refine,
                 "Ablation: no full-resolution depth search after upsampling");
+  cmd->add_flag("--no-free-space-check", opts->no_free_space_check,
+                "Ablation: keep depths that other photos' depth maps see through");
+  cmd->add_option("--free-space-tolerance", opts->dense.visibility.tolerance,
+                  "Relative depth band within which another photo's depth agrees (free-space check)")
+      ->capture_default_str();
+  cmd->add_option("--free-space-labels", opts->dense.visibility.tolerance_labels,
+                  "... or this many label steps of inverse depth, whichever is larger")
+      ->capture_default_str();
+  cmd->add_option("--free-space-rounds", opts->dense.visibility.rounds,
+                  "Rounds of the free-space check over all photos")
+      ->capture_default_str();
   cmd->add_option("--lambda-flat", opts->dense.mrf.lambda_flat,
                   "Weight of the textureless-region prior in the MRF data term")
       ->capture_default_str();

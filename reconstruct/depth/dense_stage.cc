@@ -87,6 +87,18 @@ ImageF ResizeLinear(const ImageF& image, int width, int height) {
   return out;
 }
 
+// `image` sampled at the pixel nearest each centre of a width x height grid.
+ImageF NearestSample(const ImageF& image, int width, int height) {
+  ImageF out(width, height, 1);
+  const double sx = static_cast<double>(image.width()) / width, sy = static_cast<double>(image.height()) / height;
+  for (int y = 0; y < height; ++y) {
+    const int ys = std::min(image.height() - 1, static_cast<int>((y + 0.5) * sy));
+    for (int x = 0; x < width; ++x)
+      out.at(x, y) = image.at(std::min(image.width() - 1, static_cast<int>((x + 0.5) * sx)), ys);
+  }
+  return out;
+}
+
 int CountValid(const ImageF& depth) {
   int n = 0;
   for (float v : depth.vector()) n += v > 0;
@@ -199,7 +211,7 @@ Status DenseOptions::Check() const {
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   for (const Status& s : {neighbors.Check(), sweep.Check(), gc.Check(), prune.Check(), envelope.Check(),
                           mrf.Check(), edge_median.Check(), sublabel.Check(), refine.Check(), upsample.Check(),
-                          fullres.Check(), relabel.Check(), flat.Check()})
+                          fullres.Check(), relabel.Check(), flat.Check(), visibility.Check()})
     if (!s.ok()) return s;
   return Status::Ok();
 }
@@ -311,7 +323,9 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   // one thread each (TRW-S is sequential).
   std::vector<const DenseView*> view_ptrs;
   std::vector<const ImageF*> wta_ptrs;
-  std::vector<ImageF> final_low(n);  // Final depth at working resolution, for cross-view checks.
+  // Final full-resolution depth maps: the free-space check (pass 3) compares
+  // them with each other before any is written.
+  std::vector<ImageF> final_full(n);
   for (int i = 0; i < n; ++i) {
     view_ptrs.push_back(&ws.views[i]);
     wta_ptrs.push_back(&wta[i]);
@@ -456,7 +470,6 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       low_conf.data()[p] = vol.photo_weight.data()[p] * std::max(0.0f, 1.0f - c[labels[p]]);
     }
     pool.Give(&vol.cost);
-    final_low[i] = low_depth;
     pr.t_refine = Since(t0);
 
     // Full resolution (Sec. 4.3.1: joint bilateral weighted median).
@@ -490,11 +503,9 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     } else {
       env_full = ImageF(v.full_width, v.full_height, 1, static_cast<float>(v.range.near_m));
     }
-    // The depth map with ZIP compression (a third smaller); the confidence
-    // and the envelope without: ZIP took 60-120 ms per map and saved a
-    // quarter (confidence) to a half (envelope) of 4 MB (docs/PERFORMANCE.md).
-    io::WriteExr((fs::path(out_dir) / "depth" / (stem + ".exr")).string(),
-                 static_cast<const ImageF&>(depth).view(), {"Z"});
+    // The confidence and the envelope without ZIP: it took 60-120 ms per map
+    // and saved a quarter (confidence) to a half (envelope) of 4 MB
+    // (docs/PERFORMANCE.md). The depth map is written after pass 3.
     io::ExrWriteOptions plain;
     plain.compression = io::ExrCompression::kNone;
     io::WriteExr((fs::path(out_dir) / "confidence" / (stem + ".exr")).string(), conf.view(), {"Y"}, plain);
@@ -523,14 +534,86 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       for (size_t p = 0; p < np; ++p)
         texture.data()[p] = static_cast<uint8_t>(std::lround(255.0f * vol.photo_weight.data()[p]));
       io::WritePng((fs::path(debug_dir) / (stem + "_texture.png")).string(), texture);
-      png("depth", depth);
+      png("upsampled", depth);
     }
+    final_full[i] = std::move(depth);
     pr.t_upsample = Since(t0);
 
+    // Ground truth: the anchors and the envelope (Fig. 6); the final depth
+    // is evaluated after pass 3.
+    if (!options.ground_truth_dir.empty() && !ground_truth[i].empty()) {
+      const ImageF& gt = ground_truth[i];
+      const double tol = 2.0 * grid.InvStep();
+      const char* names[] = {"wta", "gc", "median", "bilateral"};
+      const ImageF* maps[] = {&wta[i], &gc, &med, &bil};
+      for (int s = 0; s < 4; ++s) {
+        const AnchorQuality q = EvaluateAnchors(*maps[s], gt, tol);
+        pr.stages.push_back({names[s], q.completeness, q.precision});
+      }
+      if (!envelope.empty()) {
+        const EnvelopeQuality eq = EvaluateEnvelope(envelope, gt);
+        pr.envelope_error = eq.error;
+        pr.envelope_tightness = eq.tightness;
+      }
+    }
+    progress.Advance();
+  });
+  progress.Finish();
+
+  // Pass 3: the free-space check of the final maps against each other
+  // (visibility_filter.h), at full resolution. Every round reads the maps as
+  // the previous one left them, so the result does not depend on the order
+  // of the photos.
+  std::vector<PinholeCamera> full_cameras(n);
+  std::vector<const PinholeCamera*> full_camera_ptrs(n);
+  std::vector<const ImageF*> final_ptrs(n), gray_ptrs(n);
+  for (int i = 0; i < n; ++i) {
+    gray_ptrs[i] = &ws.views[i].gray_full;
+    full_cameras[i] = ws.views[i].camera_full.Resized(final_full[i].width(), final_full[i].height());
+    full_camera_ptrs[i] = &full_cameras[i];
+    final_ptrs[i] = &final_full[i];
+  }
+  if (options.visibility.enabled && n > 1) {
+    util::Progress check_progress("dense: free-space check", n * options.visibility.rounds);
+    for (int round = 0; round < options.visibility.rounds; ++round) {
+      std::vector<std::vector<DepthReplacement>> moves(n);
+      ForEachPhoto(ws.views, threads, [&](int i) {
+        const auto t0 = Clock::now();
+        VisibilityStats vs;
+        const LabelGrid grid{shells[i].inv_near, shells[i].inv_far, shells[i].num_labels};
+        moves[i] = CheckFreeSpace(i, full_camera_ptrs, final_ptrs, gray_ptrs, ws.ranked_neighbors[i], grid.InvStep(),
+                                  options.visibility, &vs);
+        PhotoReport& pr = report.photos[i];
+        pr.seen_through += vs.flagged;
+        pr.moved_back += vs.replaced;
+        pr.t_visibility += Since(t0);
+        check_progress.Advance();
+      });
+      for (int i = 0; i < n; ++i)
+        for (const DepthReplacement& m : moves[i]) final_full[i].data()[m.index] = m.depth;
+    }
+    check_progress.Finish();
+  }
+
+  // Outputs and evaluation of the final maps.
+  ForEachPhoto(ws.views, threads, [&](int i) {
+    const DenseView& v = ws.views[i];
+    PhotoReport& pr = report.photos[i];
+    const std::string stem = OutputStem(v.name);
+    const ImageF& depth = final_full[i];
+    const auto t0 = Clock::now();
+    // ZIP compression: a third smaller.
+    io::WriteExr((fs::path(out_dir) / "depth" / (stem + ".exr")).string(), depth.view(), {"Z"});
+    if (options.debug) {
+      const Image8 rgb = Colorize(depth, v.range);
+      io::WritePng((fs::path(debug_dir) / (stem + "_depth.png")).string(), rgb.view());
+    }
+    pr.t_upsample += Since(t0);
     if (!options.ground_truth_dir.empty()) {
       const ImageF& gt = ground_truth[i];
       if (!gt.empty()) {
         pr.evaluated = true;
+        const LabelGrid grid{shells[i].inv_near, shells[i].inv_far, shells[i].num_labels};
         if (options.debug) {
           const std::string base = (fs::path(debug_dir) / stem).string();
           const Image8 gt_rgb = Colorize(gt, v.range), err_rgb = ErrorMap(depth, gt);
@@ -563,31 +646,22 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
         pr.sky_near = acc.sky_near;
         pr.within_half_label = acc.within_half_label;
         pr.within_two_labels = acc.within_two_labels;
-        const double tol = 2.0 * grid.InvStep();
-        const char* names[] = {"wta", "gc", "median", "bilateral"};
-        const ImageF* maps[] = {&wta[i], &gc, &med, &bil};
-        for (int s = 0; s < 4; ++s) {
-          const AnchorQuality q = EvaluateAnchors(*maps[s], gt, tol);
-          pr.stages.push_back({names[s], q.completeness, q.precision});
-        }
-        if (!envelope.empty()) {
-          const EnvelopeQuality eq = EvaluateEnvelope(envelope, gt);
-          pr.envelope_error = eq.error;
-          pr.envelope_tightness = eq.tightness;
-        }
       }
     }
-    progress.Advance();
   });
-  progress.Finish();
 
-  // Cross-view consistency of the final depth maps.
+  // Cross-view consistency of the final depth maps, sampled at working
+  // resolution (the pixel nearest each working pixel's centre).
   {
-    std::vector<const ImageF*> final_ptrs;
-    for (const ImageF& d : final_low) final_ptrs.push_back(&d);
+    std::vector<ImageF> final_low(n);
+    std::vector<const ImageF*> low_ptrs(n);
+    for (int i = 0; i < n; ++i) {
+      final_low[i] = NearestSample(final_full[i], ws.views[i].camera.width, ws.views[i].camera.height);
+      low_ptrs[i] = &final_low[i];
+    }
     ParallelFor(0, n, threads, [&](int64_t i) {
       report.photos[i].cross_view_consistency =
-          CrossViewConsistency(static_cast<int>(i), view_ptrs, final_ptrs, ws.ranked_neighbors[i]);
+          CrossViewConsistency(static_cast<int>(i), view_ptrs, low_ptrs, ws.ranked_neighbors[i]);
     });
     for (const PhotoReport& pr : report.photos) report.cross_view_consistency += pr.cross_view_consistency / n;
   }
@@ -670,6 +744,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
                     {"fullres", pr.t_fullres}};
     p["flat_regions"] = {{"groups", pr.flat_groups}, {"fitted", pr.flat_fitted}, {"pixels", pr.flat_pixels}};
     p["relabelled_pixels"] = pr.relabelled;
+    p["free_space"] = {{"seen_through", pr.seen_through}, {"moved_back", pr.moved_back}, {"seconds", pr.t_visibility}};
     p["refined_pixels"] = pr.refined;
     if (pr.evaluated) {
       p["accuracy"] = {{"median_rel_error", pr.median_rel_error}, {"within_3pct", pr.within_3pct},

@@ -11,7 +11,8 @@
 //   envelope/<stem>.exr    float "Z": the near envelope (metres), full resolution
 //   dense.json             per photo: neighbours, depth range, anchor counts, timings,
 //                          cross-view consistency (and accuracy when ground truth is given)
-//   debug/<stem>_{wta,gc,median,bilateral,propagated,envelope,mrf,depth}.png  with debug
+//   debug/<stem>_{wta,gc,median,bilateral,propagated,envelope,trws,mrf,upsampled,depth}.png
+//                          with debug
 //   debug/<stem>_{gt,error}.png  with debug and ground truth
 //
 // Per photo: neighbour selection; plane sweep with ZNCC (plane_sweep.h);
@@ -20,7 +21,10 @@
 // (near_envelope.h); MRF of Eq. 1-4 solved by TRW-S (mrf_trws.h); sub-label
 // edge-aware median against window fattening (edge_median.h); sub-label
 // refinement (sublabel_refine.h) with a continuous search around each label
-// (continuous_refine.h); joint bilateral weighted-median upsampling (upsample.h).
+// (continuous_refine.h); joint bilateral weighted-median upsampling (upsample.h);
+// boundary relabelling and a full-resolution search (fullres_refine.h). Once
+// every photo has its map: the free-space check of the maps against each
+// other (visibility_filter.h).
 
 #include <string>
 #include <vector>
@@ -37,6 +41,7 @@
 #include "reconstruct/depth/plane_sweep.h"
 #include "reconstruct/depth/sublabel_refine.h"
 #include "reconstruct/depth/upsample.h"
+#include "reconstruct/depth/visibility_filter.h"
 
 namespace casual3d::depth {
 
@@ -102,6 +107,7 @@ struct DenseOptions {
   BoundaryRelabelOptions relabel;  // After upsampling, before fullres.
   FullResRefineOptions fullres;    // After upsampling.
   FlatRegionOptions flat;          // Priors for textureless regions (MRF data term, sub-label step).
+  VisibilityFilterOptions visibility;  // Once all final maps exist: the free-space check.
   bool use_near_envelope = true;  // false: the "MRF without near envelope" baseline (Fig. 5).
   bool use_gc_filter = true;      // false: skip the GC filter when building anchors.
   bool debug = false;             // Colour-mapped PNGs of every intermediate.
@@ -139,6 +145,8 @@ struct PhotoReport {
   int flat_groups = 0, flat_fitted = 0;  // Flat regions found and given a plane.
   long long flat_pixels = 0;             // Working pixels with a flat-region prior.
   long long relabelled = 0, refined = 0; // Full-resolution pixels changed by relabel / fullres.
+  long long seen_through = 0, moved_back = 0;  // Free-space check: flagged / replaced pixels (all rounds).
+  double t_visibility = 0;
   // Filled when ground truth is available.
   bool evaluated = false;
   double median_rel_error = 0, within_3pct = 0, near_floaters = 0, sky_near = 0;

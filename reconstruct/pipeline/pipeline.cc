@@ -76,7 +76,10 @@ std::string DenseOptionsText(const depth::DenseOptions& o) {
     << " occlusion_truncation=" << o.sweep.occlusion_truncation
     << " flat_regions=" << o.flat.enabled << " lambda_flat=" << o.mrf.lambda_flat
     << " relabel=" << o.relabel.enabled << " relabel_radius=" << o.relabel.radius
-    << " relabel_neighbors=" << o.relabel.max_neighbors << " fullres_refine=" << o.fullres.enabled;
+    << " relabel_neighbors=" << o.relabel.max_neighbors << " fullres_refine=" << o.fullres.enabled
+    << " free_space=" << o.visibility.enabled << " free_space_tolerance=" << o.visibility.tolerance
+    << " free_space_labels=" << o.visibility.tolerance_labels
+    << " free_space_views=" << o.visibility.max_views << " free_space_rounds=" << o.visibility.rounds;
   return s.str();
 }
 
