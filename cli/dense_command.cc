@@ -85,6 +85,9 @@ void AddDenseCommand(CLI::App& app) {
   cmd->add_option("--free-space-labels", opts->dense.visibility.tolerance_labels,
                   "... or this many label steps of inverse depth, whichever is larger")
       ->capture_default_str();
+  cmd->add_option("--free-space-views", opts->dense.visibility.max_views,
+                  "Other photos each depth map is checked against (best neighbours first)")
+      ->capture_default_str();
   cmd->add_option("--free-space-rounds", opts->dense.visibility.rounds,
                   "Rounds of the free-space check over all photos")
       ->capture_default_str();

@@ -136,7 +136,7 @@ struct PhotoReport {
   int cg_iterations = 0;
   double mrf_energy = 0.0;
   // Fraction of pixels whose depth agrees within 2% with >= 2 other views'
-  // final depth maps (working resolution; needs no ground truth).
+  // output depth maps, sampled at the working resolution (needs no ground truth).
   double cross_view_consistency = 0.0;
   int mrf_iterations = 0;
   // Seconds per step.
