@@ -1,11 +1,12 @@
 #include "reconstruct/depth/visibility_filter.h"
 
-#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include <Eigen/Core>
 
 #include "reconstruct/depth/fast_exp.h"
 
@@ -32,8 +33,8 @@ struct Other {
   const ImageF* gray;
 };
 
-// The ray of pixel x = 0 of row y, and the step to the next pixel, in the
-// camera frame (unit Z).
+// The ray of pixel x = 0 of row y in the camera frame (unit Z); the next
+// pixel's adds (1 / fx, 0, 0).
 Eigen::Vector3d RowRay(const PinholeCamera& c, int y) {
   return {(0.5 - c.cx) / c.fx, ((y + 0.5) - c.cy) / c.fy, 1.0};
 }
@@ -53,6 +54,7 @@ float NearestAround(const float* data, int width, int height, int u, int v) {
 // (COLMAP's: pixel centres at +0.5); NaN outside the pixel centres' hull.
 float SampleBilinear(const ImageF& image, double u, double v) {
   const double x = u - 0.5, y = v - 0.5;
+  if (image.width() < 2 || image.height() < 2) return std::numeric_limits<float>::quiet_NaN();
   if (!(x >= 0 && y >= 0 && x <= image.width() - 1 && y <= image.height() - 1))
     return std::numeric_limits<float>::quiet_NaN();
   const int x0 = std::min(static_cast<int>(x), image.width() - 2),
@@ -65,11 +67,10 @@ float SampleBilinear(const ImageF& image, double u, double v) {
 
 // How well each view agrees with reference pixel (x, y) at depth z: the
 // mean absolute grey difference between the pixel's window (half-size r,
-// every stride-th pixel) and its
-// projections at that depth (a fronto-parallel patch), with adaptive support
-// weights (Yoon and Kweon 2006: window pixels of another grey level than the
-// centre's, which may lie on another surface, count less). NaN for a view
-// that does not see the whole window.
+// every stride-th pixel) and its projections at that depth (a fronto-parallel
+// patch), with adaptive support weights (Yoon and Kweon 2006: window pixels
+// of another grey level than the centre's, which may lie on another surface,
+// count less). NaN for a view that does not see the whole window.
 void PhotoCosts(const PinholeCamera& cr, const ImageF& gray_ref, int x, int y, double z, int r,
                 int stride, const std::vector<Other>& list, std::vector<float>* costs) {
   constexpr float kSigma = 0.06f;
