@@ -88,14 +88,10 @@ ImageF ResizeLinear(const ImageF& image, int width, int height) {
 }
 
 // `image` sampled at the pixel nearest each centre of a width x height grid.
-ImageF NearestSample(const ImageF& image, int width, int height) {
-  ImageF out(width, height, 1);
-  const double sx = static_cast<double>(image.width()) / width, sy = static_cast<double>(image.height()) / height;
-  for (int y = 0; y < height; ++y) {
-    const int ys = std::min(image.height() - 1, static_cast<int>((y + 0.5) * sy));
-    for (int x = 0; x < width; ++x)
-      out.at(x, y) = image.at(std::min(image.width() - 1, static_cast<int>((x + 0.5) * sx)), ys);
-  }
+ImageF ResizeNearest(const ImageF& image, int width, int height) {
+  ImageF out(width, height, image.channels());
+  cv::Mat dst = io::ToMat(out);
+  cv::resize(io::ToMat(image), dst, cv::Size(width, height), 0, 0, cv::INTER_NEAREST_EXACT);
   return out;
 }
 
@@ -573,7 +569,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     full_camera_ptrs[i] = &full_cameras[i];
     final_ptrs[i] = &final_full[i];
   }
-  if (options.visibility.enabled && n > 1) {
+  if (options.visibility.enabled) {
     util::Progress check_progress("dense: free-space check", n * options.visibility.rounds);
     for (int round = 0; round < options.visibility.rounds; ++round) {
       std::vector<std::vector<DepthReplacement>> moves(n);
@@ -656,7 +652,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
     std::vector<ImageF> final_low(n);
     std::vector<const ImageF*> low_ptrs(n);
     for (int i = 0; i < n; ++i) {
-      final_low[i] = NearestSample(final_full[i], ws.views[i].camera.width, ws.views[i].camera.height);
+      final_low[i] = ResizeNearest(final_full[i], ws.views[i].camera.width, ws.views[i].camera.height);
       low_ptrs[i] = &final_low[i];
     }
     ParallelFor(0, n, threads, [&](int64_t i) {

@@ -14,23 +14,6 @@
 namespace casual3d::depth::sweep {
 namespace {
 
-// Bilinear sample with clamping to the border (window pixels that fall just
-// outside the neighbour keep a sensible value; the centre's own validity is
-// checked by the caller).
-inline float Bilinear(const float* img, int w, int h, float x, float y) {
-  x = std::min(std::max(x, 0.0f), static_cast<float>(w - 1));
-  y = std::min(std::max(y, 0.0f), static_cast<float>(h - 1));
-  const int x0 = std::min(static_cast<int>(x), w - 2 < 0 ? 0 : w - 2);
-  const int y0 = std::min(static_cast<int>(y), h - 2 < 0 ? 0 : h - 2);
-  const float fx = x - x0, fy = y - y0;
-  const float* p = img + static_cast<size_t>(y0) * w + x0;
-  const int dx = w > 1 ? 1 : 0;
-  const size_t dy = h > 1 ? static_cast<size_t>(w) : 0;
-  const float top = p[0] + fx * (p[dx] - p[0]);
-  const float bot = p[dy] + fx * (p[dy + dx] - p[dy]);
-  return top + fy * (bot - top);
-}
-
 // With `inv` set, the pixel's own inverse depth adds inv[x] * b (a
 // per-pixel plane); otherwise b is not read.
 inline void WarpPixel(const float* src, int sw, int sh, const HomographyRow& row, const float* inv,

@@ -11,9 +11,28 @@
 // fallback. (An AVX2 warp with gathers was slower than the SSE2 one with
 // scalar corner loads: 1.06 of its time, docs/PERFORMANCE.md.)
 
+#include <algorithm>
 #include <cstddef>
 
 namespace casual3d::depth::sweep {
+
+// Bilinear sample of a 1-channel w x h row-major image at pixel-index
+// coordinates (x, y) (pixel centres at integers), clamped to the border
+// (window pixels that fall just outside the neighbour keep a sensible value;
+// callers check the centre's own validity).
+inline float Bilinear(const float* img, int w, int h, float x, float y) {
+  x = std::min(std::max(x, 0.0f), static_cast<float>(w - 1));
+  y = std::min(std::max(y, 0.0f), static_cast<float>(h - 1));
+  const int x0 = std::min(static_cast<int>(x), w - 2 < 0 ? 0 : w - 2);
+  const int y0 = std::min(static_cast<int>(y), h - 2 < 0 ? 0 : h - 2);
+  const float fx = x - x0, fy = y - y0;
+  const float* p = img + static_cast<size_t>(y0) * w + x0;
+  const int dx = w > 1 ? 1 : 0;
+  const size_t dy = h > 1 ? static_cast<size_t>(w) : 0;
+  const float top = p[0] + fx * (p[dx] - p[0]);
+  const float bot = p[dy] + fx * (p[dy + dx] - p[dy]);
+  return top + fy * (bot - top);
+}
 
 // Cost of a neighbour that does not see the pixel; larger than any real cost
 // (costs are in [0, 1]) so that sorting puts it last.
@@ -51,8 +70,8 @@ void WarpRowPerPixel(const float* src, int src_width, int src_height, const Homo
 // running total acc[k][x]; with `old` (else nullptr), old[k][x] is then
 // subtracted from it: acc = (acc + out) - old. No output may overlap an
 // input.
-void ZnccWindowSums(const float* j, const float* i, int width, int r, float* const out[3], float* const acc[3],
-                    const float* const old[3]);
+void ZnccWindowSums(const float* j, const float* i, int width, int r, float* const out[3],
+                    float* const acc[3], const float* const old[3]);
 
 // acc[x] -= sub[x] for x in [0, width).
 void SubtractRow(const float* sub, int width, float* acc);

@@ -1,14 +1,14 @@
 #include "reconstruct/depth/visibility_filter.h"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
-#include <Eigen/Core>
-
 #include "reconstruct/depth/fast_exp.h"
+#include "reconstruct/depth/sweep_kernels.h"
 
 namespace casual3d::depth {
 
@@ -52,45 +52,49 @@ float NearestAround(const float* data, int width, int height, int u, int v) {
 
 // Bilinear sample of a 1-channel image at continuous coordinates (u, v)
 // (COLMAP's: pixel centres at +0.5); NaN outside the pixel centres' hull.
-float SampleBilinear(const ImageF& image, double u, double v) {
+float SampleInside(const ImageF& image, double u, double v) {
   const double x = u - 0.5, y = v - 0.5;
-  if (image.width() < 2 || image.height() < 2) return std::numeric_limits<float>::quiet_NaN();
   if (!(x >= 0 && y >= 0 && x <= image.width() - 1 && y <= image.height() - 1))
     return std::numeric_limits<float>::quiet_NaN();
-  const int x0 = std::min(static_cast<int>(x), image.width() - 2),
-            y0 = std::min(static_cast<int>(y), image.height() - 2);
-  const float ax = static_cast<float>(x - x0), ay = static_cast<float>(y - y0);
-  const float* r0 = image.data() + static_cast<size_t>(y0) * image.width() + x0;
-  const float* r1 = r0 + image.width();
-  return (1 - ay) * ((1 - ax) * r0[0] + ax * r0[1]) + ay * ((1 - ax) * r1[0] + ax * r1[1]);
+  return sweep::Bilinear(image.data(), image.width(), image.height(), static_cast<float>(x),
+                         static_cast<float>(y));
 }
 
-// How well each view agrees with reference pixel (x, y) at depth z: the
-// mean absolute grey difference between the pixel's window (half-size r,
-// every stride-th pixel) and its projections at that depth (a fronto-parallel
-// patch), with adaptive support weights (Yoon and Kweon 2006: window pixels
-// of another grey level than the centre's, which may lie on another surface,
-// count less). NaN for a view that does not see the whole window.
-void PhotoCosts(const PinholeCamera& cr, const ImageF& gray_ref, int x, int y, double z, int r,
-                int stride, const std::vector<Other>& list, std::vector<float>* costs) {
-  constexpr float kSigma = 0.06f;
-  constexpr float kInv2s2 = 1.0f / (2 * kSigma * kSigma);
+// A reference pixel's comparison window: half-size r, every stride-th
+// pixel, each with an adaptive support weight (Yoon and Kweon 2006: window
+// pixels of another grey level than the centre's, which may lie on another
+// surface, count less).
+struct Window {
   struct Tap {
     int dx, dy;
     float gray, weight;
   };
-  Tap taps[(2 * 10 + 1) * (2 * 10 + 1)];
-  int num_taps = 0;
-  const float centre = gray_ref.at(x, y);
+  std::vector<Tap> taps;
   double total_weight = 0;
-  for (int dy = -r; dy <= r; dy += stride)
-    for (int dx = -r; dx <= r; dx += stride) {
-      const int xs = x + dx, ys = y + dy;
-      if (xs < 0 || ys < 0 || xs >= gray_ref.width() || ys >= gray_ref.height()) continue;
-      const float g = gray_ref.at(xs, ys), e = g - centre;
-      taps[num_taps++] = {dx, dy, g, ExpNonPositive(-e * e * kInv2s2)};
-      total_weight += taps[num_taps - 1].weight;
-    }
+
+  void Reset(const ImageF& gray_ref, int x, int y, int r, int stride) {
+    constexpr float kSigma = 0.06f;
+    constexpr float kInv2s2 = 1.0f / (2 * kSigma * kSigma);
+    const float centre = gray_ref.at(x, y);
+    taps.clear();
+    total_weight = 0;
+    for (int dy = -r; dy <= r; dy += stride)
+      for (int dx = -r; dx <= r; dx += stride) {
+        const int xs = x + dx, ys = y + dy;
+        if (xs < 0 || ys < 0 || xs >= gray_ref.width() || ys >= gray_ref.height()) continue;
+        const float g = gray_ref.at(xs, ys), e = g - centre;
+        taps.push_back({dx, dy, g, ExpNonPositive(-e * e * kInv2s2)});
+        total_weight += taps.back().weight;
+      }
+  }
+};
+
+// How well each view agrees with reference pixel (x, y) at depth z: the
+// weighted mean absolute grey difference between the pixel's window and its
+// projections at that depth (a fronto-parallel patch). NaN for a view that
+// does not see the whole window.
+void PhotoCosts(const PinholeCamera& cr, const Window& window, int x, int y, double z,
+                const std::vector<Other>& list, std::vector<float>* costs) {
   const Eigen::Vector3d ray(((x + 0.5) - cr.cx) / cr.fx, ((y + 0.5) - cr.cy) / cr.fy, 1.0);
   costs->assign(list.size(), std::numeric_limits<float>::quiet_NaN());
   for (size_t k = 0; k < list.size(); ++k) {
@@ -100,17 +104,18 @@ void PhotoCosts(const PinholeCamera& cr, const ImageF& gray_ref, int x, int y, d
     const Eigen::Vector3d hx = (z / cr.fx) * o.kr.col(0), hy = (z / cr.fy) * o.kr.col(1);
     double sum = 0;
     bool inside = true;
-    for (int i = 0; i < num_taps; ++i) {
-      const Eigen::Vector3d h = h0 + taps[i].dx * hx + taps[i].dy * hy;
-      const float g = h.z() > 0 ? SampleBilinear(*o.gray, h.x() / h.z(), h.y() / h.z())
+    for (const Window::Tap& tap : window.taps) {
+      const Eigen::Vector3d h = h0 + tap.dx * hx + tap.dy * hy;
+      const float g = h.z() > 0 ? SampleInside(*o.gray, h.x() / h.z(), h.y() / h.z())
                                 : std::numeric_limits<float>::quiet_NaN();
       if (std::isnan(g)) {
         inside = false;
         break;
       }
-      sum += taps[i].weight * std::abs(g - taps[i].gray);
+      sum += tap.weight * std::abs(g - tap.gray);
     }
-    if (inside && total_weight > 0) (*costs)[k] = static_cast<float>(sum / total_weight);
+    if (inside && window.total_weight > 0)
+      (*costs)[k] = static_cast<float>(sum / window.total_weight);
   }
 }
 
@@ -248,6 +253,7 @@ std::vector<DepthReplacement> CheckFreeSpace(int ref,
   const ImageF& gray_ref = *grays[ref];
   std::vector<DepthReplacement> out;
   std::vector<float> beyond, diffs, cost_far, cost_now;
+  Window window;
   beyond.reserve(k_views);
   for (size_t s = 0; s < flagged.size(); ++s) {
     const double d = dr.data()[flagged[s]];
@@ -265,10 +271,9 @@ std::vector<DepthReplacement> CheckFreeSpace(int ref,
       // move is refused when even the better half of the views (those that
       // may see past an occluder) find it worse by more than the margin.
       const int x = flagged[s] % width, y = flagged[s] / width;
-      PhotoCosts(cr, gray_ref, x, y, *mid, options.photo_radius, options.photo_stride, list,
-                 &cost_far);
-      PhotoCosts(cr, gray_ref, x, y, d, options.photo_radius, options.photo_stride, list,
-                 &cost_now);
+      window.Reset(gray_ref, x, y, options.photo_radius, options.photo_stride);
+      PhotoCosts(cr, window, x, y, *mid, list, &cost_far);
+      PhotoCosts(cr, window, x, y, d, list, &cost_now);
       diffs.clear();
       for (size_t k = 0; k < k_views; ++k)
         if (!std::isnan(cost_far[k]) && !std::isnan(cost_now[k]))

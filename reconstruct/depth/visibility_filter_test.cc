@@ -147,16 +147,33 @@ TEST(VisibilityFilter, NeverMovesADepthNearer) {
 
 TEST(VisibilityFilter, SkipsPixelsWithoutDepth) {
   const Rig rig;
+  // The floater patch again, with a row of it and row 10 without depth in the
+  // reference; one other view has no depth at all (0) and another none but
+  // NaN: neither sees through anything (a missing depth is not a far one).
   ImageF ref = rig.depth[0];
-  for (int x = 0; x < 120; ++x) ref.at(x, 10) = std::numeric_limits<float>::quiet_NaN();
-  ImageF other = rig.depth[1];
-  for (float& d : other.vector()) d = 0.0f;  // A view without any depth says nothing.
-  std::vector<const ImageF*> maps = {&ref, &other, &rig.depth[2], &rig.depth[3], &rig.depth[4]};
+  for (int y = 70; y < 80; ++y)
+    for (int x = 10; x < 20; ++x) ref.at(x, y) *= 0.4f;
+  for (int x = 0; x < 120; ++x) {
+    ref.at(x, 10) = std::numeric_limits<float>::quiet_NaN();
+    ref.at(x, 75) = 0.0f;
+  }
+  ImageF zero = rig.depth[1], missing = rig.depth[2];
+  for (float& d : zero.vector()) d = 0.0f;
+  for (float& d : missing.vector()) d = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<const ImageF*> maps = {&ref, &zero, &missing, &rig.depth[3], &rig.depth[4]};
+  VisibilityFilterOptions options;
+  options.min_violations = 3;  // Only views 3 and 4 can see through the patch.
   VisibilityStats stats;
-  EXPECT_TRUE(CheckFreeSpace(0, rig.cameras, maps, rig.grays, {1, 2, 3, 4}, kInvStep,
-                             VisibilityFilterOptions(), &stats)
-                  .empty());
+  EXPECT_TRUE(
+      CheckFreeSpace(0, rig.cameras, maps, rig.grays, {1, 2, 3, 4}, kInvStep, options, &stats)
+          .empty());
   EXPECT_EQ(stats.flagged, 0);
+  options.min_violations = 2;
+  stats = VisibilityStats();
+  const auto moves =
+      CheckFreeSpace(0, rig.cameras, maps, rig.grays, {1, 2, 3, 4}, kInvStep, options, &stats);
+  EXPECT_EQ(stats.flagged, 90);  // The patch but its row without depth.
+  for (const DepthReplacement& m : moves) EXPECT_NE(m.index / 120, 75);
 }
 
 TEST(VisibilityFilter, OptionsAreChecked) {
