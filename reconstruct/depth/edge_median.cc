@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
+#include "reconstruct/depth/avx2_clones.h"
 #include "reconstruct/depth/fast_exp.h"
 #include "reconstruct/depth/parallel.h"
 
@@ -17,6 +19,73 @@ Status EdgeMedianOptions::Check() const {
     return InvalidArgument("edge median sigma_color outside (0, 10]");
   return Status::Ok();
 }
+
+namespace {
+
+// The colour guide as three planes (contiguous loads for the weight loop).
+struct Planes {
+  std::vector<float> r, g, b;
+};
+
+// Filters row y of `labels` into `out`. hist (num_labels zeros, left zeroed)
+// and wgt (2r + 1 floats) are the caller's scratch.
+CASUAL3D_AVX2_CLONES
+void FilterRow(int y, const std::vector<int>& labels, const Planes& planes, int w, int h, int r,
+               const float* spatial, float inv2s2, float* __restrict hist, float* __restrict wgt, int* out) {
+  for (int x = 0; x < w; ++x) {
+    const size_t c = static_cast<size_t>(y) * w + x;
+    const float r0 = planes.r[c], g0 = planes.g[c], b0 = planes.b[c];
+    float total = 0.0f;
+    int kmin = std::numeric_limits<int>::max(), kmax = -1;
+    const int u0 = std::max(0, x - r), u1 = std::min(w - 1, x + r), n = u1 - u0 + 1;
+    for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
+      // The row's weights in a loop that vectorises, then the histogram.
+      const size_t row = static_cast<size_t>(v) * w + u0;
+      const float* __restrict srow = spatial + (v - y + r) * (2 * r + 1) + (u0 - x + r);
+      const float* __restrict pr = planes.r.data() + row;
+      const float* __restrict pg = planes.g.data() + row;
+      const float* __restrict pb = planes.b.data() + row;
+      for (int i = 0; i < n; ++i) {
+        const float dr = pr[i] - r0, dg = pg[i] - g0, db = pb[i] - b0;
+        wgt[i] = srow[i] * ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv2s2);
+      }
+      for (int i = 0; i < n; ++i) total += wgt[i];
+      // Labels come in runs (the MRF's labelling is piecewise constant): a
+      // run's weights are summed in a register and added to the histogram
+      // once, instead of a chain of dependent adds to one bin.
+      const int* lrow = labels.data() + row;
+      int run_label = lrow[0];
+      float run_sum = 0.0f;
+      for (int i = 0; i < n; ++i) {
+        const int k = lrow[i];
+        if (k != run_label) {
+          hist[run_label] += run_sum;
+          kmin = std::min(kmin, run_label);
+          kmax = std::max(kmax, run_label);
+          run_label = k;
+          run_sum = 0.0f;
+        }
+        run_sum += wgt[i];
+      }
+      hist[run_label] += run_sum;
+      kmin = std::min(kmin, run_label);
+      kmax = std::max(kmax, run_label);
+    }
+    float acc = 0.0f;
+    int med = kmax;
+    for (int k = kmin; k <= kmax; ++k) {
+      acc += hist[k];
+      if (acc >= 0.5f * total) {
+        med = k;
+        break;
+      }
+    }
+    std::fill(hist + kmin, hist + kmax + 1, 0.0f);
+    out[c] = med;
+  }
+}
+
+}  // namespace
 
 std::vector<int> EdgeAwareMedian(const std::vector<int>& labels, int num_labels,
                                  const ImageF& color, const EdgeMedianOptions& options,
@@ -33,48 +102,22 @@ std::vector<int> EdgeAwareMedian(const std::vector<int>& labels, int num_labels,
       spatial[(dy + r) * (2 * r + 1) + dx + r] = static_cast<float>(
           std::exp(-(dx * dx + dy * dy) / (2.0 * options.sigma_spatial * options.sigma_spatial)));
   const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
+  const size_t n = labels.size();
+  Planes planes;
+  planes.r.resize(n);
+  planes.g.resize(n);
+  planes.b.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    planes.r[i] = color.data()[3 * i];
+    planes.g[i] = color.data()[3 * i + 1];
+    planes.b[i] = color.data()[3 * i + 2];
+  }
 
-  std::vector<int> out(labels.size());
-  ParallelFor(0, h, ResolveThreads(num_threads), [&](int64_t yy) {
-    const int y = static_cast<int>(yy);
-    std::vector<float> hist(num_labels, 0.0f);
-    std::vector<float> wgt(2 * r + 1);
-    for (int x = 0; x < w; ++x) {
-      const float* c0 = &color.at(x, y, 0);
-      float total = 0.0f;
-      int kmin = num_labels, kmax = -1;
-      const int u0 = std::max(0, x - r), u1 = std::min(w - 1, x + r);
-      for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
-        // The row's weights in a loop that vectorises, then the histogram.
-        const float* srow = spatial.data() + (v - y + r) * (2 * r + 1) + r - x;
-        const float* crow = color.row(v);
-        for (int u = u0; u <= u1; ++u) {
-          const float* c = crow + 3 * u;
-          const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
-                           (c[2] - c0[2]) * (c[2] - c0[2]);
-          wgt[u - u0] = srow[u] * ExpNonPositive(-d2 * inv2s2);
-        }
-        const int* lrow = labels.data() + static_cast<size_t>(v) * w;
-        for (int u = u0; u <= u1; ++u) {
-          const int k = lrow[u];
-          hist[k] += wgt[u - u0];
-          total += wgt[u - u0];
-          kmin = std::min(kmin, k);
-          kmax = std::max(kmax, k);
-        }
-      }
-      float acc = 0.0f;
-      int med = kmax;
-      for (int k = kmin; k <= kmax; ++k) {
-        acc += hist[k];
-        if (acc >= 0.5f * total) {
-          med = k;
-          break;
-        }
-      }
-      std::fill(hist.begin() + kmin, hist.begin() + kmax + 1, 0.0f);
-      out[static_cast<size_t>(y) * w + x] = med;
-    }
+  std::vector<int> out(n);
+  ParallelFor(0, h, ResolveThreads(num_threads), [&](int64_t y) {
+    std::vector<float> hist(num_labels, 0.0f), wgt(2 * r + 1);
+    FilterRow(static_cast<int>(y), labels, planes, w, h, r, spatial.data(), inv2s2, hist.data(), wgt.data(),
+              out.data());
   });
   return out;
 }

@@ -268,32 +268,78 @@ double MrfEnergy(const GridMrf& mrf, const std::vector<uint16_t>& labels) {
   return e;
 }
 
-size_t TrwsMessageBytes(int width, int height, int num_labels) {
-  return 2 * static_cast<size_t>(width) * height * PaddedLabels(num_labels) * sizeof(float);
+size_t TrwsMessageBytes(int width, int height, int num_labels, bool half) {
+  return 2 * static_cast<size_t>(width) * height * PaddedLabels(num_labels) * (half ? 2 : 4);
 }
 
-CASUAL3D_AVX2_CLONES
-TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool* pool) {
+namespace {
+
+#if defined(CASUAL3D_AVX2_MESSAGES)
+// IEEE half <-> float for a message of n labels (n a multiple of 8), F16C.
+__attribute__((target("avx2,f16c"), noinline)) void HalfToFloat(const uint16_t* src, float* dst, int n) {
+  for (int i = 0; i < n; i += 8)
+    _mm256_storeu_ps(dst + i, _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i))));
+}
+__attribute__((target("avx2,f16c"), noinline)) void FloatToHalf(const float* src, uint16_t* dst, int n) {
+  for (int i = 0; i < n; i += 8)
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + i),
+                     _mm256_cvtps_ph(_mm256_loadu_ps(src + i), _MM_FROUND_TO_NEAREST_INT));
+}
+#endif
+
+// Where the messages live. The passes work on float messages of S labels:
+// with float storage these are the stored messages themselves; with half
+// storage (Msg = uint16_t) a message is converted into a scratch buffer on
+// Open and back on Close.
+template <typename Msg>
+struct MessageStore {
+  Msg* base = nullptr;
+  int stride = 0;
+  float* Open(size_t p, float* /*scratch*/) const { return base + p * stride; }
+  void Close(size_t /*p*/, const float* /*scratch*/) const {}
+  const void* Address(size_t p) const { return base + p * stride; }
+};
+
+#if defined(CASUAL3D_AVX2_MESSAGES)
+template <>
+struct MessageStore<uint16_t> {
+  uint16_t* base = nullptr;
+  int stride = 0;
+  float* Open(size_t p, float* scratch) const {
+    HalfToFloat(base + p * stride, scratch, stride);
+    return scratch;
+  }
+  void Close(size_t p, const float* scratch) const { FloatToHalf(scratch, base + p * stride, stride); }
+  const void* Address(size_t p) const { return base + p * stride; }
+};
+#endif
+
+// The solver, for either message storage; `avx2` selects the AVX2 distance
+// transform.
+template <typename Msg>
+__attribute__((always_inline)) inline TrwsResult SolveTrwsWith(const GridMrf& mrf, const TrwsOptions& options,
+                                                                BufferPool* pool, bool avx2) {
   const int w = mrf.width, h = mrf.height, L = mrf.num_labels;
   const size_t n = static_cast<size_t>(w) * h;
-  if (w <= 0 || h <= 0 || L < 1 || L > 65535 || mrf.unary.size() != n * L ||
-      mrf.weight_right.size() != n || mrf.weight_down.size() != n || mrf.truncation < 1)
-    throw std::invalid_argument("TRW-S: inconsistent MRF sizes");
-  if (options.max_iterations < 1) throw std::invalid_argument("TRW-S: max_iterations < 1");
-  for (size_t p = 0; p < n; ++p)
-    if (!(mrf.weight_right[p] >= 0.0f && mrf.weight_down[p] >= 0.0f))
-      throw std::invalid_argument("TRW-S: edge weight of pixel " + std::to_string(p) +
-                                  " is negative or NaN");
-
   // One message per edge (as in Kolmogorov 2006): at any time the edge
   // holds the message towards the endpoint that the current pass reaches
   // last, which is the only direction still needed. horizontal[p] is the edge
   // (x, y)-(x+1, y), vertical[p] the edge (x, y)-(x, y+1). Half the memory of
   // storing both directions, and the same results.
   const int S = PaddedLabels(L);
+  // The pool hands out float buffers: half messages take half as many.
+  const size_t floats = n * S * sizeof(Msg) / sizeof(float);
   std::vector<float> horizontal, vertical;
-  TakeBuffer(pool, &horizontal, n * S);
-  TakeBuffer(pool, &vertical, n * S);
+  TakeBuffer(pool, &horizontal, floats);
+  TakeBuffer(pool, &vertical, floats);
+  const MessageStore<Msg> hor{reinterpret_cast<Msg*>(horizontal.data()), S};
+  const MessageStore<Msg> ver{reinterpret_cast<Msg*>(vertical.data()), S};
+  // Scratch for the four messages at a node (used with half storage).
+  std::vector<float> scratch(4 * static_cast<size_t>(S));
+  float* const s_left = scratch.data();
+  float* const s_right = s_left + S;
+  float* const s_up = s_right + S;
+  float* const s_down = s_up + S;
   const std::vector<float> zeros(S, 0.0f);
   std::vector<float> belief(S, 0.0f), cost(S, kInf);
   std::vector<float> label_f(S);
@@ -316,9 +362,6 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
   };
   // Messages from the node whose belief is in `belief` along one or two
   // edges (each holding the message towards the node; overwritten).
-#if defined(CASUAL3D_AVX2_MESSAGES)
-  const bool avx2 = options.avx2_messages && __builtin_cpu_supports("avx2");
-#endif
   auto send = [&](float gamma, float* e0, float w0, float* e1, float w1) {
     if (e0 && e1) {
       float* const edges[2] = {e0, e1};
@@ -336,15 +379,17 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
       SendMessages<1>(belief.data(), gamma, L, S, edges, weights, T);
     }
   };
+  (void)avx2;
 
   // Prefetching: node q's unary and the messages a pass reads at q (its own
   // edges, and the edge from the node above when q has one).
   const size_t kAhead = 2;  // Nodes ahead.
+  const int msg_floats = static_cast<int>(S * sizeof(Msg) / sizeof(float));
   auto prefetch_node = [&](size_t q) {
     PrefetchFloats(&mrf.unary[q * L], L);
-    PrefetchFloats(&horizontal[q * S], S);
-    PrefetchFloats(&vertical[q * S], S);
-    if (q >= static_cast<size_t>(w)) PrefetchFloats(&vertical[(q - w) * S], S);
+    PrefetchFloats(static_cast<const float*>(hor.Address(q)), msg_floats);
+    PrefetchFloats(static_cast<const float*>(ver.Address(q)), msg_floats);
+    if (q >= static_cast<size_t>(w)) PrefetchFloats(static_cast<const float*>(ver.Address(q - w)), msg_floats);
   };
   for (int iter = 0; iter < options.max_iterations; ++iter) {
     // Forward pass (raster order): messages to the right and down neighbours,
@@ -352,10 +397,10 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
         const size_t p = static_cast<size_t>(y) * w + x;
-        float* mr = &horizontal[p * S];
-        float* md = &vertical[p * S];
-        const float* ml = x > 0 ? &horizontal[(p - 1) * S] : zeros.data();
-        const float* mu = y > 0 ? &vertical[(p - w) * S] : zeros.data();
+        float* mr = hor.Open(p, s_right);
+        float* md = ver.Open(p, s_down);
+        const float* ml = x > 0 ? hor.Open(p - 1, s_left) : zeros.data();
+        const float* mu = y > 0 ? ver.Open(p - w, s_up) : zeros.data();
         if (p + kAhead < n) prefetch_node(p + kAhead);
         // Belief, and the labelling cost (Kolmogorov 2006, Sec. 5): unary,
         // messages from the nodes not yet labelled in this pass, and the
@@ -384,6 +429,8 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
         const float gamma = 1.0f / static_cast<float>(std::max(1, std::max(before, after)));
         send(gamma, x + 1 < w ? mr : nullptr, mrf.weight_right[p], y + 1 < h ? md : nullptr,
              mrf.weight_down[p]);
+        if (x + 1 < w) hor.Close(p, mr);
+        if (y + 1 < h) ver.Close(p, md);
       }
     }
     const double e = MrfEnergy(mrf, labels);
@@ -397,16 +444,18 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
     for (int y = h - 1; y >= 0; --y) {
       for (int x = w - 1; x >= 0; --x) {
         const size_t p = static_cast<size_t>(y) * w + x;
-        float* ml = x > 0 ? &horizontal[(p - 1) * S] : nullptr;
-        float* mu = y > 0 ? &vertical[(p - w) * S] : nullptr;
-        const float* mr = x + 1 < w ? &horizontal[p * S] : zeros.data();
-        const float* md = y + 1 < h ? &vertical[p * S] : zeros.data();
+        float* ml = x > 0 ? hor.Open(p - 1, s_left) : nullptr;
+        float* mu = y > 0 ? ver.Open(p - w, s_up) : nullptr;
+        const float* mr = x + 1 < w ? hor.Open(p, s_right) : zeros.data();
+        const float* md = y + 1 < h ? ver.Open(p, s_down) : zeros.data();
         if (p >= kAhead) prefetch_node(p - kAhead);
         compute_belief(p, ml ? ml : zeros.data(), mr, mu ? mu : zeros.data(), md);
         const int before = (x > 0) + (y > 0), after = (x + 1 < w) + (y + 1 < h);
         const float gamma = 1.0f / static_cast<float>(std::max(1, std::max(before, after)));
         send(gamma, ml, x > 0 ? mrf.weight_right[p - 1] : 0.0f, mu,
              y > 0 ? mrf.weight_down[p - w] : 0.0f);
+        if (ml) hor.Close(p - 1, ml);
+        if (mu) ver.Close(p - w, mu);
       }
     }
     // Stop after `patience` passes without a significant improvement.
@@ -422,6 +471,47 @@ TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool*
     pool->Give(&vertical);
   }
   return result;
+}
+
+CASUAL3D_AVX2_CLONES
+TrwsResult SolveTrwsFloat(const GridMrf& mrf, const TrwsOptions& options, BufferPool* pool, bool avx2) {
+  return SolveTrwsWith<float>(mrf, options, pool, avx2);
+}
+
+#if defined(CASUAL3D_AVX2_MESSAGES)
+__attribute__((target("avx2,f16c"))) TrwsResult SolveTrwsHalf(const GridMrf& mrf, const TrwsOptions& options,
+                                                              BufferPool* pool) {
+  return SolveTrwsWith<uint16_t>(mrf, options, pool, true);
+}
+#endif
+
+}  // namespace
+
+bool TrwsHalfMessagesAvailable() {
+#if defined(CASUAL3D_AVX2_MESSAGES)
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("f16c");
+#else
+  return false;
+#endif
+}
+
+TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options, BufferPool* pool) {
+  const int w = mrf.width, h = mrf.height, L = mrf.num_labels;
+  const size_t n = static_cast<size_t>(w) * h;
+  if (w <= 0 || h <= 0 || L < 1 || L > 65535 || mrf.unary.size() != n * L ||
+      mrf.weight_right.size() != n || mrf.weight_down.size() != n || mrf.truncation < 1)
+    throw std::invalid_argument("TRW-S: inconsistent MRF sizes");
+  if (options.max_iterations < 1) throw std::invalid_argument("TRW-S: max_iterations < 1");
+  for (size_t p = 0; p < n; ++p)
+    if (!(mrf.weight_right[p] >= 0.0f && mrf.weight_down[p] >= 0.0f))
+      throw std::invalid_argument("TRW-S: edge weight of pixel " + std::to_string(p) +
+                                  " is negative or NaN");
+#if defined(CASUAL3D_AVX2_MESSAGES)
+  if (options.half_messages && TrwsHalfMessagesAvailable()) return SolveTrwsHalf(mrf, options, pool);
+  return SolveTrwsFloat(mrf, options, pool, options.avx2_messages && __builtin_cpu_supports("avx2"));
+#else
+  return SolveTrwsFloat(mrf, options, pool, false);
+#endif
 }
 
 }  // namespace casual3d::depth

@@ -10,10 +10,11 @@
 // edge with the lower-envelope distance transform of Felzenszwalb and
 // Huttenlocher (2006), so one iteration costs O(pixels * labels).
 //
-// Memory: one message of L floats per edge (about 2 * pixels * L * 4 bytes,
-// see TrwsMessageBytes), half of what storing both directions takes. Speed:
-// the distance transforms run on eight labels at a time with AVX2 where the
-// CPU has it (bit-identical to the SSE2 code used otherwise), the beliefs and
+// Memory: one message of L labels per edge, half of what storing both
+// directions takes, stored as half floats where the CPU has F16C (about
+// 2 * pixels * L * 2 bytes, otherwise 4; see TrwsMessageBytes). Speed: the
+// distance transforms run on eight labels at a time with AVX2 where the CPU
+// has it (bit-identical to the SSE2 code used otherwise), the beliefs and
 // labelling costs are vectorised loops, and each node's data is prefetched
 // two nodes ahead.
 
@@ -43,6 +44,11 @@ struct TrwsOptions {
   // Send messages with AVX2 where the CPU has it. The results are the same to
   // the bit either way (the tests compare the two).
   bool avx2_messages = true;
+  // Store the messages as IEEE half floats where the CPU has AVX2 and F16C
+  // (TrwsHalfMessagesAvailable): half the memory and memory traffic; the
+  // arithmetic stays in float. The messages lie in [0, w T] and are rounded
+  // to 11 significant bits when stored.
+  bool half_messages = true;
 };
 
 struct TrwsResult {
@@ -61,8 +67,12 @@ class BufferPool;  // huge_pages.h
 TrwsResult SolveTrws(const GridMrf& mrf, const TrwsOptions& options = TrwsOptions(),
                      BufferPool* pool = nullptr);
 
-// Bytes of message storage SolveTrws allocates for a width x height grid.
-size_t TrwsMessageBytes(int width, int height, int num_labels);
+// Bytes of message storage SolveTrws allocates for a width x height grid,
+// with half or float messages.
+size_t TrwsMessageBytes(int width, int height, int num_labels, bool half = false);
+
+// True when SolveTrws can store half messages on this CPU.
+bool TrwsHalfMessagesAvailable();
 
 // Energy of a labelling.
 double MrfEnergy(const GridMrf& mrf, const std::vector<uint16_t>& labels);

@@ -156,12 +156,17 @@ TEST(Trws, ExactOnChains) {
         const int len = 17;
         GridMrf m = RandomMrf(vertical ? 1 : len, vertical ? len : 1, labels, truncation,
                               1000 + labels * 7 + truncation + vertical, 0.4f);
-        const TrwsResult r = SolveTrws(m);
         const double exact = ChainMinimum(m);
-        EXPECT_NEAR(r.energy, exact, 1e-5 * std::max(1.0, exact))
-            << labels << " labels, truncation " << truncation
-            << (vertical ? ", vertical" : ", horizontal");
-        EXPECT_NEAR(r.energy, MrfEnergy(m, r.labels), 1e-5);
+        // Float messages, and half ones where the CPU has them.
+        for (bool half : {false, true}) {
+          TrwsOptions opt;
+          opt.half_messages = half;
+          const TrwsResult r = SolveTrws(m, opt);
+          EXPECT_NEAR(r.energy, exact, 1e-5 * std::max(1.0, exact))
+              << labels << " labels, truncation " << truncation
+              << (vertical ? ", vertical" : ", horizontal") << (half ? ", half messages" : "");
+          EXPECT_NEAR(r.energy, MrfEnergy(m, r.labels), 1e-5);
+        }
         ++cases;
       }
     }
@@ -181,6 +186,7 @@ TEST(Trws, Avx2AndSse2MessagesAgreeExactly) {
   opt.max_iterations = 5;
   opt.relative_tolerance = 0.0;
   opt.patience = 1000;
+  opt.half_messages = false;
   int cases = 0;
   for (int labels : {1, 3, 8, 9, 21, 64, 220})
     for (int truncation : {1, 3, 8, 100}) {
@@ -194,6 +200,37 @@ TEST(Trws, Avx2AndSse2MessagesAgreeExactly) {
       ++cases;
     }
   EXPECT_EQ(cases, 28);
+}
+
+// Half messages round every stored message to 11 significant bits: on a
+// denoising problem of the dense stage's kind (220 labels, truncation 8,
+// unary in [0, 1]) the solution stays that of float messages.
+TEST(Trws, HalfMessagesMatchFloatOnes) {
+  if (!TrwsHalfMessagesAvailable()) GTEST_SKIP() << "this CPU has no AVX2 and F16C";
+  const int w = 96, h = 72, L = 220;
+  GridMrf m = RandomMrf(w, h, L, 8, 5, 0.0f);
+  // A smooth label surface with a step; unary: distance to it, plus noise.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> noise(0.0f, 0.3f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t p = static_cast<size_t>(y) * w + x;
+      const float truth = (x < w / 2 ? 40.0f : 150.0f) + 0.3f * y;
+      for (int l = 0; l < L; ++l)
+        m.unary[p * L + l] = std::min(1.0f, std::abs(l - truth) / 20.0f) + noise(rng);
+      m.weight_right[p] = x == w / 2 - 1 ? 0.002f : 0.03f;
+      m.weight_down[p] = 0.03f;
+    }
+  TrwsOptions opt;
+  opt.half_messages = false;
+  const TrwsResult full = SolveTrws(m, opt);
+  opt.half_messages = true;
+  const TrwsResult half = SolveTrws(m, opt);
+  EXPECT_NEAR(half.energy, full.energy, 1e-3 * full.energy);
+  size_t same = 0;
+  for (size_t p = 0; p < full.labels.size(); ++p) same += std::abs(full.labels[p] - half.labels[p]) <= 1;
+  EXPECT_GE(static_cast<double>(same) / full.labels.size(), 0.99);
+  EXPECT_EQ(TrwsMessageBytes(w, h, L, true) * 2, TrwsMessageBytes(w, h, L, false));
 }
 
 TEST(Trws, ReportsTheEnergyOfEveryPass) {
