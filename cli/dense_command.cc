@@ -112,6 +112,9 @@ void AddDenseCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--lambda-near", opts->dense.mrf.lambda_near, "Near envelope penalty (Eq. 4)")
       ->capture_default_str();
+  cmd->add_option("--mrf-passes", opts->dense.mrf.max_iterations,
+                  "Most TRW-S passes (each forward and backward); fewer is faster, at a higher energy")
+      ->capture_default_str();
   cmd->add_option("--window-radius", opts->dense.sweep.window_radius,
                   "ZNCC window radius at working resolution (2: 5x5)")
       ->capture_default_str();

@@ -212,6 +212,18 @@ bool WindowSums(const PlaneHomography& H, const ImageF& J, int m8, int centre, c
   return true;
 }
 
+// Colour weights exp(-|c_i - c0|^2 inv2s2) of n pixels whose colours are in
+// the planes r, g, b (a loop that vectorises).
+CASUAL3D_AVX2_CLONES
+void ColourWeights(const float* __restrict r, const float* __restrict g, const float* __restrict b, int n,
+                   const float* c0, float inv2s2, float* __restrict out) {
+  const float r0 = c0[0], g0 = c0[1], b0 = c0[2];
+  for (int i = 0; i < n; ++i) {
+    const float dr = r[i] - r0, dg = g[i] - g0, db = b[i] - b0;
+    out[i] = ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv2s2);
+  }
+}
+
 }  // namespace
 
 ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeCamera& camera,
@@ -297,6 +309,11 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
     std::vector<float> us(padded), vs(padded), wk(padded), jv(padded);
     std::vector<float> costs(K);
     std::vector<std::pair<float, float>> samples;
+    // Colours of the samples whose colour weights are computed together.
+    const int R = options.radius, cs = 4;  // The band window: every 4th pixel.
+    const int band_side = 2 * (R / cs) + 1;
+    const size_t max_samples = std::max<size_t>(padded, static_cast<size_t>(band_side) * band_side);
+    std::vector<float> pr(max_samples), pg(max_samples), pb(max_samples), pw(max_samples), pinv(max_samples);
     for (int x = 0; x < w; ++x) {
       const size_t p = static_cast<size_t>(y) * w + x;
       if (!near_edge[p]) continue;
@@ -309,32 +326,33 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       // The colour-weighted window of the reference: pixel (u, v) weighs
       // exp(-|c_uv - c_xy|^2 / (2 sigma_color^2)).
       const float* c0 = &color.at(x, y, 0);
-      auto colour_weight = [&](int u, int v) {
+      auto gather_colour = [&](int i, int u, int v) {
         const float* c = &color.at(u, v, 0);
-        const float d2 = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
-                         (c[2] - c0[2]) * (c[2] - c0[2]);
-        return ExpNonPositive(-d2 * inv2s2);
+        pr[i] = c[0];
+        pg[i] = c[1];
+        pb[i] = c[2];
       };
       int m = 0, centre = 0;
-      double sw = 0, si = 0, sii = 0;
       for (int dv = -reach; dv <= reach; dv += step) {
         const int v = y + dv;
         if (v < 0 || v >= h) continue;
         for (int du = -reach; du <= reach; du += step) {
           const int u = x + du;
           if (u < 0 || u >= w) continue;
-          const float wq = colour_weight(u, v);
-          const float iv = gray.at(u, v);
           if (du == 0 && dv == 0) centre = m;
-          wgt[m] = wq;
-          ival[m] = iv;
+          gather_colour(m, u, v);
+          ival[m] = gray.at(u, v);
           sx[m] = static_cast<float>(u);
           sy[m] = static_cast<float>(v);
-          sw += wq;
-          si += wq * iv;
-          sii += wq * iv * iv;
           ++m;
         }
+      }
+      ColourWeights(pr.data(), pg.data(), pb.data(), m, c0, inv2s2, wgt.data());
+      double sw = 0, si = 0, sii = 0;
+      for (int i = 0; i < m; ++i) {
+        sw += wgt[i];
+        si += wgt[i] * ival[i];
+        sii += wgt[i] * ival[i] * ival[i];
       }
       for (int i = m; i < padded; ++i) wgt[i] = ival[i] = sx[i] = sy[i] = 0.0f;
       const int m8 = (m + 7) & ~7;
@@ -374,17 +392,21 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       float cands[3];
       int num_cands = 0;
       if (far_differs) {
-        samples.clear();
-        double total = 0;
-        const int R = options.radius, cs = 4;  // Every 4th pixel of the band window.
+        int ns = 0;
         for (int v = std::max(0, y - R); v <= std::min(h - 1, y + R); v += cs)
           for (int u = std::max(0, x - R); u <= std::min(w - 1, x + R); u += cs) {
             const size_t q = static_cast<size_t>(v) * w + u;
             if (cur - inv[q] < same) continue;
-            const float wq = colour_weight(u, v);
-            samples.push_back({inv[q], wq});
-            total += wq;
+            gather_colour(ns, u, v);
+            pinv[ns++] = inv[q];
           }
+        ColourWeights(pr.data(), pg.data(), pb.data(), ns, c0, inv2s2, pw.data());
+        samples.clear();
+        double total = 0;
+        for (int i = 0; i < ns; ++i) {
+          samples.push_back({pinv[i], pw[i]});
+          total += pw[i];
+        }
         if (total > 0.5) {
           std::sort(samples.begin(), samples.end());
           double acc = 0;

@@ -134,4 +134,15 @@ inline void TakeBuffer(BufferPool* pool, std::vector<float>* v, size_t n) {
   }
 }
 
+// `*v` becomes n floats for the caller to overwrite, from `pool` when there
+// is one (BufferPool::TakeForOverwrite: a kept buffer is not zeroed again),
+// otherwise a fresh allocation of zeros (AssignHuge).
+inline void TakeBufferForOverwrite(BufferPool* pool, std::vector<float>* v, size_t n) {
+  if (pool) {
+    pool->TakeForOverwrite(v, n);
+  } else {
+    AssignHuge(v, n);
+  }
+}
+
 }  // namespace casual3d::depth

@@ -127,7 +127,8 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
   const int best_k = std::min(options.best_k, num_nb);
   const float truncation = static_cast<float>(options.occlusion_truncation);
   const int num_groups = (num_labels + kGroup - 1) / kGroup;
-  TakeBuffer(pool, &vol.cost, n * num_labels);
+  // Every label of every pixel is written below (the groups cover all labels).
+  TakeBufferForOverwrite(pool, &vol.cost, n * num_labels);
   std::atomic<int> next_group(0);
   auto worker = [&]() {
     ZnccStream stream(w, h, r, num_nb, best_k, truncation, eps, gi, &windows);

@@ -5,8 +5,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
+#include "reconstruct/depth/huge_pages.h"
 #include "reconstruct/depth/sweep_kernels.h"
 #include "reconstruct/depth/testing/toy_scene.h"
 
@@ -240,6 +242,28 @@ TEST(PlaneSweep, RecoversAPlaneDespiteExposureChanges) {
   SweepOptions plain = opt;
   plain.texture_color_sigma = 0.0;
   EXPECT_GT(ComputeCostVolume(ref, {&a, &b, &c}, plain).photo_weight.at(80, 60), 0.55f);
+}
+
+// The volume takes a kept buffer from the pool without zeroing it: every
+// cost must still be written, whatever the buffer held before.
+TEST(PlaneSweep, OverwritesEveryCostOfAKeptBuffer) {
+  ToyScene scene;
+  scene.rects.push_back({3.0, -50, 50, -50, 50, 8.0, 5});
+  const DepthRange range{1.0, 20.0};
+  const DenseView ref = MakeView(scene, ToyCamera({0, 0, 0}, 160, 120, 150), range);
+  const DenseView a = MakeView(scene, ToyCamera({0.2, 0, 0}, 160, 120, 150), range);
+  const DenseView b = MakeView(scene, ToyCamera({-0.2, 0, 0}, 160, 120, 150), range);
+  SweepOptions opt;
+  opt.num_threads = 2;
+  const CostVolume plain = ComputeCostVolume(ref, {&a, &b}, opt);
+  BufferPool pool(1);
+  std::vector<float> stale(plain.cost.size(), std::numeric_limits<float>::quiet_NaN());
+  pool.Give(&stale);
+  const CostVolume pooled = ComputeCostVolume(ref, {&a, &b}, opt, &pool);
+  ASSERT_EQ(pooled.cost.size(), plain.cost.size());
+  size_t differ = 0;
+  for (size_t i = 0; i < plain.cost.size(); ++i) differ += !(pooled.cost[i] == plain.cost[i]);
+  EXPECT_EQ(differ, 0u);
 }
 
 TEST(PlaneSweep, BestKAveragingSurvivesAnOccludingNeighbour) {
