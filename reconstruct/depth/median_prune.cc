@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "reconstruct/depth/avx2_clones.h"
+#include "reconstruct/depth/fast_exp.h"
 #include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
@@ -68,6 +71,75 @@ ImageF MedianPrune(const ImageF& depth, const LabelGrid& grid, const MedianPrune
   return out;
 }
 
+namespace {
+
+// Median labels of the anchors of row y for BilateralMedianPrune: med[x] is
+// the colour-weighted median label of the (2r + 1)^2 window around anchor
+// (x, y), -1 where (x, y) is no anchor. `label` and the four `planes`
+// (colour, then 1 at anchors) are padded by 8 past the image; hist (bins zeros, left zeroed)
+// and wgt (2r + 8 floats) are scratch.
+CASUAL3D_AVX2_CLONES
+void BilateralMedianRow(int y, const std::vector<int>& label, const std::vector<float>& planes, int w, int h,
+                        int r, float inv2s2, float* __restrict hist, float* __restrict wgt, int* med) {
+  const size_t stride = static_cast<size_t>(w) * h + 8;
+  const float* __restrict pr = planes.data();
+  const float* __restrict pg = pr + stride;
+  const float* __restrict pb = pg + stride;
+  const float* __restrict pa = pb + stride;  // 1 at anchors, else 0.
+  for (int x = 0; x < w; ++x) {
+    const size_t c = static_cast<size_t>(y) * w + x;
+    med[x] = -1;
+    if (label[c] < 0) continue;
+    const float r0 = pr[c], g0 = pg[c], b0 = pb[c];
+    float total = 0.0f;
+    int kmin = std::numeric_limits<int>::max(), kmax = -1;
+    const int u0 = std::max(0, x - r), u1 = std::min(w - 1, x + r), n = u1 - u0 + 1;
+    for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
+      const size_t row = static_cast<size_t>(v) * w + u0;
+      const int* __restrict lrow = label.data() + row;
+      // Weights (0 where there is no anchor) in a loop that vectorises, over
+      // whole blocks of 8 (the planes and labels are padded; lanes past the
+      // window weigh 0).
+      const int n8 = (n + 7) & ~7;
+      for (int i = 0; i < n8; ++i) {
+        const float dr = pr[row + i] - r0, dg = pg[row + i] - g0, db = pb[row + i] - b0;
+        wgt[i] = pa[row + i] * ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv2s2);
+      }
+      for (int i = n; i < n8; ++i) wgt[i] = 0.0f;
+      for (int i = 0; i < n8; ++i) total += wgt[i];
+      // Runs of one label summed before they reach the histogram.
+      int run_label = lrow[0];
+      float run_sum = 0.0f;
+      for (int i = 0; i <= n; ++i) {
+        const int k = i < n ? lrow[i] : -2;
+        if (k != run_label) {
+          if (run_label >= 0) {
+            hist[run_label] += run_sum;
+            kmin = std::min(kmin, run_label);
+            kmax = std::max(kmax, run_label);
+          }
+          run_label = k;
+          run_sum = 0.0f;
+        }
+        if (i < n) run_sum += wgt[i];
+      }
+    }
+    float acc = 0.0f;
+    int m = kmin;
+    for (int k = kmin; k <= kmax; ++k) {
+      acc += hist[k];
+      if (acc >= 0.5f * total) {
+        m = k;
+        break;
+      }
+    }
+    std::fill(hist + kmin, hist + kmax + 1, 0.0f);
+    med[x] = m;
+  }
+}
+
+}  // namespace
+
 ImageF BilateralMedianPrune(const ImageF& depth, const ImageF& color, const LabelGrid& grid,
                             const MedianPruneOptions& options, int num_threads) {
   const Status st = options.Check();
@@ -76,63 +148,34 @@ ImageF BilateralMedianPrune(const ImageF& depth, const ImageF& color, const Labe
     throw std::invalid_argument("bilateral median: colour image size does not match the depth map");
   const int w = depth.width(), h = depth.height(), r = options.large_radius;
   const int bins = grid.num_labels;
-  // Labels as integers once (WTA depths sit on labels), -1 = invalid.
-  std::vector<int> label(static_cast<size_t>(w) * h, -1);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const float d = depth.at(x, y);
-      if (d > 0) {
-        const int k = static_cast<int>(std::lround(grid.LabelOf(d)));
-        label[static_cast<size_t>(y) * w + x] = std::min(bins - 1, std::max(0, k));
-      }
+  const size_t n = static_cast<size_t>(w) * h;
+  // Labels as integers once (WTA depths sit on labels), -1 = invalid; the
+  // colour guide as three planes and a fourth of 1 at anchors, 0 elsewhere.
+  // Both padded by 8 for the weight loop's last block.
+  std::vector<int> label(n + 8, -1);
+  std::vector<float> planes(4 * (n + 8), 0.0f);
+  for (size_t p = 0; p < n; ++p) {
+    const float d = depth.data()[p];
+    if (d > 0) {
+      const int k = static_cast<int>(std::lround(grid.LabelOf(d)));
+      label[p] = std::min(bins - 1, std::max(0, k));
     }
-  // exp(-dist^2 / (2 sigma^2)) tabulated on squared colour distance.
-  constexpr int kLut = 4096;
-  const double max_d2 = 3.0;
-  std::vector<float> lut(kLut + 1);
-  for (int i = 0; i <= kLut; ++i)
-    lut[i] = static_cast<float>(
-        std::exp(-(max_d2 * i / kLut) / (2 * options.sigma_color * options.sigma_color)));
-  const float lut_scale = kLut / max_d2;
+    for (int c = 0; c < 3; ++c) planes[c * (n + 8) + p] = color.data()[3 * p + c];
+    planes[3 * (n + 8) + p] = label[p] >= 0 ? 1.0f : 0.0f;
+  }
+  // Colour weights exp(-|c_q - c_p|^2 / (2 sigma_c^2)).
+  const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
 
   ImageF out(w, h, 1, 0.0f);
   ParallelFor(0, h, ResolveThreads(num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
-    std::vector<float> hist(bins);
+    std::vector<float> hist(bins, 0.0f), wgt(2 * r + 8);
+    std::vector<int> med(w);
+    BilateralMedianRow(y, label, planes, w, h, r, inv2s2, hist.data(), wgt.data(), med.data());
     for (int x = 0; x < w; ++x) {
-      const int k0 = label[static_cast<size_t>(y) * w + x];
-      if (k0 < 0) continue;
-      std::fill(hist.begin(), hist.end(), 0.0f);
-      const float* c0 = &color.at(x, y, 0);
-      float total = 0.0f;
-      int kmin = bins, kmax = -1;
-      for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
-        const int* lrow = label.data() + static_cast<size_t>(v) * w;
-        const float* crow = color.row(v);
-        for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) {
-          const int k = lrow[u];
-          if (k < 0) continue;
-          const float* c = crow + 3 * u;
-          const float d0 = c[0] - c0[0], d1 = c[1] - c0[1], d2 = c[2] - c0[2];
-          const float d = std::min(static_cast<float>(max_d2), d0 * d0 + d1 * d1 + d2 * d2);
-          const float wgt = lut[static_cast<int>(d * lut_scale)];
-          hist[k] += wgt;
-          total += wgt;
-          kmin = std::min(kmin, k);
-          kmax = std::max(kmax, k);
-        }
-      }
-      float acc = 0.0f;
-      int med = kmin;
-      for (int k = kmin; k <= kmax; ++k) {
-        acc += hist[k];
-        if (acc >= 0.5f * total) {
-          med = k;
-          break;
-        }
-      }
+      if (med[x] < 0) continue;
       const float d = depth.at(x, y);
-      if (WithinBand(d, k0, med, grid, options)) out.at(x, y) = d;
+      if (WithinBand(d, label[static_cast<size_t>(y) * w + x], med[x], grid, options)) out.at(x, y) = d;
     }
   });
   return out;
