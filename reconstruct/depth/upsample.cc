@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "reconstruct/depth/avx2_clones.h"
+#include "reconstruct/depth/fast_exp.h"
 #include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
@@ -19,6 +21,27 @@ Status UpsampleOptions::Check() const {
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   return Status::Ok();
 }
+
+namespace {
+
+// Weights of a window's `count` samples for one output pixel of colour c0:
+// spatial[s] * wc[column[s]] * exp(-|c_s - c0|^2 inv_sc) + 1e-12, the
+// samples' colours in the planes sr, sg, sb. Returns their sum.
+CASUAL3D_AVX2_CLONES
+float SampleWeights(int count, const float* __restrict sr, const float* __restrict sg, const float* __restrict sb,
+                    const float* __restrict spatial, const int* __restrict column, const float* __restrict wc,
+                    const float* c0, float inv_sc, float* __restrict weight) {
+  const float r0 = c0[0], g0 = c0[1], b0 = c0[2];
+  for (int s = 0; s < count; ++s) {
+    const float dr = sr[s] - r0, dg = sg[s] - g0, db = sb[s] - b0;
+    weight[s] = spatial[s] * wc[column[s]] * ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv_sc) + 1e-12f;
+  }
+  float total = 0.0f;
+  for (int s = 0; s < count; ++s) total += weight[s];
+  return total;
+}
+
+}  // namespace
 
 ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
                                     const ImageF& high_color, const UpsampleOptions& options) {
@@ -36,8 +59,7 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
   ImageF out(hw, hh, 1, 0.0f);
   // The spatial weight is separable: per column and per row, the 2r + 1
   // factors exp(-d^2 / (2 sigma_s^2)) of its window. The colour weight
-  // exp(-t) comes from a table over t in [0, kMaxT) with linear
-  // interpolation (relative error below 2e-4; exp(-kMaxT) is 2e-9).
+  // is computed per sample (SampleWeights, vectorised).
   const int taps = 2 * r + 1;
   std::vector<int> ucol(hw);
   std::vector<float> wcol(static_cast<size_t>(hw) * taps);
@@ -52,22 +74,16 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
     ucol[x] = static_cast<int>(std::lround(u));
     factors(u, ucol[x], &wcol[static_cast<size_t>(x) * taps]);
   }
-  constexpr float kMaxT = 20.0f;
-  constexpr int kTable = 2048;
-  std::vector<float> exp_table(kTable + 2);
-  for (int i = 0; i <= kTable + 1; ++i) exp_table[i] = static_cast<float>(std::exp(-kMaxT * i / kTable));
-  const float to_index = kTable / kMaxT;
   // Pixels of a row that share a low-resolution window (two in a row at
   // half resolution) share its samples' order by value: the window's valid
   // samples are sorted once (stably, in scanning order among equal values)
-  // and each pixel only weighs them. The weights are summed in scanning
-  // order and accumulated in sorted order, as a per-pixel insertion sort
-  // would: the result is the same to the bit.
+  // and each pixel only weighs them, then walks them in that order to its
+  // weighted median.
   ParallelFor(0, hh, ResolveThreads(options.num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
     const size_t max_samples = static_cast<size_t>(taps) * taps;
     std::vector<float> value(max_samples), weight(max_samples), spatial(max_samples);
-    std::vector<const float*> colour(max_samples);
+    std::vector<float> sr(max_samples), sg(max_samples), sb(max_samples);
     std::vector<int> column(max_samples), order(max_samples);
     std::vector<float> wrow(taps);
     const double v = (y + 0.5) * sy - 0.5;
@@ -86,7 +102,10 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
             const float val = low.at(p, q);
             if (!(val > 0)) continue;
             value[count] = val;
-            colour[count] = &low_color.at(p, q, 0);
+            const float* c = &low_color.at(p, q, 0);
+            sr[count] = c[0];
+            sg[count] = c[1];
+            sb[count] = c[2];
             spatial[count] = wrow[q - vc + r];
             column[count] = p - uc + r;
             int k = count;
@@ -101,18 +120,8 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
       if (count == 0) continue;
       const float* wc = &wcol[static_cast<size_t>(x) * taps];
       const float* c0 = &high_color.at(x, y, 0);
-      float total = 0.0f;
-      for (int s = 0; s < count; ++s) {
-        const float* c = colour[s];
-        const float dc = (c[0] - c0[0]) * (c[0] - c0[0]) + (c[1] - c0[1]) * (c[1] - c0[1]) +
-                         (c[2] - c0[2]) * (c[2] - c0[2]);
-        const float t = std::min(dc * inv_sc * to_index, static_cast<float>(kTable));
-        const int i = static_cast<int>(t);
-        const float f = t - static_cast<float>(i);
-        const float wcolor = exp_table[i] + f * (exp_table[i + 1] - exp_table[i]);
-        weight[s] = spatial[s] * wc[column[s]] * wcolor + 1e-12f;
-        total += weight[s];
-      }
+      const float total = SampleWeights(count, sr.data(), sg.data(), sb.data(), spatial.data(), column.data(), wc,
+                                        c0, inv_sc, weight.data());
       float acc = 0.0f;
       float med = value[order[count - 1]];
       for (int k = 0; k < count; ++k) {
