@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 #include "reconstruct/depth/avx2_clones.h"
 #include "reconstruct/depth/fast_exp.h"
+#include "reconstruct/depth/label_histogram.h"
 #include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
@@ -36,7 +36,7 @@ void FilterRow(int y, const std::vector<int>& labels, const Planes& planes, int 
     const size_t c = static_cast<size_t>(y) * w + x;
     const float r0 = planes.r[c], g0 = planes.g[c], b0 = planes.b[c];
     float total = 0.0f;
-    int kmin = std::numeric_limits<int>::max(), kmax = -1;
+    LabelHistogram histogram(hist);
     const int u0 = std::max(0, x - r), u1 = std::min(w - 1, x + r), n = u1 - u0 + 1;
     for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
       // The row's weights in a loop that vectorises, then the histogram.
@@ -50,38 +50,9 @@ void FilterRow(int y, const std::vector<int>& labels, const Planes& planes, int 
         wgt[i] = srow[i] * ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv2s2);
       }
       for (int i = 0; i < n; ++i) total += wgt[i];
-      // Labels come in runs (the MRF's labelling is piecewise constant): a
-      // run's weights are summed in a register and added to the histogram
-      // once, instead of a chain of dependent adds to one bin.
-      const int* lrow = labels.data() + row;
-      int run_label = lrow[0];
-      float run_sum = 0.0f;
-      for (int i = 0; i < n; ++i) {
-        const int k = lrow[i];
-        if (k != run_label) {
-          hist[run_label] += run_sum;
-          kmin = std::min(kmin, run_label);
-          kmax = std::max(kmax, run_label);
-          run_label = k;
-          run_sum = 0.0f;
-        }
-        run_sum += wgt[i];
-      }
-      hist[run_label] += run_sum;
-      kmin = std::min(kmin, run_label);
-      kmax = std::max(kmax, run_label);
+      histogram.AddRow(labels.data() + row, wgt, n);
     }
-    float acc = 0.0f;
-    int med = kmax;
-    for (int k = kmin; k <= kmax; ++k) {
-      acc += hist[k];
-      if (acc >= 0.5f * total) {
-        med = k;
-        break;
-      }
-    }
-    std::fill(hist + kmin, hist + kmax + 1, 0.0f);
-    out[c] = med;
+    out[c] = histogram.MedianAndClear(total);
   }
 }
 

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "reconstruct/depth/avx2_clones.h"
 #include "reconstruct/depth/fast_exp.h"
+#include "reconstruct/depth/label_histogram.h"
 #include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
@@ -92,7 +92,7 @@ void BilateralMedianRow(int y, const std::vector<int>& label, const std::vector<
     if (label[c] < 0) continue;
     const float r0 = pr[c], g0 = pg[c], b0 = pb[c];
     float total = 0.0f;
-    int kmin = std::numeric_limits<int>::max(), kmax = -1;
+    LabelHistogram histogram(hist);
     const int u0 = std::max(0, x - r), u1 = std::min(w - 1, x + r), n = u1 - u0 + 1;
     for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v) {
       const size_t row = static_cast<size_t>(v) * w + u0;
@@ -107,34 +107,9 @@ void BilateralMedianRow(int y, const std::vector<int>& label, const std::vector<
       }
       for (int i = n; i < n8; ++i) wgt[i] = 0.0f;
       for (int i = 0; i < n8; ++i) total += wgt[i];
-      // Runs of one label summed before they reach the histogram.
-      int run_label = lrow[0];
-      float run_sum = 0.0f;
-      for (int i = 0; i <= n; ++i) {
-        const int k = i < n ? lrow[i] : -2;
-        if (k != run_label) {
-          if (run_label >= 0) {
-            hist[run_label] += run_sum;
-            kmin = std::min(kmin, run_label);
-            kmax = std::max(kmax, run_label);
-          }
-          run_label = k;
-          run_sum = 0.0f;
-        }
-        if (i < n) run_sum += wgt[i];
-      }
+      histogram.AddRow(lrow, wgt, n);
     }
-    float acc = 0.0f;
-    int m = kmin;
-    for (int k = kmin; k <= kmax; ++k) {
-      acc += hist[k];
-      if (acc >= 0.5f * total) {
-        m = k;
-        break;
-      }
-    }
-    std::fill(hist + kmin, hist + kmax + 1, 0.0f);
-    med[x] = m;
+    med[x] = histogram.MedianAndClear(total);
   }
 }
 
