@@ -311,7 +311,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
     std::vector<std::pair<float, float>> samples;
     // Colours of the samples whose colour weights are computed together.
     const int R = options.radius, cs = 4;  // The band window: every 4th pixel.
-    const int band_side = 2 * (R / cs) + 1;
+    const int band_side = 2 * R / cs + 1;  // Samples along a side of the band window, at most.
     const size_t max_samples = std::max<size_t>(padded, static_cast<size_t>(band_side) * band_side);
     std::vector<float> pr(max_samples), pg(max_samples), pb(max_samples), pw(max_samples), pinv(max_samples);
     for (int x = 0; x < w; ++x) {

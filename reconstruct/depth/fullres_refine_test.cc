@@ -412,6 +412,14 @@ TEST(RelabelBoundaries, RemovesFatteningWithOtherWindowSamplings) {
   CheckRemovesFattening(full);
 }
 
+// A band window whose radius is not a multiple of its sample step (4): 22
+// takes 12 samples a side (-22, -18, ..., 22), more than a radius of 20.
+TEST(RelabelBoundaries, RemovesFatteningWithAnOddBandRadius) {
+  BoundaryRelabelOptions opt;
+  opt.radius = 22;
+  CheckRemovesFattening(opt);
+}
+
 // A slope is no depth edge: a depth map ramping from 2.5 m to 8 m across a
 // textured plane at 4 m spans more than min_jump_labels over every band
 // window but steps by a tenth of a label between pixels. Nothing in it is
