@@ -218,16 +218,13 @@ void BM_EdgeMedian(benchmark::State& state) {
   const Rig& rig = GetRig(width);
   const ImageF& truth = rig.depth[0];
   const LabelGrid grid{2.0, 0.02, 220};
-  const int w = truth.width(), h = truth.height(), r = 3;
-  std::vector<int> labels(static_cast<size_t>(w) * h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      float d = truth.at(x, y);
-      for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v)
-        for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) d = std::min(d, truth.at(u, v));
-      const double k = std::isfinite(d) ? grid.LabelOf(d) : grid.num_labels - 1;
-      labels[static_cast<size_t>(y) * w + x] = std::clamp(static_cast<int>(std::lround(k)), 0, grid.num_labels - 1);
-    }
+  const ImageF fat = MinFilter(truth, 2 * 3 + 1);
+  std::vector<int> labels(fat.vector().size());
+  for (size_t p = 0; p < labels.size(); ++p) {
+    const float d = fat.data()[p];
+    const double k = std::isfinite(d) ? grid.LabelOf(d) : grid.num_labels - 1;
+    labels[p] = std::clamp(static_cast<int>(std::lround(k)), 0, grid.num_labels - 1);
+  }
   std::vector<int> out;
   for (auto _ : state) {
     out = EdgeAwareMedian(labels, grid.num_labels, rig.views[0].color, EdgeMedianOptions(), 1);
@@ -255,15 +252,9 @@ const FullResInput& GetFullResInput(int width) {
   const Rig& rig = GetRig(width);
   FullResInput in;
   const ImageF& truth = rig.depth[0];
-  const int w = truth.width(), h = truth.height(), r = 6;
-  in.depth = ImageF(w, h, 1);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      float d = truth.at(x, y);
-      for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v)
-        for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) d = std::min(d, truth.at(u, v));
-      in.depth.at(x, y) = std::isfinite(d) ? d : 50.0f;
-    }
+  in.depth = MinFilter(truth, 2 * 6 + 1);
+  for (float& d : in.depth.vector())
+    if (!std::isfinite(d)) d = 50.0f;
   for (size_t i = 1; i < rig.views.size(); ++i) in.neighbors.push_back({&rig.views[i].gray, rig.views[i].camera});
   return inputs.emplace(width, std::move(in)).first->second;
 }

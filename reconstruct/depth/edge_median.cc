@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "reconstruct/depth/avx2_clones.h"
-#include "reconstruct/depth/fast_exp.h"
+#include "reconstruct/depth/colour_weights.h"
 #include "reconstruct/depth/label_histogram.h"
 #include "reconstruct/depth/parallel.h"
 
@@ -22,15 +22,10 @@ Status EdgeMedianOptions::Check() const {
 
 namespace {
 
-// The colour guide as three planes (contiguous loads for the weight loop).
-struct Planes {
-  std::vector<float> r, g, b;
-};
-
 // Filters row y of `labels` into `out`. hist (num_labels zeros, left zeroed)
 // and wgt (2r + 1 floats) are the caller's scratch.
 CASUAL3D_AVX2_CLONES
-void FilterRow(int y, const std::vector<int>& labels, const Planes& planes, int w, int h, int r,
+void FilterRow(int y, const std::vector<int>& labels, const ColourPlanes& planes, int w, int h, int r,
                const float* spatial, float inv2s2, float* __restrict hist, float* __restrict wgt, int* out) {
   for (int x = 0; x < w; ++x) {
     const size_t c = static_cast<size_t>(y) * w + x;
@@ -46,8 +41,7 @@ void FilterRow(int y, const std::vector<int>& labels, const Planes& planes, int 
       const float* __restrict pg = planes.g.data() + row;
       const float* __restrict pb = planes.b.data() + row;
       for (int i = 0; i < n; ++i) {
-        const float dr = pr[i] - r0, dg = pg[i] - g0, db = pb[i] - b0;
-        wgt[i] = srow[i] * ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv2s2);
+        wgt[i] = srow[i] * ColourAffinity(pr[i] - r0, pg[i] - g0, pb[i] - b0, inv2s2);
       }
       for (int i = 0; i < n; ++i) total += wgt[i];
       histogram.AddRow(labels.data() + row, wgt, n);
@@ -74,15 +68,7 @@ std::vector<int> EdgeAwareMedian(const std::vector<int>& labels, int num_labels,
           std::exp(-(dx * dx + dy * dy) / (2.0 * options.sigma_spatial * options.sigma_spatial)));
   const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
   const size_t n = labels.size();
-  Planes planes;
-  planes.r.resize(n);
-  planes.g.resize(n);
-  planes.b.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    planes.r[i] = color.data()[3 * i];
-    planes.g[i] = color.data()[3 * i + 1];
-    planes.b[i] = color.data()[3 * i + 2];
-  }
+  const ColourPlanes planes = SplitColour(color);
 
   std::vector<int> out(n);
   ParallelFor(0, h, ResolveThreads(num_threads), [&](int64_t y) {

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "reconstruct/depth/avx2_clones.h"
+#include "reconstruct/depth/colour_weights.h"
 #include "reconstruct/depth/fast_exp.h"
 #include "reconstruct/depth/near_envelope.h"
 #include "reconstruct/depth/parallel.h"
@@ -210,18 +211,6 @@ bool WindowSums(const PlaneHomography& H, const ImageF& J, int m8, int centre, c
     sums[3] += a_ij[l];
   }
   return true;
-}
-
-// Colour weights exp(-|c_i - c0|^2 inv2s2) of n pixels whose colours are in
-// the planes r, g, b (a loop that vectorises).
-CASUAL3D_AVX2_CLONES
-void ColourWeights(const float* __restrict r, const float* __restrict g, const float* __restrict b, int n,
-                   const float* c0, float inv2s2, float* __restrict out) {
-  const float r0 = c0[0], g0 = c0[1], b0 = c0[2];
-  for (int i = 0; i < n; ++i) {
-    const float dr = r[i] - r0, dg = g[i] - g0, db = b[i] - b0;
-    out[i] = ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv2s2);
-  }
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "reconstruct/depth/avx2_clones.h"
-#include "reconstruct/depth/fast_exp.h"
+#include "reconstruct/depth/colour_weights.h"
 #include "reconstruct/depth/label_histogram.h"
 #include "reconstruct/depth/parallel.h"
 
@@ -75,17 +75,17 @@ namespace {
 
 // Median labels of the anchors of row y for BilateralMedianPrune: med[x] is
 // the colour-weighted median label of the (2r + 1)^2 window around anchor
-// (x, y), -1 where (x, y) is no anchor. `label` and the four `planes`
-// (colour, then 1 at anchors) are padded by 8 past the image; hist (bins zeros, left zeroed)
-// and wgt (2r + 8 floats) are scratch.
+// (x, y), -1 where (x, y) is no anchor. `label`, the colour `planes` and
+// `anchor` (1 at anchors, else 0) are padded by 8 past the image; hist (bins
+// zeros, left zeroed) and wgt (2r + 8 floats) are scratch.
 CASUAL3D_AVX2_CLONES
-void BilateralMedianRow(int y, const std::vector<int>& label, const std::vector<float>& planes, int w, int h,
-                        int r, float inv2s2, float* __restrict hist, float* __restrict wgt, int* med) {
-  const size_t stride = static_cast<size_t>(w) * h + 8;
-  const float* __restrict pr = planes.data();
-  const float* __restrict pg = pr + stride;
-  const float* __restrict pb = pg + stride;
-  const float* __restrict pa = pb + stride;  // 1 at anchors, else 0.
+void BilateralMedianRow(int y, const std::vector<int>& label, const ColourPlanes& planes,
+                        const std::vector<float>& anchor, int w, int h, int r, float inv2s2, float* __restrict hist,
+                        float* __restrict wgt, int* med) {
+  const float* __restrict pr = planes.r.data();
+  const float* __restrict pg = planes.g.data();
+  const float* __restrict pb = planes.b.data();
+  const float* __restrict pa = anchor.data();
   for (int x = 0; x < w; ++x) {
     const size_t c = static_cast<size_t>(y) * w + x;
     med[x] = -1;
@@ -102,8 +102,7 @@ void BilateralMedianRow(int y, const std::vector<int>& label, const std::vector<
       // window weigh 0).
       const int n8 = (n + 7) & ~7;
       for (int i = 0; i < n8; ++i) {
-        const float dr = pr[row + i] - r0, dg = pg[row + i] - g0, db = pb[row + i] - b0;
-        wgt[i] = pa[row + i] * ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv2s2);
+        wgt[i] = pa[row + i] * ColourAffinity(pr[row + i] - r0, pg[row + i] - g0, pb[row + i] - b0, inv2s2);
       }
       for (int i = n; i < n8; ++i) wgt[i] = 0.0f;
       for (int i = 0; i < n8; ++i) total += wgt[i];
@@ -124,20 +123,20 @@ ImageF BilateralMedianPrune(const ImageF& depth, const ImageF& color, const Labe
   const int w = depth.width(), h = depth.height(), r = options.large_radius;
   const int bins = grid.num_labels;
   const size_t n = static_cast<size_t>(w) * h;
-  // Labels as integers once (WTA depths sit on labels), -1 = invalid; the
-  // colour guide as three planes and a fourth of 1 at anchors, 0 elsewhere.
-  // Both padded by 8 for the weight loop's last block.
+  // Labels as integers once (WTA depths sit on labels), -1 = invalid, and 1
+  // at anchors, 0 elsewhere; the colour guide as planes. All padded by 8 for
+  // the weight loop's last block.
   std::vector<int> label(n + 8, -1);
-  std::vector<float> planes(4 * (n + 8), 0.0f);
+  std::vector<float> anchor(n + 8, 0.0f);
   for (size_t p = 0; p < n; ++p) {
     const float d = depth.data()[p];
     if (d > 0) {
       const int k = static_cast<int>(std::lround(grid.LabelOf(d)));
       label[p] = std::min(bins - 1, std::max(0, k));
+      anchor[p] = 1.0f;
     }
-    for (int c = 0; c < 3; ++c) planes[c * (n + 8) + p] = color.data()[3 * p + c];
-    planes[3 * (n + 8) + p] = label[p] >= 0 ? 1.0f : 0.0f;
   }
+  const ColourPlanes planes = SplitColour(color, 8);
   // Colour weights exp(-|c_q - c_p|^2 / (2 sigma_c^2)).
   const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
 
@@ -146,7 +145,7 @@ ImageF BilateralMedianPrune(const ImageF& depth, const ImageF& color, const Labe
     const int y = static_cast<int>(yy);
     std::vector<float> hist(bins, 0.0f), wgt(2 * r + 8);
     std::vector<int> med(w);
-    BilateralMedianRow(y, label, planes, w, h, r, inv2s2, hist.data(), wgt.data(), med.data());
+    BilateralMedianRow(y, label, planes, anchor, w, h, r, inv2s2, hist.data(), wgt.data(), med.data());
     for (int x = 0; x < w; ++x) {
       if (med[x] < 0) continue;
       const float d = depth.at(x, y);

@@ -141,12 +141,12 @@ void SendMessages(const float* belief, float gamma, int num_labels, int padded, 
 #endif
 }
 
-// Asks for the cache lines of count floats from ptr (a node's unary or
-// message, about 14 lines each at 220 labels) ahead of their use: a pass
-// streams through over a gigabyte at the working resolution.
-inline void PrefetchFloats(const float* ptr, int count) {
+// Asks for the cache lines of `bytes` bytes from ptr (a node's unary or
+// message, about 14 lines each at 220 float labels) ahead of their use: a
+// pass streams through over a gigabyte at the working resolution.
+inline void Prefetch(const void* ptr, size_t bytes) {
 #if defined(__GNUC__)
-  for (int i = 0; i < count; i += 16) __builtin_prefetch(ptr + i);
+  for (size_t i = 0; i < bytes; i += 64) __builtin_prefetch(static_cast<const char*>(ptr) + i);
 #endif
 }
 
@@ -297,7 +297,6 @@ struct MessageStore {
   int stride = 0;
   float* Open(size_t p, float* /*scratch*/) const { return base + p * stride; }
   void Close(size_t /*p*/, const float* /*scratch*/) const {}
-  const void* Address(size_t p) const { return base + p * stride; }
 };
 
 #if defined(CASUAL3D_AVX2_MESSAGES)
@@ -310,7 +309,6 @@ struct MessageStore<uint16_t> {
     return scratch;
   }
   void Close(size_t p, const float* scratch) const { FloatToHalf(scratch, base + p * stride, stride); }
-  const void* Address(size_t p) const { return base + p * stride; }
 };
 #endif
 
@@ -318,7 +316,7 @@ struct MessageStore<uint16_t> {
 // transform.
 template <typename Msg>
 __attribute__((always_inline)) inline TrwsResult SolveTrwsWith(const GridMrf& mrf, const TrwsOptions& options,
-                                                                BufferPool* pool, bool avx2) {
+                                                                BufferPool* pool, [[maybe_unused]] bool avx2) {
   const int w = mrf.width, h = mrf.height, L = mrf.num_labels;
   const size_t n = static_cast<size_t>(w) * h;
   // One message per edge (as in Kolmogorov 2006): at any time the edge
@@ -379,17 +377,16 @@ __attribute__((always_inline)) inline TrwsResult SolveTrwsWith(const GridMrf& mr
       SendMessages<1>(belief.data(), gamma, L, S, edges, weights, T);
     }
   };
-  (void)avx2;
 
   // Prefetching: node q's unary and the messages a pass reads at q (its own
   // edges, and the edge from the node above when q has one).
   const size_t kAhead = 2;  // Nodes ahead.
-  const int msg_floats = static_cast<int>(S * sizeof(Msg) / sizeof(float));
+  const size_t msg_bytes = S * sizeof(Msg);
   auto prefetch_node = [&](size_t q) {
-    PrefetchFloats(&mrf.unary[q * L], L);
-    PrefetchFloats(static_cast<const float*>(hor.Address(q)), msg_floats);
-    PrefetchFloats(static_cast<const float*>(ver.Address(q)), msg_floats);
-    if (q >= static_cast<size_t>(w)) PrefetchFloats(static_cast<const float*>(ver.Address(q - w)), msg_floats);
+    Prefetch(&mrf.unary[q * L], L * sizeof(float));
+    Prefetch(hor.base + q * S, msg_bytes);
+    Prefetch(ver.base + q * S, msg_bytes);
+    if (q >= static_cast<size_t>(w)) Prefetch(ver.base + (q - w) * S, msg_bytes);
   };
   for (int iter = 0; iter < options.max_iterations; ++iter) {
     // Forward pass (raster order): messages to the right and down neighbours,

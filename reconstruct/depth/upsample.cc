@@ -6,8 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "reconstruct/depth/avx2_clones.h"
-#include "reconstruct/depth/fast_exp.h"
+#include "reconstruct/depth/colour_weights.h"
 #include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
@@ -21,27 +20,6 @@ Status UpsampleOptions::Check() const {
   if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
   return Status::Ok();
 }
-
-namespace {
-
-// Weights of a window's `count` samples for one output pixel of colour c0:
-// spatial[s] * wc[column[s]] * exp(-|c_s - c0|^2 inv_sc) + 1e-12, the
-// samples' colours in the planes sr, sg, sb. Returns their sum.
-CASUAL3D_AVX2_CLONES
-float SampleWeights(int count, const float* __restrict sr, const float* __restrict sg, const float* __restrict sb,
-                    const float* __restrict spatial, const int* __restrict column, const float* __restrict wc,
-                    const float* c0, float inv_sc, float* __restrict weight) {
-  const float r0 = c0[0], g0 = c0[1], b0 = c0[2];
-  for (int s = 0; s < count; ++s) {
-    const float dr = sr[s] - r0, dg = sg[s] - g0, db = sb[s] - b0;
-    weight[s] = spatial[s] * wc[column[s]] * ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv_sc) + 1e-12f;
-  }
-  float total = 0.0f;
-  for (int s = 0; s < count; ++s) total += weight[s];
-  return total;
-}
-
-}  // namespace
 
 ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
                                     const ImageF& high_color, const UpsampleOptions& options) {
@@ -58,8 +36,8 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
   const float inv_sc = static_cast<float>(1.0 / (2 * options.sigma_color * options.sigma_color));
   ImageF out(hw, hh, 1, 0.0f);
   // The spatial weight is separable: per column and per row, the 2r + 1
-  // factors exp(-d^2 / (2 sigma_s^2)) of its window. The colour weight
-  // is computed per sample (SampleWeights, vectorised).
+  // factors exp(-d^2 / (2 sigma_s^2)) of its window. The colour weights
+  // are computed per sample (ColourWeights).
   const int taps = 2 * r + 1;
   std::vector<int> ucol(hw);
   std::vector<float> wcol(static_cast<size_t>(hw) * taps);
@@ -120,8 +98,12 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
       if (count == 0) continue;
       const float* wc = &wcol[static_cast<size_t>(x) * taps];
       const float* c0 = &high_color.at(x, y, 0);
-      const float total = SampleWeights(count, sr.data(), sg.data(), sb.data(), spatial.data(), column.data(), wc,
-                                        c0, inv_sc, weight.data());
+      ColourWeights(sr.data(), sg.data(), sb.data(), count, c0, inv_sc, weight.data());
+      float total = 0.0f;
+      for (int s = 0; s < count; ++s) {
+        weight[s] = spatial[s] * wc[column[s]] * weight[s] + 1e-12f;
+        total += weight[s];
+      }
       float acc = 0.0f;
       float med = value[order[count - 1]];
       for (int k = 0; k < count; ++k) {

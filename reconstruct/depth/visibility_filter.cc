@@ -1,6 +1,5 @@
 #include "reconstruct/depth/visibility_filter.h"
 
-#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -8,6 +7,7 @@
 #include <string>
 
 #include "reconstruct/depth/fast_exp.h"
+#include "reconstruct/depth/plane_sweep.h"
 #include "reconstruct/depth/sweep_kernels.h"
 
 namespace casual3d::depth {
@@ -18,26 +18,31 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 bool HasDepth(float d) { return d > 0 && std::isfinite(d); }
 
-// Another view seen from the reference: the rigid motion from the reference
-// camera's frame to its frame.
+// Another view seen from the reference. A reference pixel (x, y) at depth d
+// lands at `to`'s homogeneous coordinates h = Homogeneous(c, x, y, 1 / d)
+// in it, at depth d * h[2]; `from` maps the view's pixels into the
+// reference the same way.
 struct Other {
-  Eigen::Matrix3d r;
-  Eigen::Vector3d t;
-  // The same motion followed by the view's intrinsics: a point p of the
-  // reference frame lands at pixel (h.x / h.z, h.y / h.z) for h = kr * p + kt,
-  // with h.z its depth in the view.
-  Eigen::Matrix3d kr;
-  Eigen::Vector3d kt;
-  const PinholeCamera* camera;
+  PlaneHomography to, from;
   const ImageF* depth;
   const ImageF* gray;
 };
 
-// The ray of pixel x = 0 of row y in the camera frame (unit Z); the next
-// pixel's adds (1 / fx, 0, 0).
-Eigen::Vector3d RowRay(const PinholeCamera& c, int y) {
-  return {(0.5 - c.cx) / c.fx, ((y + 0.5) - c.cy) / c.fy, 1.0};
+// Where reference pixel (x, y) at depth d lands in a view through `hom`:
+// pixel-index coordinates (u, v) (centres at integers) and its depth there.
+// False behind the view.
+bool Land(const PlaneHomography& hom, int x, int y, double d, float* u, float* v, double* depth) {
+  const float inv_d = static_cast<float>(1.0 / d);
+  const float qz = hom.Homogeneous(2, x, y, inv_d);
+  if (!(qz > 0)) return false;
+  *u = hom.Homogeneous(0, x, y, inv_d) / qz - 0.5f;
+  *v = hom.Homogeneous(1, x, y, inv_d) / qz - 0.5f;
+  *depth = d * qz;
+  return true;
 }
+
+// True when pixel-index coordinates (u, v) fall on a pixel of a w x h image.
+bool OnImage(float u, float v, int w, int h) { return u >= -0.5f && v >= -0.5f && u < w - 0.5f && v < h - 0.5f; }
 
 // The nearest valid depth among the 3x3 pixels around (u, v); +inf if none.
 float NearestAround(const float* data, int width, int height, int u, int v) {
@@ -50,14 +55,12 @@ float NearestAround(const float* data, int width, int height, int u, int v) {
   return nearest;
 }
 
-// Bilinear sample of a 1-channel image at continuous coordinates (u, v)
-// (COLMAP's: pixel centres at +0.5); NaN outside the pixel centres' hull.
-float SampleInside(const ImageF& image, double u, double v) {
-  const double x = u - 0.5, y = v - 0.5;
-  if (!(x >= 0 && y >= 0 && x <= image.width() - 1 && y <= image.height() - 1))
+// Bilinear sample of a 1-channel image at pixel-index coordinates (u, v);
+// NaN outside the pixel centres' hull.
+float SampleInside(const ImageF& image, float u, float v) {
+  if (!(u >= 0 && v >= 0 && u <= image.width() - 1 && v <= image.height() - 1))
     return std::numeric_limits<float>::quiet_NaN();
-  return sweep::Bilinear(image.data(), image.width(), image.height(), static_cast<float>(x),
-                         static_cast<float>(y));
+  return sweep::Bilinear(image.data(), image.width(), image.height(), u, v);
 }
 
 // A reference pixel's comparison window: half-size r, every stride-th
@@ -91,23 +94,21 @@ struct Window {
 
 // How well each view agrees with reference pixel (x, y) at depth z: the
 // weighted mean absolute grey difference between the pixel's window and its
-// projections at that depth (a fronto-parallel patch). NaN for a view that
-// does not see the whole window.
-void PhotoCosts(const PinholeCamera& cr, const Window& window, int x, int y, double z,
-                const std::vector<Other>& list, std::vector<float>* costs) {
-  const Eigen::Vector3d ray(((x + 0.5) - cr.cx) / cr.fx, ((y + 0.5) - cr.cy) / cr.fy, 1.0);
+// projections at that depth (a fronto-parallel patch: the plane of inverse
+// depth 1 / z). NaN for a view that does not see the whole window.
+void PhotoCosts(const Window& window, int x, int y, double z, const std::vector<Other>& list,
+                std::vector<float>* costs) {
+  const float inv_z = static_cast<float>(1.0 / z);
   costs->assign(list.size(), std::numeric_limits<float>::quiet_NaN());
   for (size_t k = 0; k < list.size(); ++k) {
     const Other& o = list[k];
-    // h(dx, dy) = z * kr * ray(x + dx, y + dy) + kt, affine in (dx, dy).
-    const Eigen::Vector3d h0 = z * (o.kr * ray) + o.kt;
-    const Eigen::Vector3d hx = (z / cr.fx) * o.kr.col(0), hy = (z / cr.fy) * o.kr.col(1);
     double sum = 0;
     bool inside = true;
     for (const Window::Tap& tap : window.taps) {
-      const Eigen::Vector3d h = h0 + tap.dx * hx + tap.dy * hy;
-      const float g = h.z() > 0 ? SampleInside(*o.gray, h.x() / h.z(), h.y() / h.z())
-                                : std::numeric_limits<float>::quiet_NaN();
+      float u, v;
+      const float g = o.to.Project(static_cast<float>(x + tap.dx), static_cast<float>(y + tap.dy), inv_z, &u, &v)
+                          ? SampleInside(*o.gray, u, v)
+                          : std::numeric_limits<float>::quiet_NaN();
       if (std::isnan(g)) {
         inside = false;
         break;
@@ -159,15 +160,8 @@ std::vector<DepthReplacement> CheckFreeSpace(int ref,
   for (int j : others) {
     if (j == ref) continue;
     if (static_cast<int>(list.size()) >= options.max_views) break;
-    Other o;
-    o.camera = cameras[j];
-    o.depth = depths[j];
-    o.gray = grays[j];
-    o.r = o.camera->R * cr.R.transpose();
-    o.t = o.camera->t - o.r * cr.t;
-    o.kr = o.camera->K() * o.r;
-    o.kt = o.camera->K() * o.t;
-    list.push_back(o);
+    list.push_back({ComputePlaneHomography(cr, *cameras[j]), ComputePlaneHomography(*cameras[j], cr), depths[j],
+                    grays[j]});
   }
   const double band_floor = options.tolerance_labels * inv_step;
   // The band of agreement around depth z, in inverse depth.
@@ -175,11 +169,7 @@ std::vector<DepthReplacement> CheckFreeSpace(int ref,
 
   // 1. Pixels that other views see through.
   std::vector<int> flagged;
-  // h = kr * (d * ray(x, y)) + kt, with kr * ray(x, y) = row[k] + x * step[k].
-  std::vector<Eigen::Vector3d> row(list.size()), step(list.size());
-  for (size_t k = 0; k < list.size(); ++k) step[k] = list[k].kr.col(0) / cr.fx;
   for (int y = 0; y < height; ++y) {
-    for (size_t k = 0; k < list.size(); ++k) row[k] = list[k].kr * RowRay(cr, y);
     for (int x = 0; x < width; ++x) {
       const float d = dr.at(x, y);
       if (!HasDepth(d)) continue;
@@ -189,13 +179,12 @@ std::vector<DepthReplacement> CheckFreeSpace(int ref,
         // Settled once the views left cannot outvote the agreeing ones.
         if (agree >= through + (num_views - k)) break;
         const Other& o = list[k];
-        const Eigen::Vector3d h = d * (row[k] + x * step[k]) + o.kt;
-        if (h.z() <= 0) continue;
-        const double fu = h.x() / h.z(), fv = h.y() / h.z();
+        float fu, fv;
+        double zq;
         const int ow = o.depth->width(), oh = o.depth->height();
-        if (!(fu >= 0 && fv >= 0 && fu < ow && fv < oh)) continue;
-        const int u = static_cast<int>(fu), v = static_cast<int>(fv);
-        const double inv_q = 1.0 / h.z(), b = band(h.z());
+        if (!Land(o.to, x, y, d, &fu, &fv, &zq) || !OnImage(fu, fv, ow, oh)) continue;
+        const int u = static_cast<int>(fu + 0.5f), v = static_cast<int>(fv + 0.5f);
+        const double inv_q = 1.0 / zq, b = band(zq);
         const float dj = o.depth->at(u, v);
         if (HasDepth(dj) && std::abs(inv_q - 1.0 / dj) <= b) {
           ++agree;
@@ -217,24 +206,16 @@ std::vector<DepthReplacement> CheckFreeSpace(int ref,
   std::vector<float> zbuf(np);
   for (size_t k = 0; k < k_views; ++k) {
     const Other& o = list[k];
-    const PinholeCamera& co = *o.camera;
-    // The other view's frame to the reference's pixels: h = kr * q + kt.
-    const Eigen::Matrix3d kr = cr.K() * o.r.transpose();
-    const Eigen::Vector3d kt = -(kr * o.t);
-    const Eigen::Vector3d step = kr.col(0) / co.fx;
     std::fill(zbuf.begin(), zbuf.end(), kInf);
     for (int y = 0; y < o.depth->height(); ++y) {
-      const Eigen::Vector3d row = kr * RowRay(co, y);
       const float* drow = o.depth->data() + static_cast<size_t>(y) * o.depth->width();
       for (int x = 0; x < o.depth->width(); ++x) {
         const float dj = drow[x];
-        if (!HasDepth(dj)) continue;
-        const Eigen::Vector3d h = dj * (row + x * step) + kt;
-        if (h.z() <= 0) continue;
-        const double fu = h.x() / h.z(), fv = h.y() / h.z();
-        if (!(fu >= 0 && fv >= 0 && fu < width && fv < height)) continue;
-        float& z = zbuf[static_cast<size_t>(static_cast<int>(fv)) * width + static_cast<int>(fu)];
-        z = std::min(z, static_cast<float>(h.z()));
+        float fu, fv;
+        double zr;
+        if (!HasDepth(dj) || !Land(o.from, x, y, dj, &fu, &fv, &zr) || !OnImage(fu, fv, width, height)) continue;
+        float& z = zbuf[static_cast<size_t>(static_cast<int>(fv + 0.5f)) * width + static_cast<int>(fu + 0.5f)];
+        z = std::min(z, static_cast<float>(zr));
       }
     }
     // A pixel no splat reached (the view magnifies there) takes the nearest
@@ -272,8 +253,8 @@ std::vector<DepthReplacement> CheckFreeSpace(int ref,
       // may see past an occluder) find it worse by more than the margin.
       const int x = flagged[s] % width, y = flagged[s] / width;
       window.Reset(gray_ref, x, y, options.photo_radius, options.photo_stride);
-      PhotoCosts(cr, window, x, y, *mid, list, &cost_far);
-      PhotoCosts(cr, window, x, y, d, list, &cost_now);
+      PhotoCosts(window, x, y, *mid, list, &cost_far);
+      PhotoCosts(window, x, y, d, list, &cost_now);
       diffs.clear();
       for (size_t k = 0; k < k_views; ++k)
         if (!std::isnan(cost_far[k]) && !std::isnan(cost_now[k]))

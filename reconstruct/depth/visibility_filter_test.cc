@@ -178,27 +178,21 @@ TEST(VisibilityFilter, SkipsPixelsWithoutDepth) {
 
 TEST(VisibilityFilter, OptionsAreChecked) {
   EXPECT_TRUE(VisibilityFilterOptions().Check().ok());
-  VisibilityFilterOptions o;
-  o.tolerance = 0;
-  EXPECT_FALSE(o.Check().ok());
-  o = VisibilityFilterOptions();
-  o.tolerance_labels = -1;
-  EXPECT_FALSE(o.Check().ok());
-  o = VisibilityFilterOptions();
-  o.min_violations = 0;
-  EXPECT_FALSE(o.Check().ok());
-  o = VisibilityFilterOptions();
-  o.max_views = 0;
-  EXPECT_FALSE(o.Check().ok());
-  o = VisibilityFilterOptions();
-  o.rounds = 11;
-  EXPECT_FALSE(o.Check().ok());
-  o = VisibilityFilterOptions();
-  o.photo_margin = -0.1;
-  EXPECT_FALSE(o.Check().ok());
-  o = VisibilityFilterOptions();
-  o.photo_stride = 0;
-  EXPECT_FALSE(o.Check().ok());
+  auto bad = [](auto change) {
+    VisibilityFilterOptions o;
+    change(&o);
+    return !o.Check().ok();
+  };
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->tolerance = 0; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->tolerance = 1.5; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->tolerance_labels = -1; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->min_violations = 0; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->max_views = 0; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->max_views = 256; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->rounds = 11; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->photo_margin = -0.1; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->photo_radius = 11; }));
+  EXPECT_TRUE(bad([](VisibilityFilterOptions* o) { o->photo_stride = 0; }));
 }
 
 }  // namespace

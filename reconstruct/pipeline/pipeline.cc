@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 // Bump when a stage's output format or algorithm changes, so old caches are stale.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-2", "dense-3", "panorama-3",
+constexpr const char* kStageVersions[kNumStages] = {"sparse-2", "dense-4", "panorama-3",
                                                     "encode-1"};
 
 std::string HashHex(const std::string& text) {
