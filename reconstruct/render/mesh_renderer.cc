@@ -104,6 +104,10 @@ class Rasterizer {
       }
     }
     color_ = &result.color;
+    if (options_.want_triangle_ids) {
+      result.triangle_ids = Image<uint32_t>(view_.width, view_.height, 1, kNoTriangle);
+      ids_ = result.triangle_ids.data();
+    }
     ParallelFor(num_bands_, num_threads_,
                 [&](int64_t band) { RasterBand(static_cast<int>(band)); });
 
@@ -267,13 +271,13 @@ class Rasterizer {
     for (uint32_t t : bands_[band]) {
       const int count = ClipAndProject(t, poly);
       for (int k = 1; k + 1 < count; ++k) {
-        RasterTriangle(poly[0], poly[k], poly[k + 1], row_begin, row_end);
+        RasterTriangle(poly[0], poly[k], poly[k + 1], t, row_begin, row_end);
       }
     }
   }
 
   void RasterTriangle(const ScreenVertex& p0, const ScreenVertex& p1_in, const ScreenVertex& p2_in,
-                      int row_begin, int row_end) {
+                      uint32_t triangle, int row_begin, int row_end) {
     const ScreenVertex* v[3] = {&p0, &p1_in, &p2_in};
     int64_t area =
         (v[1]->x - v[0]->x) * (v[2]->y - v[0]->y) - (v[1]->y - v[0]->y) * (v[2]->x - v[0]->x);
@@ -329,6 +333,7 @@ class Rasterizer {
         const size_t pixel = static_cast<size_t>(j) * width + static_cast<size_t>(i);
         if (!(z < zbuffer_[pixel])) continue;
         zbuffer_[pixel] = z;
+        if (ids_ != nullptr) ids_[pixel] = triangle;
         double attr[kNumAttrs];
         for (int c = 0; c < kNumAttrs; ++c) {
           attr[c] = (b[0] * v[0]->attr_over_z[c] + b[1] * v[1]->attr_over_z[c] +
@@ -382,6 +387,7 @@ class Rasterizer {
   std::vector<std::vector<uint32_t>> bands_;
   std::vector<float> zbuffer_;
   Image8* color_ = nullptr;
+  uint32_t* ids_ = nullptr;  // RenderResult::triangle_ids when wanted.
 };
 
 void CheckInputs(const Mesh& mesh, ImageView<const uint8_t> atlas, const PinholeView& view,

@@ -53,6 +53,9 @@ struct RenderOptions {
   uint8_t background[3] = {0, 0, 0};
   // Worker threads; 0 uses all cores. Range [0, 256]. Does not change output.
   int num_threads = 0;
+  // Also output, per pixel, the index of the triangle that drew it
+  // (RenderResult::triangle_ids); off by default, costing nothing then.
+  bool want_triangle_ids = false;
 
   // InvalidArgument naming the first field out of range.
   Status Check() const;
@@ -63,7 +66,13 @@ struct RenderResult {
   ImageF depth;  // width x height x 1, camera-frame z in metres; 0 where uncovered.
   Image8 mask;   // width x height x 1, 255 where covered, 0 elsewhere.
   int64_t covered_pixels = 0;
+  // Only with RenderOptions::want_triangle_ids: width x height x 1, the index
+  // (into Mesh::indices / 3) of the triangle whose fragment won the z-test at
+  // each pixel, kNoTriangle where uncovered. Empty otherwise.
+  Image<uint32_t> triangle_ids;
 };
+
+constexpr uint32_t kNoTriangle = 0xffffffffu;
 
 // A pinhole view of the panorama frame (format/equirect.h):
 //   x_cam = rotation * p_panorama + translation

@@ -571,6 +571,52 @@ TEST(MeshRendererTest, OutputDoesNotDependOnThreadCount) {
   EXPECT_NEAR(one.depth.at(166, 108), 2.0, 0.3);
 }
 
+TEST(MeshRendererTest, TriangleIdsNameTheTriangleThatWonTheDepthTest) {
+  // A quad (triangles 0 and 1) at z = -4 behind a quad (triangles 2 and 3) at
+  // z = -2 that covers the left half of the view.
+  Mesh scene = Parallelogram({-3, 2, -4}, {6, 0, 0}, {0, -4, 0});
+  const Mesh near = Parallelogram({-3, 2, -2}, {3, 0, 0}, {0, -4, 0});
+  const uint32_t offset = static_cast<uint32_t>(scene.num_vertices());
+  scene.positions.insert(scene.positions.end(), near.positions.begin(), near.positions.end());
+  scene.normals.insert(scene.normals.end(), near.normals.begin(), near.normals.end());
+  scene.uvs.insert(scene.uvs.end(), near.uvs.begin(), near.uvs.end());
+  scene.colors.insert(scene.colors.end(), near.colors.begin(), near.colors.end());
+  for (uint32_t index : near.indices) scene.indices.push_back(index + offset);
+  GlCamera camera;
+  camera.fov_y_deg = 100.0;
+  const PinholeView view = ViewFromGlCamera(camera, 120, 90);
+  const Image8 atlas = LinearAtlas(64, 64);
+  RenderOptions options;
+  const RenderResult plain = RenderMesh(scene, atlas.view(), view, options);
+  EXPECT_TRUE(plain.triangle_ids.empty());
+  options.want_triangle_ids = true;
+  const RenderResult r = RenderMesh(scene, atlas.view(), view, options);
+  ASSERT_EQ(r.triangle_ids.width(), 120);
+  ASSERT_EQ(r.triangle_ids.height(), 90);
+  // Asking for ids changes nothing else.
+  EXPECT_TRUE(plain.color == r.color);
+  EXPECT_TRUE(plain.depth == r.depth);
+  int64_t near_pixels = 0;
+  for (int y = 0; y < 90; ++y) {
+    for (int x = 0; x < 120; ++x) {
+      const uint32_t id = r.triangle_ids.at(x, y);
+      if (!r.mask.at(x, y)) {
+        EXPECT_EQ(id, kNoTriangle);
+        continue;
+      }
+      ASSERT_LT(id, 4u);
+      // The near quad wins wherever it is drawn, and its depth says so.
+      EXPECT_EQ(id >= 2, r.depth.at(x, y) < 3.0f) << x << "," << y;
+      near_pixels += id >= 2;
+      // Left of the centre column only the near quad is seen.
+      if (x < 59) {
+        EXPECT_GE(id, 2u) << x << "," << y;
+      }
+    }
+  }
+  EXPECT_GT(near_pixels, 1000);
+}
+
 TEST(MeshRendererTest, RejectsInconsistentInput) {
   Mesh mesh = Parallelogram({-1, 1, -2}, {2, 0, 0}, {0, -2, 0});
   const Image8 atlas = LinearAtlas(8, 8);

@@ -1,0 +1,109 @@
+#include "reconstruct/render/derived_view_hints.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace casual3d::render {
+namespace {
+
+constexpr double kDeg = 180.0 / kPi;
+// A 4:3 view is what the field of view is fitted to.
+constexpr double kFitAspect = 4.0 / 3.0;
+
+// 5th percentile of the present front depths, from at most about a million
+// evenly spaced nodes; 0 when there are none.
+double LowFrontDepth(const TwoLayerPanorama& pano) {
+  const LayerData& front = pano.layer(kFront);
+  const size_t n = front.present.size();
+  const size_t step = std::max<size_t>(1, n / (1 << 20));
+  std::vector<float> depths;
+  for (size_t i = 0; i < n; i += step)
+    if (front.present[i] && std::isfinite(front.depth_m[i]) && front.depth_m[i] > 0)
+      depths.push_back(front.depth_m[i]);
+  if (depths.empty()) return 0.0;
+  const size_t k = depths.size() / 20;
+  std::nth_element(depths.begin(), depths.begin() + k, depths.end());
+  return depths[k];
+}
+
+}  // namespace
+
+ViewHints DeriveViewHints(const TwoLayerPanorama& pano) {
+  ViewHints hints;
+  const int w = pano.width(), h = pano.height();
+  const LayerData& front = pano.layer(kFront);
+  std::vector<int> column_count(w, 0), row_count(h, 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) column_count[x] += front.present[pano.index(x, y)] != 0;
+  const int column_min = std::max(1, h / 200);
+  std::vector<bool> column(w);
+  int content_columns = 0;
+  for (int x = 0; x < w; ++x) content_columns += column[x] = column_count[x] >= column_min;
+
+  const double low_depth = LowFrontDepth(pano);
+  if (low_depth > 0) {
+    hints.volume_radius = kDerivedVolumeFraction * low_depth;
+  } else {
+    double near_m = 0, far_m = 0;
+    hints.volume_radius = pano.NodeDepthRange(&near_m, &far_m) && near_m > 0
+                              ? kDerivedVolumeFraction * near_m
+                              : 0.1;
+  }
+  if (content_columns == 0) return hints;
+
+  // Longitudes: the complement of the largest circular run of empty columns.
+  double yaw_min = -180, yaw_max = 180;
+  if (content_columns < w) {
+    int best_start = 0, best_length = 0;
+    for (int x = 0; x < w; ++x) {
+      // Runs starting right after a content column, scanned around the seam.
+      if (column[x] || !column[(x + w - 1) % w]) continue;
+      int length = 0;
+      while (length < w && !column[(x + length) % w]) ++length;
+      if (length > best_length) best_length = length, best_start = x;
+    }
+    const int first = (best_start + best_length) % w;  // First content column after the gap.
+    const double extent = 360.0 * (w - best_length) / w;
+    const double start = (double(first) / w - 0.5) * 360.0;
+    double middle = start + extent / 2;
+    if (middle >= 180) middle -= 360;
+    yaw_min = middle - extent / 2;
+    yaw_max = middle + extent / 2;
+    hints.yaw_deg = middle;
+  }
+  hints.content_yaw_min_deg = yaw_min;
+  hints.content_yaw_max_deg = yaw_max;
+
+  // Latitudes: first and last rows with enough front nodes in content columns.
+  const int row_min = std::max(1, content_columns / 200);
+  int top = -1, bottom = -1;
+  for (int y = 0; y < h; ++y) {
+    int count = 0;
+    for (int x = 0; x < w; ++x) count += column[x] && front.present[pano.index(x, y)];
+    if (count >= row_min) {
+      if (top < 0) top = y;
+      bottom = y;
+    }
+  }
+  if (top < 0) top = 0, bottom = h - 1;
+  hints.content_pitch_max_deg = (0.5 - double(top) / h) * 180.0;
+  hints.content_pitch_min_deg = (0.5 - double(bottom + 1) / h) * 180.0;
+  hints.pitch_deg = 0.5 * (hints.content_pitch_min_deg + hints.content_pitch_max_deg);
+
+  const double lat_extent = hints.content_pitch_max_deg - hints.content_pitch_min_deg;
+  const double lon_half = std::min(89.9, 0.5 * (yaw_max - yaw_min)) / kDeg;
+  const double fov_from_lon = 2.0 * std::atan(std::tan(lon_half) / kFitAspect) * kDeg;
+  hints.fov_deg = std::clamp(std::min(lat_extent, fov_from_lon), 10.0, 120.0);
+  return hints;
+}
+
+ViewHints ResolveViewHints(const TwoLayerPanorama& pano, const std::optional<ViewHints>& hints,
+                           bool* derived) {
+  const bool use_given = hints.has_value() && hints->Validate().ok();
+  if (derived != nullptr) *derived = !use_given;
+  return use_given ? *hints : DeriveViewHints(pano);
+}
+
+}  // namespace casual3d::render
