@@ -1,8 +1,10 @@
 // `casual3d evaluate <capture> <3d-photo> [more 3d photos] [-o report.html]
 // [--json out.json] [--width 900] [--photos names...] [--holdout-every N]
-// [--labels names...] [--reference NAME:PSNR:SSIM]`:
+// [--labels names...] [--reference NAME:PSNR:SSIM] [--no-viewer-views]
+// [--viewer-width 640] [--viewer-height 400] [--viewer-images DIR]`:
 // virtual rephotography (paper Sec. 6.3) of one or more 3D photos of the same
-// capture, with a self-contained HTML report and a JSON summary.
+// capture and what a viewer sees of each (tears, stretched fill), with a
+// self-contained HTML report and a JSON summary.
 
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +15,7 @@
 #include "cli/command.h"
 #include "reconstruct/eval/evaluate.h"
 #include "reconstruct/eval/report.h"
+#include "reconstruct/eval/viewer_views_report.h"
 #include "reconstruct/io/file_util.h"
 
 namespace casual3d::cli {
@@ -27,6 +30,8 @@ void AddEvaluateCommand(CLI::App& app) {
     eval::ReportOptions report;
     std::vector<std::string> labels;
     std::vector<std::string> references;
+    bool no_viewer_views = false;
+    std::string viewer_images;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -64,7 +69,24 @@ void AddEvaluateCommand(CLI::App& app) {
                   "Published result on the same protocol shown in the report, NAME:PSNR_DB:SSIM "
                   "(repeatable; e.g. LLFF:23.22:0.753)");
   cmd->add_option("--title", args->report.title, "Title of the HTML report")->capture_default_str();
+  cmd->add_flag("--no-viewer-views", args->no_viewer_views,
+                "Skip the viewer-side measure (tears and stretched fill seen from 17 eyes over "
+                "the viewing volume)");
+  cmd->add_option("--viewer-width", args->options.viewer.width,
+                  "Width of the viewer views, pixels")
+      ->capture_default_str();
+  cmd->add_option("--viewer-height", args->options.viewer.height,
+                  "Height of the viewer views, pixels")
+      ->capture_default_str();
+  cmd->add_option("--stretch-factor", args->options.viewer.stretch_factor,
+                  "A triangle is stretched when longer on screen than this many times the "
+                  "view's median triangle")
+      ->capture_default_str();
+  cmd->add_option("--viewer-images", args->viewer_images,
+                  "Also write each viewer view's heatmap and their grid as PNG files to this "
+                  "folder (prefixed with the 3D photo's number)");
   cmd->callback([args] {
+    args->options.viewer_views = !args->no_viewer_views;
     if (const std::string why = args->options.Check(); !why.empty())
       throw std::invalid_argument("evaluate: --" + why);
     if (!args->labels.empty() && args->labels.size() != args->photo3d.size())
@@ -108,6 +130,14 @@ void AddEvaluateCommand(CLI::App& app) {
         std::printf(", depth median rel. error %.4f, within 3%% %.3f", e.mean_depth_median_rel,
                     e.mean_depth_within);
       std::printf("\n");
+      if (e.viewer) {
+        std::printf("  %s\n", eval::ViewerViewsSummary(*e.viewer).c_str());
+        if (!args->viewer_images.empty()) {
+          std::filesystem::create_directories(args->viewer_images);
+          eval::WriteViewerHeatmaps(*e.viewer, args->viewer_images, std::to_string(k) + "_");
+          std::printf("  viewer heatmaps: %s/%zu_viewer_*.png\n", args->viewer_images.c_str(), k);
+        }
+      }
       for (const eval::PhotoEvaluation& q : e.photos)
         std::printf(
             "  %-24s %dx%d error %.4f completeness %.3f PSNR %6.2f SSIM %.3f whole frame %6.2f "

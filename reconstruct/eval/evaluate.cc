@@ -39,6 +39,7 @@ std::string EvaluateOptions::Check() const {
   if (num_threads < 0 || num_threads > 256)
     return "num_threads: " + std::to_string(num_threads) + " is outside [0, 256]";
   if (const std::string why = metrics.Check(); !why.empty()) return "metrics." + why;
+  if (const std::string why = viewer.Check(); !why.empty()) return "viewer." + why;
   return {};
 }
 
@@ -329,6 +330,17 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
   util::LogInfo("evaluate: " + photo3d_path + ": mesh of " + std::to_string(eval.mesh_triangles) +
                 " triangles in " + std::to_string(SecondsSince(mesh_start)) + " s; " +
                 std::to_string(selected.size()) + " photos");
+
+  if (options.viewer_views) {
+    const auto viewer_start = std::chrono::steady_clock::now();
+    ViewerViewsOptions viewer = options.viewer;
+    viewer.num_threads = options.num_threads;
+    viewer.keep_images = viewer.keep_images && options.keep_images;
+    eval.viewer =
+        EvaluateViewerViews(photo3d.pano, *mesh, atlas.view(), photo3d.pano.view_hints(), viewer);
+    util::LogInfo("evaluate: " + photo3d_path + ": 17 viewer views in " +
+                  std::to_string(SecondsSince(viewer_start)) + " s");
+  }
 
   render::RenderOptions render_options;
   render_options.num_threads = options.num_threads;

@@ -25,11 +25,13 @@
 // those are evaluated. Without such a list every registered photo is.
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "format/image.h"
 #include "reconstruct/eval/rephoto_metrics.h"
+#include "reconstruct/eval/viewer_views.h"
 
 namespace casual3d::eval {
 
@@ -51,6 +53,10 @@ struct EvaluateOptions {
   // (0.03 = 3%); (0, 1].
   double depth_tolerance = 0.03;
   int num_threads = 0;  // Rendering threads; 0 = all cores.
+  // What a viewer sees (viewer_views.h): tears and stretched fill from 17
+  // views over the viewing volume. Needs the 3D photo only.
+  bool viewer_views = true;
+  ViewerViewsOptions viewer;
 
   std::string Check() const;  // Empty if valid, else "field: reason".
 };
@@ -106,6 +112,8 @@ struct PhotoModelEvaluation {
   double depth_scale = 1.0;
   std::vector<int64_t> error_histogram;  // Sum over photos.
   int64_t total_pixels = 0;              // Sum of photo sizes.
+  // With EvaluateOptions::viewer_views: the viewer-side measure.
+  std::optional<ViewerViewsEvaluation> viewer;
 };
 
 // Evaluates one 3D photo on `capture_dir`. Throws std::invalid_argument for

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "reconstruct/eval/viewer_views_report.h"
 #include "reconstruct/io/colour_map.h"
 #include "reconstruct/io/cv_bridge.h"
 #include "reconstruct/util/html.h"
@@ -52,6 +53,18 @@ std::string Base64(const std::string& bytes) {
   return out;
 }
 
+std::string PngDataUri(const Image8& rgb, int width) {
+  if (rgb.empty()) return {};
+  cv::Mat src = io::ToMat(rgb), scaled, bgr;
+  const int w = std::min(width, rgb.width());
+  const int h = std::max(1, static_cast<int>(std::lround(double(rgb.height()) * w / rgb.width())));
+  cv::resize(src, scaled, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+  cv::cvtColor(scaled, bgr, cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> png;
+  cv::imencode(".png", bgr, png);
+  return "data:image/png;base64," + Base64(std::string(png.begin(), png.end()));
+}
+
 void HeatmapColor(float error, double max_error, uint8_t rgb[3]) {
   if (!(error >= 0)) {
     rgb[0] = rgb[1] = rgb[2] = 128;
@@ -66,19 +79,6 @@ std::string Fmt(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
   return buf;
-}
-
-// A PNG data URI of an RGB image scaled to `width` pixels wide.
-std::string PngDataUri(const Image8& rgb, int width) {
-  if (rgb.empty()) return {};
-  cv::Mat src = io::ToMat(rgb), scaled, bgr;
-  const int w = std::min(width, rgb.width());
-  const int h = std::max(1, static_cast<int>(std::lround(double(rgb.height()) * w / rgb.width())));
-  cv::resize(src, scaled, cv::Size(w, h), 0, 0, cv::INTER_AREA);
-  cv::cvtColor(scaled, bgr, cv::COLOR_RGB2BGR);
-  std::vector<uint8_t> png;
-  cv::imencode(".png", bgr, png);
-  return "data:image/png;base64," + Base64(std::string(png.begin(), png.end()));
 }
 
 Image8 Heatmap(const ImageF& error, double max_error) {
@@ -256,6 +256,7 @@ std::string RenderHtmlReport(const std::string& capture,
           << "</td></tr>\n";
       s << "</table>\n";
     }
+    if (e.viewer) s << ViewerViewsHtml(*e.viewer, options.thumbnail_width / 2);
     s << "<h3>Photos, rephotographs and error heatmaps</h3>\n<p>Heatmap: dark = low error, pale "
          "yellow = "
       << Fmt("%.2f", options.heatmap_max_error) << " or more, grey = not covered.</p>\n";
@@ -285,7 +286,11 @@ std::string RenderJsonReport(const std::string& capture,
   j["options"] = {{"width", options.width},
                   {"shift_radius_px", options.metrics.shift_radius_px},
                   {"psnr_cap_db", options.metrics.psnr_cap_db},
-                  {"depth_tolerance", options.depth_tolerance}};
+                  {"depth_tolerance", options.depth_tolerance},
+                  {"viewer_views", options.viewer_views},
+                  {"viewer_width", options.viewer.width},
+                  {"viewer_height", options.viewer.height},
+                  {"viewer_stretch_factor", options.viewer.stretch_factor}};
   j["photo3d"] = nlohmann::json::array();
   for (const auto& e : evals) {
     nlohmann::json m;
@@ -308,6 +313,7 @@ std::string RenderJsonReport(const std::string& capture,
       m["mean"]["depth_median_relative_error"] = e.mean_depth_median_rel;
       m["mean"]["depth_within_tolerance"] = e.mean_depth_within;
     }
+    if (e.viewer) m["viewer_views"] = nlohmann::json::parse(ViewerViewsJson(*e.viewer));
     m["stages"] = nlohmann::json::array();
     for (const auto& [stage, sec] : e.stage_seconds)
       m["stages"].push_back({{"stage", stage}, {"seconds", sec}});

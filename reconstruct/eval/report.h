@@ -8,7 +8,8 @@
 // per-photo figures (error, plain error, completeness, PSNR, SSIM and, on
 // synthetic captures, depth error against the ground truth), the error
 // versus completeness plot (paper Fig. 13: one curve per 3D photo), per-photo
-// thumbnails of photo, rendering and error heatmap, and the timings per stage;
+// thumbnails of photo, rendering and error heatmap, the timings per stage and,
+// when measured, what a viewer sees (viewer_views_report.h);
 // with several 3D photos (ablations) or reference results, a comparison table
 // of their means and stage timings side by side.
 
@@ -46,8 +47,9 @@ std::string RenderHtmlReport(const std::string& capture,
                              const ReportOptions& options = {});
 
 // The JSON document (pretty-printed): {"capture", "options", "photo3d": [{label,
-// source, means, stages, photos: [{name, index, held_out, error, error_plain,
-// completeness, psnr_db, ssim, covered_pixels, width, height, depth?}]}]}.
+// source, means, viewer_views? (viewer_views_report.h), stages, photos: [{name,
+// index, held_out, error, error_plain, completeness, psnr_db, ssim,
+// covered_pixels, width, height, depth?}]}]}.
 std::string RenderJsonReport(const std::string& capture,
                              const std::vector<PhotoModelEvaluation>& evaluations,
                              const EvaluateOptions& options);
@@ -58,5 +60,9 @@ void HeatmapColor(float error, double max_error, uint8_t rgb[3]);
 
 // Base64 (RFC 4648, with padding) of `bytes`.
 std::string Base64(const std::string& bytes);
+
+// A PNG data URI of an RGB image scaled down to at most `width` pixels wide
+// (area averaging); empty for an empty image.
+std::string PngDataUri(const Image8& rgb, int width);
 
 }  // namespace casual3d::eval
