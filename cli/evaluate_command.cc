@@ -82,6 +82,9 @@ void AddEvaluateCommand(CLI::App& app) {
                   "A triangle is stretched when longer on screen than this many times the "
                   "view's median triangle")
       ->capture_default_str();
+  cmd->add_flag("--derive-view-hints", args->options.viewer.derive_hints,
+                "Viewer views: derive the view hints from the panorama even when the 3D photo "
+                "carries its own");
   cmd->add_option("--viewer-images", args->viewer_images,
                   "Also write each viewer view's heatmap and their grid as PNG files to this "
                   "folder (prefixed with the 3D photo's number)");

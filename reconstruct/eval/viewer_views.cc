@@ -146,7 +146,8 @@ ViewerViewsEvaluation EvaluateViewerViews(const TwoLayerPanorama& pano, const Me
   if (const std::string why = options.Check(); !why.empty())
     throw std::invalid_argument("viewer views: " + why);
   ViewerViewsEvaluation eval;
-  eval.hints = render::ResolveViewHints(pano, hints, &eval.hints_derived);
+  eval.hints = render::ResolveViewHints(pano, options.derive_hints ? std::nullopt : hints,
+                                       &eval.hints_derived);
   eval.width = options.width;
   eval.height = options.height;
   eval.stretch_factor = options.stretch_factor;

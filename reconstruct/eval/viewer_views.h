@@ -61,6 +61,9 @@ struct ViewerViewsOptions {
   double stretch_factor = 8.0;
   // Closing radius of the captured field's content mask, degrees; [0, 45].
   double closing_deg = 2.0;
+  // Derive the view hints from the panorama even when the 3D photo has its
+  // own (to compare 3D photos with and without them on the same footing).
+  bool derive_hints = false;
   // Keep the rendering and the heatmap of each view (for the report).
   bool keep_images = true;
   int num_threads = 0;  // Rendering threads; 0 = all cores. [0, 256].
@@ -108,7 +111,8 @@ struct ViewerViewsEvaluation {
 };
 
 // Measures the 17 views of `mesh`, the mesh of `pano` (BuildMesh), with its
-// colour atlas `atlas`. `hints`: the 3D photo's own, or nullopt to derive them.
+// colour atlas `atlas`. `hints`: the 3D photo's own, or nullopt to derive them
+// (render::ResolveViewHints; always derived with options.derive_hints).
 // Throws std::invalid_argument for invalid options or the renderer's errors.
 ViewerViewsEvaluation EvaluateViewerViews(const TwoLayerPanorama& pano, const Mesh& mesh,
                                           ImageView<const uint8_t> atlas,

@@ -10,6 +10,7 @@
 #include "format/mesh_builder.h"
 #include "format/testing/test_panoramas.h"
 #include "reconstruct/eval/captured_field.h"
+#include "reconstruct/eval/viewer_views_report.h"
 #include "reconstruct/render/derived_view_hints.h"
 
 namespace casual3d::eval {
@@ -251,6 +252,48 @@ TEST(ViewerViewsTest, LinkedDepthStepGivesStretchedFill) {
     for (int x = 0; x < heat.width(); ++x)
       orange += heat.at(x, y, 0) == 255 && heat.at(x, y, 1) == 150 && heat.at(x, y, 2) == 0;
   EXPECT_EQ(orange, right.stretched_pixels);
+}
+
+TEST(ViewerViewsReportTest, GridHtmlAndJsonCarryEveryView) {
+  std::set<std::pair<int, int>> cells;
+  for (int k = 0; k < 17; ++k) {
+    int column, row;
+    ViewerGridCell(k, &column, &row);
+    EXPECT_TRUE(column >= 0 && column < 8 && row >= 0 && row < 3) << k;
+    cells.insert({column, row});
+  }
+  EXPECT_EQ(cells.size(), 17u);  // No two views share a cell.
+
+  TwoLayerPanorama pano = testing::MakeSpherePanorama(128, 64, 2.0f);
+  for (int y = 28; y < 34; ++y)
+    for (int x = 60; x < 66; ++x) CutLinks(&pano, x, y);
+  const MeshAndAtlas m = Build(pano);
+  ViewerViewsOptions options;
+  options.width = 64;
+  options.height = 48;
+  const ViewerViewsEvaluation e =
+      EvaluateViewerViews(pano, m.mesh, m.atlas.view(), Ahead(0.2), options);
+  ASSERT_GT(e.views[0].tear_pixels, 0);
+  // A thumbnail keeps a single tear visible: reduced 4 times, the red pixels
+  // still cover every tear.
+  const Image8 thumb = ViewerHeatmapThumbnail(e.views[0], 4);
+  EXPECT_EQ(thumb.width(), 16);
+  int64_t red = 0;
+  for (int y = 0; y < thumb.height(); ++y)
+    for (int x = 0; x < thumb.width(); ++x)
+      red += thumb.at(x, y, 0) == 255 && thumb.at(x, y, 1) == 0 && thumb.at(x, y, 2) == 0;
+  EXPECT_GE(red * 16, e.views[0].tear_pixels);
+  const Image8 grid = ViewerHeatmapGrid(e, 4);
+  EXPECT_EQ(grid.width(), 8 * 17 + 1);
+  EXPECT_EQ(grid.height(), 3 * 13 + 1);
+
+  const std::string html = ViewerViewsHtml(e, 32);
+  for (const std::string& name : ViewerCameraNames())
+    EXPECT_NE(html.find(">" + name + "<"), std::string::npos) << name;
+  const std::string json = ViewerViewsJson(e);
+  EXPECT_NE(json.find("\"centre_tears\""), std::string::npos);
+  EXPECT_NE(json.find("\"below az 315\""), std::string::npos);
+  EXPECT_NE(ViewerViewsSummary(e).find("tears centre"), std::string::npos);
 }
 
 }  // namespace
