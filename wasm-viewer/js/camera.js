@@ -4,9 +4,10 @@
 // forward): yaw and pitch are the longitude and latitude of the viewing
 // direction, so yaw 0, pitch 0 looks along -Z, yaw +90 deg looks along +X and
 // pitch +90 deg looks up (+Y); roll is always 0 (the up vector is +Y). The
-// vertical field of view is in degrees. `position` is the eye in metres in the
-// panorama frame; motion parallax keeps it inside a ball of `maxOffset` metres
-// around the centre (where the photo was captured). Matrices are column-major
+// vertical field of view is in degrees. `position` is the eye in the panorama
+// frame, in the unit of the package's depths (metres when known); motion
+// parallax keeps it inside a ball of radius `maxOffset` around the centre
+// (the package's viewing volume, where the photo was captured). Matrices are column-major
 // Float32Array(16) as WebGL expects; clip space is OpenGL's (z in [-1, 1]).
 
 const DEG = Math.PI / 180;
@@ -63,6 +64,31 @@ export function multiply(a, b) {
   return m;
 }
 
+/** Inverse of a column-major 4x4 matrix (cofactors); the identity if singular. */
+export function invert(m) {
+  const inv = new Float32Array(16);
+  inv[0] = m[5] * m[10] * m[15] - m[5] * m[11] * m[14] - m[9] * m[6] * m[15] + m[9] * m[7] * m[14] + m[13] * m[6] * m[11] - m[13] * m[7] * m[10];
+  inv[4] = -m[4] * m[10] * m[15] + m[4] * m[11] * m[14] + m[8] * m[6] * m[15] - m[8] * m[7] * m[14] - m[12] * m[6] * m[11] + m[12] * m[7] * m[10];
+  inv[8] = m[4] * m[9] * m[15] - m[4] * m[11] * m[13] - m[8] * m[5] * m[15] + m[8] * m[7] * m[13] + m[12] * m[5] * m[11] - m[12] * m[7] * m[9];
+  inv[12] = -m[4] * m[9] * m[14] + m[4] * m[10] * m[13] + m[8] * m[5] * m[14] - m[8] * m[6] * m[13] - m[12] * m[5] * m[10] + m[12] * m[6] * m[9];
+  inv[1] = -m[1] * m[10] * m[15] + m[1] * m[11] * m[14] + m[9] * m[2] * m[15] - m[9] * m[3] * m[14] - m[13] * m[2] * m[11] + m[13] * m[3] * m[10];
+  inv[5] = m[0] * m[10] * m[15] - m[0] * m[11] * m[14] - m[8] * m[2] * m[15] + m[8] * m[3] * m[14] + m[12] * m[2] * m[11] - m[12] * m[3] * m[10];
+  inv[9] = -m[0] * m[9] * m[15] + m[0] * m[11] * m[13] + m[8] * m[1] * m[15] - m[8] * m[3] * m[13] - m[12] * m[1] * m[11] + m[12] * m[3] * m[9];
+  inv[13] = m[0] * m[9] * m[14] - m[0] * m[10] * m[13] - m[8] * m[1] * m[14] + m[8] * m[2] * m[13] + m[12] * m[1] * m[10] - m[12] * m[2] * m[9];
+  inv[2] = m[1] * m[6] * m[15] - m[1] * m[7] * m[14] - m[5] * m[2] * m[15] + m[5] * m[3] * m[14] + m[13] * m[2] * m[7] - m[13] * m[3] * m[6];
+  inv[6] = -m[0] * m[6] * m[15] + m[0] * m[7] * m[14] + m[4] * m[2] * m[15] - m[4] * m[3] * m[14] - m[12] * m[2] * m[7] + m[12] * m[3] * m[6];
+  inv[10] = m[0] * m[5] * m[15] - m[0] * m[7] * m[13] - m[4] * m[1] * m[15] + m[4] * m[3] * m[13] + m[12] * m[1] * m[7] - m[12] * m[3] * m[5];
+  inv[14] = -m[0] * m[5] * m[14] + m[0] * m[6] * m[13] + m[4] * m[1] * m[14] - m[4] * m[2] * m[13] - m[12] * m[1] * m[6] + m[12] * m[2] * m[5];
+  inv[3] = -m[1] * m[6] * m[11] + m[1] * m[7] * m[10] + m[5] * m[2] * m[11] - m[5] * m[3] * m[10] - m[9] * m[2] * m[7] + m[9] * m[3] * m[6];
+  inv[7] = m[0] * m[6] * m[11] - m[0] * m[7] * m[10] - m[4] * m[2] * m[11] + m[4] * m[3] * m[10] + m[8] * m[2] * m[7] - m[8] * m[3] * m[6];
+  inv[11] = -m[0] * m[5] * m[11] + m[0] * m[7] * m[9] + m[4] * m[1] * m[11] - m[4] * m[3] * m[9] - m[8] * m[1] * m[7] + m[8] * m[3] * m[5];
+  inv[15] = m[0] * m[5] * m[10] - m[0] * m[6] * m[9] - m[4] * m[1] * m[10] + m[4] * m[2] * m[9] + m[8] * m[1] * m[6] - m[8] * m[2] * m[5];
+  const det = m[0] * inv[0] + m[1] * inv[4] + m[2] * inv[8] + m[3] * inv[12];
+  if (!det) return new Float32Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
+  for (let i = 0; i < 16; ++i) inv[i] /= det;
+  return inv;
+}
+
 /** Clamps v into [lo, hi]. */
 export function clamp(v, lo, hi) {
   return Math.min(hi, Math.max(lo, v));
@@ -80,7 +106,7 @@ export class Camera {
   constructor(options = {}) {
     this.minFovDeg = options.minFovDeg ?? 20;
     this.maxFovDeg = options.maxFovDeg ?? 120;
-    this.maxOffset = options.maxOffset ?? 0.3;  // Parallax ball radius, metres.
+    this.maxOffset = options.maxOffset ?? 0.3;  // Parallax ball radius, unit of the depths.
     this.near = options.near ?? 0.05;           // Metres.
     this.far = options.far ?? 2000;             // Metres.
     this.reset();

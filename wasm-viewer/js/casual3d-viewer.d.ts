@@ -8,8 +8,38 @@ export interface CameraState {
   pitchDeg: number;
   /** Vertical field of view, degrees (clamped to [minFovDeg, maxFovDeg]). */
   fovDeg: number;
-  /** Eye position in metres in the panorama frame, inside the parallax ball. */
+  /**
+   * Eye position in the panorama frame, in the unit of the package's depths
+   * (metres when ViewHints.metric), inside the viewing volume.
+   */
   position: [number, number, number];
+}
+
+/**
+ * How a package should be looked at (manifest.json "view", spec/package.md
+ * 1.1, or derived from its coarsest level when it has none).
+ */
+export interface ViewHints {
+  /** Direction the package opens at: longitude and latitude, degrees. */
+  yawDeg: number;
+  pitchDeg: number;
+  /** Vertical field of view that frames the content, degrees. */
+  fovDeg: number;
+  /**
+   * Longitudes of the captured content [min, max], taken modulo 360 (narrowed
+   * to where the coarsest level has surface); [-180, 180]: all around.
+   */
+  contentYawDeg: [number, number];
+  /** Latitudes of the captured content [min, max], degrees. */
+  contentPitchDeg: [number, number];
+  /** Radius of the viewing volume around the panorama centre, unit of the depths. */
+  volumeRadius: number;
+  /** Whether the depths are in metres (else the capture's own unit). */
+  metric: boolean;
+  /** Near depth of the coarsest level (its 10th percentile), unit of the depths. */
+  nearDepth: number;
+  /** 'package': from the manifest; 'derived': from the coarsest level. */
+  source: 'package' | 'derived';
 }
 
 export interface Effects {
@@ -30,13 +60,21 @@ export interface ViewerOptions {
   maxLevelWidth?: number;
   /** Triangle budget per level's mesh; larger meshes are simplified. Default 2,000,000. */
   maxTriangles?: number;
-  /** Radius of the ball the eye may move in (metres). Default 0.3. */
-  maxOffset?: number;
+  /**
+   * Radius of the ball the eye may move in (unit of the package's depths).
+   * Default null: the package's viewing volume (ViewHints.volumeRadius).
+   */
+  maxOffset?: number | null;
   keyRotateDegPerSec?: number;
-  keyMoveMPerSec?: number;
+  /** W/A/S/D/Q/E speed in viewing-volume radii per second. Default 1. */
+  keyMoveRadiiPerSec?: number;
   dragDegPerPixel?: number;
-  /** Mouse position over the view moves the eye (motion parallax). Default true. */
+  /** Mouse position over the view moves the eye (motion parallax, up to the volume). Default true. */
   mouseParallax?: boolean;
+  /** Soft limits keep the view on the captured content. Default true. */
+  keepInContent?: boolean;
+  /** A blurred continuation of the photo where no surface is; false: black. Default true. */
+  softBackground?: boolean;
 }
 
 export interface ProgressDetail { loadedBytes: number; totalBytes: number; level: number; levels: number; }
@@ -84,9 +122,19 @@ export class Casual3dViewer extends EventTarget {
   readonly stats: ViewerStats;
   /** Loads a package from its manifest URL; resolves when the first level is shown. */
   load(url: string): Promise<void>;
+  /** Held inside the viewing volume and (keepInContent) the content's limits. */
   setCamera(camera: Partial<CameraState>): void;
   getCamera(): CameraState;
+  /** Back to the package's framed view, eye at the centre. */
   resetView(): void;
+  /** The package's view hints; null until its first level is shown. */
+  getViewHints(): ViewHints | null;
+  /** Radius of the ball the eye is held in (the package's volume unless options.maxOffset). */
+  readonly maxOffset: number;
+  /** The eye this frame: the camera's position plus mouse parallax, inside the volume. */
+  readonly eyePosition: [number, number, number];
+  /** Fraction of the current view's pixels that no surface covers (measured offscreen). */
+  measureBackground(): number;
   setEffects(effects: Partial<Effects>): void;
   getEffects(): Effects;
   /** Freezes the effects' animation at a time in seconds (null: real time). */
@@ -118,6 +166,7 @@ export class Casual3dViewerElement extends HTMLElement {
   setCamera(camera: Partial<CameraState>): void;
   getCamera(): CameraState | undefined;
   resetView(): void;
+  getViewHints(): ViewHints | null;
   setEffects(effects: Partial<Effects>): void;
   addEventListener<K extends keyof ViewerEventMap>(type: K, listener: (ev: ViewerEventMap[K]) => void,
     options?: boolean | AddEventListenerOptions): void;

@@ -5,8 +5,9 @@
 //   <casual3d-viewer src="manifest.json" controls></casual3d-viewer>
 //
 // Attributes: src (manifest URL), controls (show the toolbar), effects (any of
-// "lighting water object", space separated), yaw, pitch, fov (degrees),
-// max-level-width (finest level loaded, pixels).
+// "lighting water object", space separated), yaw, pitch, fov (degrees; without
+// them a package opens framed on its captured content), max-level-width
+// (finest level loaded, pixels).
 // Events (bubbling, composed): progress, level, firstframe, load, error; see
 // viewer-core.js. Property `viewer` gives the Casual3dViewer (JS API).
 
@@ -129,8 +130,14 @@ export class Casual3dViewerElement extends HTMLElement {
     return this._viewer?.getCamera();
   }
 
+  /** Back to the package's framed view. */
   resetView() {
     this._viewer?.resetView();
+  }
+
+  /** See Casual3dViewer.getViewHints: null until the first level shows. */
+  getViewHints() {
+    return this._viewer?.getViewHints() ?? null;
   }
 
   setEffects(effects) {
@@ -145,14 +152,20 @@ export class Casual3dViewerElement extends HTMLElement {
     this._els.progress.hidden = false;
     this._els.bar.style.width = '0';
     this._loading = this._viewer.load(this.src).catch(() => {});  // Errors arrive as 'error' events.
+    this._applyCamera();  // yaw, pitch, fov replace the package's framed view.
     return this._loading;
+  }
+
+  _applyCamera() {
+    const num = (n) => (this.hasAttribute(n) ? Number(this.getAttribute(n)) : undefined);
+    const camera = { yawDeg: num('yaw'), pitchDeg: num('pitch'), fovDeg: num('fov') };
+    if (Object.values(camera).some((v) => v !== undefined)) this._viewer.setCamera(camera);
   }
 
   _applyAttributes() {
     const v = this._viewer;
     this._els.toolbar.hidden = !this.hasAttribute('controls');
-    const num = (n) => (this.hasAttribute(n) ? Number(this.getAttribute(n)) : undefined);
-    v.setCamera({ yawDeg: num('yaw'), pitchDeg: num('pitch'), fovDeg: num('fov') });
+    this._applyCamera();
     if (this.hasAttribute('effects')) {
       const on = new Set((this.getAttribute('effects') || '').split(/\s+/));
       v.setEffects({ lighting: on.has('lighting'), water: on.has('water'), object: on.has('object') });

@@ -8,8 +8,13 @@
 // back one; every triangle's uvs lie in one half, spec/mesh.md Sec. 4.4), no
 // mipmaps, no antialiasing: the same sampling as the project's native software
 // renderer, so screenshots can be compared with its renders.
+//
+// Behind the mesh it draws the soft environment (environment.js) at infinite
+// distance where one is set: a blurred continuation of the photo's colours
+// instead of black where no surface is. `backgroundFraction` measures how
+// much of a view no surface covers.
 
-import { multiply } from './camera.js';
+import { invert, multiply } from './camera.js';
 
 const SCENE_VS = `#version 300 es
 layout(location = 0) in vec3 aPosition;
@@ -95,6 +100,32 @@ void main() {
   fragColor = vec4(color, 0.55 + 0.35 * grazing);
 }`;
 
+// The environment: a full-screen triangle at the far plane; each pixel's ray
+// (rotation-only inverse view-projection) looks up the equirectangular image
+// (format/equirect.h: u = lon / 2 pi + 0.5, v = 0.5 - lat / pi).
+const ENVIRONMENT_VS = `#version 300 es
+out vec2 vNdc;
+void main() {
+  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+  vNdc = p;
+  gl_Position = vec4(p, 1.0, 1.0);
+}`;
+
+const ENVIRONMENT_FS = `#version 300 es
+precision highp float;
+in vec2 vNdc;
+uniform mat4 uRayFromNdc;
+uniform sampler2D uEnvironment;
+out vec4 fragColor;
+void main() {
+  vec4 h = uRayFromNdc * vec4(vNdc, 1.0, 1.0);
+  vec3 d = normalize(h.xyz / h.w);
+  float lon = atan(d.x, -d.z);
+  float lat = asin(clamp(d.y, -1.0, 1.0));
+  vec2 uv = vec2(lon / 6.28318530718 + 0.5, 0.5 - lat / 3.14159265359);
+  fragColor = vec4(texture(uEnvironment, uv).rgb, 1.0);
+}`;
+
 function compile(gl, type, source) {
   const shader = gl.createShader(type);
   gl.shaderSource(shader, source);
@@ -165,6 +196,10 @@ export class Renderer {
     this.scene = program(gl, SCENE_VS, SCENE_FS);
     this.object = program(gl, SCENE_VS, OBJECT_FS);
     this.water = program(gl, SCENE_VS, WATER_FS);
+    this.environmentProgram = program(gl, ENVIRONMENT_VS, ENVIRONMENT_FS);
+    this.environmentVao = gl.createVertexArray();  // No attributes: gl_VertexID.
+    this.environment = null;  // Texture, or null: black background.
+    this.coverageTarget = null;  // Framebuffer of backgroundFraction.
     this.mesh = null;
     this.cube = this._upload(cubeGeometry(1));
     const r = 1000;  // Water plane half-extent (m); far beyond any scene.
@@ -239,6 +274,63 @@ export class Renderer {
     this.texture = texture;
   }
 
+  /**
+   * Sets the environment drawn behind the mesh ({width, height, data: RGBA},
+   * equirectangular) or removes it (null: black).
+   */
+  setEnvironment(image) {
+    const gl = this.gl;
+    if (this.environment) gl.deleteTexture(this.environment);
+    this.environment = null;
+    if (!image) return;
+    const texture = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, texture);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, image.width, image.height, 0, gl.RGBA, gl.UNSIGNED_BYTE, image.data);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.REPEAT);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    this.environment = texture;
+  }
+
+  /**
+   * The fraction of the pixels of a view (the arguments of draw, without
+   * effects) that no triangle of the mesh covers, at `width` x `height`
+   * pixels: drawn offscreen without the environment, alpha 0 where nothing is.
+   */
+  backgroundFraction({ view, projection, eye }, width, height) {
+    const gl = this.gl;
+    let t = this.coverageTarget;
+    if (!t || t.width !== width || t.height !== height) {
+      if (t) {
+        gl.deleteFramebuffer(t.framebuffer);
+        gl.deleteRenderbuffer(t.color);
+        gl.deleteRenderbuffer(t.depth);
+      }
+      t = { width, height, framebuffer: gl.createFramebuffer(), color: gl.createRenderbuffer(), depth: gl.createRenderbuffer() };
+      gl.bindRenderbuffer(gl.RENDERBUFFER, t.color);
+      gl.renderbufferStorage(gl.RENDERBUFFER, gl.RGBA8, width, height);
+      gl.bindRenderbuffer(gl.RENDERBUFFER, t.depth);
+      gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, width, height);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, t.framebuffer);
+      gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, t.color);
+      gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, t.depth);
+      this.coverageTarget = t;
+    }
+    this.draw({
+      view, projection, eye, effects: { ...DEFAULT_EFFECTS }, viewport: [0, 0, width, height],
+      framebuffer: t.framebuffer, clearColor: [0, 0, 0, 0], environment: false,
+    });
+    const px = new Uint8Array(width * height * 4);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, t.framebuffer);
+    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    let empty = 0;
+    for (let i = 3; i < px.length; i += 4) if (px[i] === 0) ++empty;
+    return empty / (width * height);
+  }
+
   get hasMesh() {
     return this.mesh !== null;
   }
@@ -256,17 +348,21 @@ export class Renderer {
    * Draws one view. `viewport` [x, y, w, h] in framebuffer pixels; `framebuffer`
    * null for the canvas (WebXR passes its layer's framebuffer).
    */
-  draw({ view, projection, eye, effects = DEFAULT_EFFECTS, timeSec = 0, viewport, framebuffer = null, clear = true }) {
+  draw({
+    view, projection, eye, effects = DEFAULT_EFFECTS, timeSec = 0, viewport, framebuffer = null, clear = true,
+    clearColor = [0, 0, 0, 1], environment = true,
+  }) {
     const gl = this.gl;
     gl.bindFramebuffer(gl.FRAMEBUFFER, framebuffer);
     const [vx, vy, vw, vh] = viewport ?? [0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight];
     gl.viewport(vx, vy, vw, vh);
     if (clear) {
-      gl.clearColor(0, 0, 0, 1);
+      gl.clearColor(...clearColor);
       gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     }
     if (!this.mesh) return;
     const viewProjection = multiply(projection, view);
+    if (environment && this.environment) this._drawEnvironment(view, projection);
     gl.enable(gl.DEPTH_TEST);
     gl.depthFunc(gl.LEQUAL);
     gl.disable(gl.CULL_FACE);  // The two-layer mesh is seen from both sides.
@@ -330,7 +426,33 @@ export class Renderer {
     gl.bindVertexArray(null);
   }
 
+  _drawEnvironment(view, projection) {
+    const gl = this.gl;
+    // The view's rotation only: the environment lies at infinite distance.
+    const rotation = Float32Array.from(view);
+    rotation[12] = rotation[13] = rotation[14] = 0;
+    gl.disable(gl.DEPTH_TEST);
+    gl.depthMask(false);
+    gl.disable(gl.BLEND);
+    gl.useProgram(this.environmentProgram.program);
+    gl.uniformMatrix4fv(this.environmentProgram.uniforms.uRayFromNdc, false, invert(multiply(projection, rotation)));
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, this.environment);
+    gl.uniform1i(this.environmentProgram.uniforms.uEnvironment, 0);
+    gl.bindVertexArray(this.environmentVao);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.depthMask(true);
+  }
+
   dispose() {
+    this.setEnvironment(null);
+    if (this.coverageTarget) {
+      const gl = this.gl;
+      gl.deleteFramebuffer(this.coverageTarget.framebuffer);
+      gl.deleteRenderbuffer(this.coverageTarget.color);
+      gl.deleteRenderbuffer(this.coverageTarget.depth);
+      this.coverageTarget = null;
+    }
     this._release(this.mesh);
     this._release(this.cube);
     this._release(this.waterPlane);

@@ -9,21 +9,43 @@
 //   'load'       {levels, bytes, timeMs}: every level is loaded
 //   'error'      {message, fatal}: fatal errors leave nothing to show; others
 //                keep the coarser level that is already on screen.
+//
+// What the viewer shows of a package follows its view hints (view-hints.js;
+// the manifest's "view" member, or derived from the coarsest level): it opens
+// framed on the captured content, keeps the view on that content with soft
+// limits (view-limits.js: input is resisted past a limit and eased back when
+// it ends), draws a blurred continuation of the photo behind it where no
+// surface is (environment.js), and holds the eye inside the package's viewing
+// volume; key speed and mouse parallax scale with that volume.
 
 import { Camera, clamp, lookAlong, multiply } from './camera.js';
 import { Renderer, DEFAULT_EFFECTS } from './renderer.js';
+import { wrapDeg } from './view-hints.js';
+import {
+  clampView, contentCentreYaw, easeFactor, easeView, fittingPitchRange, maxFovDeg, OVERSHOOT_FRACTION, resist,
+  yawAllowance,
+} from './view-limits.js';
 
 const DEG = Math.PI / 180;
+/** Input counts as ongoing this long after its last event (ms): no easing back meanwhile. */
+const INPUT_HOLD_MS = 200;
+/** Largest margin (degrees) kept inside the content's edges for the eye's parallax. */
+const MAX_MARGIN_DEG = 10;
 
 export const DEFAULT_OPTIONS = Object.freeze({
   maxLevelWidth: 4096,       // Finest level loaded (panorama width, pixels).
   maxTriangles: 2000000,     // Triangle budget per level's mesh (simplified above it).
-  maxOffset: 0.3,            // Radius of the ball the eye may move in (m).
+  maxOffset: null,           // Radius of the ball the eye may move in (unit of the depths); null: the package's volume.
   keyRotateDegPerSec: 90,    // Arrow keys.
-  keyMoveMPerSec: 0.3,       // W/A/S/D/Q/E head motion.
+  keyMoveRadiiPerSec: 1,     // W/A/S/D/Q/E head motion, in viewing-volume radii per second.
   dragDegPerPixel: 0.15,     // Scaled by the field of view (divided by 75 deg).
   mouseParallax: true,       // Moving the mouse over the view moves the eye.
+  keepInContent: true,       // Soft limits keep the view on the captured content.
+  softBackground: true,      // A blurred continuation of the photo where no surface is (else black).
 });
+
+/** Radius of the eye's ball before a package's volume is known (unit of the depths). */
+const INITIAL_MAX_OFFSET = 0.3;
 
 export class Casual3dViewer extends EventTarget {
   /**
@@ -38,7 +60,7 @@ export class Casual3dViewer extends EventTarget {
     this.canvas.style.cssText = 'display:block;width:100%;height:100%;touch-action:none;outline:none';
     this.canvas.tabIndex = 0;
     container.appendChild(this.canvas);
-    this.camera = new Camera({ maxOffset: this.options.maxOffset });
+    this.camera = new Camera({ maxOffset: this.options.maxOffset ?? INITIAL_MAX_OFFSET });
     this.renderer = new Renderer(this.canvas, { xrCompatible: true });
     this.effects = { ...DEFAULT_EFFECTS };
     this.effectsTime = null;          // Fixed effects time (s) or null: real time.
@@ -51,6 +73,11 @@ export class Casual3dViewer extends EventTarget {
     this._frameWaiters = [];
     this._keys = new Set();
     this._mouseOffset = [0, 0];
+    this._hints = null;        // View hints of the package shown (view-hints.js).
+    this._limits = null;       // Content limits (view-limits.js), with the hints.
+    this._cameraSet = false;   // Whether setCamera chose a view since load().
+    this._pointers = 0;        // Pointers down on the canvas.
+    this._lastInput = -Infinity;  // performance.now() of the last turn or zoom input.
     this._lastTick = performance.now();
     this._xrSession = null;
     this._resizeObserver = new ResizeObserver(() => this._resize());
@@ -74,6 +101,7 @@ export class Casual3dViewer extends EventTarget {
     }
     this.stats = { loadStart: performance.now(), url: manifestUrl };
     this._levelShown = false;  // Whether this load has shown a level yet.
+    this._cameraSet = false;   // The new package opens framed unless setCamera says otherwise.
     if (this._pending) this._pending.resolve();  // A superseded load settles quietly.
     return new Promise((resolve, reject) => {
       this._pending = { id, resolve, reject };
@@ -84,23 +112,61 @@ export class Casual3dViewer extends EventTarget {
     });
   }
 
-  /** Sets any of {yawDeg, pitchDeg, fovDeg, position: [x, y, z] metres}. */
+  /**
+   * Sets any of {yawDeg, pitchDeg, fovDeg, position: [x, y, z]} (position in
+   * the unit of the package's depths). The position is held inside the
+   * viewing volume and, with `keepInContent`, the view inside the content's
+   * limits (the nearest view inside them). A view set after load() starts
+   * replaces the framed view the package would open at.
+   */
   setCamera(camera) {
+    if (['yawDeg', 'pitchDeg', 'fovDeg'].some((k) => Number.isFinite(camera?.[k]))) this._cameraSet = true;
     this.camera.set(camera);
-    this._dirty = true;
-    if (this._worker && Number.isFinite(camera?.yawDeg)) {
-      this._worker.postMessage({ type: 'view', yawDeg: this.camera.yawDeg });
-    }
+    this._clampToLimits();
+    this._viewChanged();
   }
 
   getCamera() {
     return this.camera.get();
   }
 
+  /** Back to the framed view of the package (its view hints) with the eye at the centre. */
   resetView() {
+    const h = this._hints;
     this.camera.reset();
+    if (h) this.camera.set({ yawDeg: h.yawDeg, pitchDeg: h.pitchDeg, fovDeg: h.fovDeg });
+    this._clampToLimits();
     this._mouseOffset = [0, 0];
-    this._dirty = true;
+    this._viewChanged();
+  }
+
+  /**
+   * The view hints of the package shown (view-hints.js, casual3d-viewer.d.ts
+   * ViewHints): from its manifest's "view" member or derived from its coarsest
+   * level; null until its first level is shown.
+   */
+  getViewHints() {
+    const h = this._hints;
+    return h ? { ...h, contentYawDeg: [...h.contentYawDeg], contentPitchDeg: [...h.contentPitchDeg] } : null;
+  }
+
+  /** Radius of the ball the eye is held in (the package's viewing volume unless options.maxOffset). */
+  get maxOffset() {
+    return this.camera.maxOffset;
+  }
+
+  /** The eye this frame: the camera's position plus mouse parallax, inside the volume. */
+  get eyePosition() {
+    return [...this._currentView().eye];
+  }
+
+  /**
+   * The fraction of the current view's pixels (mouse parallax included) that
+   * no surface of the 3D photo covers, measured offscreen at the canvas size.
+   */
+  measureBackground() {
+    const { view, projection, eye } = this._currentView();
+    return this.renderer.backgroundFraction({ view, projection, eye }, this.canvas.width, this.canvas.height);
   }
 
   /** Sets any of the effect fields (renderer.js DEFAULT_EFFECTS). */
@@ -140,8 +206,9 @@ export class Casual3dViewer extends EventTarget {
    * transform from the headset; the 'local' reference space (its origin where
    * the head was when the session started) is placed at the capture centre,
    * turned so that the headset starts looking where the viewer looked, and the
-   * head is kept inside the ball of `maxOffset` metres where the 3D photo holds
-   * (both eyes move with it, keeping their baseline).
+   * head is kept inside the package's viewing volume (the ball of `maxOffset`;
+   * one unit of the package's depths per metre of head motion), where the 3D
+   * photo holds (both eyes move with it, keeping their baseline).
    */
   async enterVR() {
     if (this._xrSession) return;
@@ -249,6 +316,7 @@ export class Casual3dViewer extends EventTarget {
         break;
       case 'level': {
         const t0 = performance.now();
+        if (msg.view) this._setViewHints(msg.view);
         // Keep the whole scene inside the far plane (near plane unchanged).
         if (msg.depthFarM > 0) this.camera.far = Math.max(this.camera.far, 1.5 * msg.depthFarM);
         try {
@@ -303,17 +371,9 @@ export class Casual3dViewer extends EventTarget {
     }
   }
 
-  _tick(now) {
-    if (this._xrSession) return;  // The XR session drives frames.
-    this._raf = requestAnimationFrame((t) => this._tick(t));
-    const dt = Math.min(0.1, (now - this._lastTick) / 1000);
-    this._lastTick = now;
-    this._applyKeys(dt);
-    const animated = this.effectsTime === null && (this.effects.lighting || this.effects.water);
-    if (!this._dirty && !animated) return;
-    this._dirty = false;
+  /** The current view: camera plus mouse parallax (an offset along the view's right and up). */
+  _currentView() {
     const cam = this.camera;
-    // Mouse parallax: an extra offset along the view's right and up vectors.
     const eye = [...cam.position];
     if (this.options.mouseParallax && (this._mouseOffset[0] || this._mouseOffset[1])) {
       const yaw = cam.yawDeg * DEG;
@@ -323,11 +383,110 @@ export class Casual3dViewer extends EventTarget {
       const len = Math.hypot(...eye);
       if (len > cam.maxOffset) for (let i = 0; i < 3; ++i) eye[i] *= cam.maxOffset / len;
     }
-    const aspect = this.canvas.width / this.canvas.height;
-    this.renderer.draw({
-      view: lookAlong(eye, cam.forward()), projection: cam.projectionMatrix(aspect), eye,
-      effects: this.effects, timeSec: this._effectsSeconds(),
-    });
+    return { view: lookAlong(eye, cam.forward()), projection: cam.projectionMatrix(this._aspect()), eye };
+  }
+
+  _aspect() {
+    return this.canvas.width / this.canvas.height;
+  }
+
+  /** Takes the hints (and background) of a package's first level and frames it. */
+  _setViewHints({ hints, warning, environment }) {
+    if (warning) console.warn(`casual3d-viewer: ${warning}`);
+    this._hints = hints;
+    const cam = this.camera;
+    cam.maxOffset = this.options.maxOffset ?? hints.volumeRadius;
+    // Keep nearby surfaces in front of the near plane in any unit of depth.
+    if (hints.nearDepth > 0) cam.near = Math.min(0.05, 0.25 * hints.nearDepth);
+    // The content's edges move by up to atan(radius / depth) with the eye.
+    const marginDeg = hints.nearDepth > 0
+      ? Math.min(MAX_MARGIN_DEG, Math.atan(cam.maxOffset / hints.nearDepth) / DEG) : 0;
+    this._limits = {
+      yawDeg: hints.contentYawDeg, pitchDeg: hints.contentPitchDeg, marginDeg,
+      minFovDeg: cam.minFovDeg, maxFovDeg: cam.maxFovDeg,
+    };
+    this.renderer.setEnvironment(this.options.softBackground ? environment : null);
+    if (!this._cameraSet) {
+      cam.set({ yawDeg: hints.yawDeg, pitchDeg: hints.pitchDeg, fovDeg: hints.fovDeg, position: [0, 0, 0] });
+    }
+    cam.set({ position: cam.position });  // Inside the new volume.
+    this._clampToLimits();
+    this._viewChanged();
+  }
+
+  /** The nearest view inside the content's limits (hard), if limits apply. */
+  _clampToLimits() {
+    if (!this._limits || !this.options.keepInContent) return;
+    this.camera.set(clampView(this.camera, this._limits, this._aspect()));
+  }
+
+  _viewChanged() {
+    this._dirty = true;
+    if (this._worker) this._worker.postMessage({ type: 'view', yawDeg: this.camera.yawDeg });
+  }
+
+  /** Turns the view by input (degrees), resisted past the content's limits. */
+  _turn(dYawDeg, dPitchDeg) {
+    const c = this.camera;
+    this._lastInput = performance.now();
+    const L = this.options.keepInContent ? this._limits : null;
+    if (!L) {
+      c.set({ yawDeg: c.yawDeg + dYawDeg, pitchDeg: c.pitchDeg + dPitchDeg });
+    } else {
+      const range = OVERSHOOT_FRACTION * c.fovDeg;
+      const [lo, hi] = fittingPitchRange(L, c.fovDeg, this._aspect());
+      const pitch = resist(c.pitchDeg, dPitchDeg, lo, hi, range);
+      const allowance = yawAllowance(L, c.fovDeg, this._aspect(), pitch);
+      let yaw = c.yawDeg + dYawDeg;
+      if (allowance !== Infinity) {
+        const centre = contentCentreYaw(L);
+        const a = Math.max(0, allowance);
+        yaw = centre + resist(wrapDeg(c.yawDeg - centre), dYawDeg, -a, a, range);
+      }
+      c.set({ yawDeg: yaw, pitchDeg: pitch });
+    }
+    this._viewChanged();
+  }
+
+  /** Zooms to `fovDeg` by input, resisted past the widest view that fits the content. */
+  _zoom(fovDeg) {
+    const c = this.camera;
+    this._lastInput = performance.now();
+    const L = this.options.keepInContent ? this._limits : null;
+    if (!L) {
+      c.set({ fovDeg });
+    } else {
+      const widest = maxFovDeg(L, this._aspect());
+      c.set({ fovDeg: resist(c.fovDeg, fovDeg - c.fovDeg, L.minFovDeg, widest, OVERSHOOT_FRACTION * widest) });
+    }
+    this._viewChanged();
+  }
+
+  /** Eases the view back inside the limits once input has ended. */
+  _easeToLimits(now, dt) {
+    if (!this._limits || !this.options.keepInContent) return;
+    if (this._pointers > 0 || this._keys.size > 0 || now - this._lastInput < INPUT_HOLD_MS) return;
+    const { view, settled } = easeView(this.camera, this._limits, this._aspect(), easeFactor(dt));
+    const before = this.camera.get();
+    this.camera.set(view);
+    if (!settled || before.yawDeg !== this.camera.yawDeg || before.pitchDeg !== this.camera.pitchDeg ||
+        before.fovDeg !== this.camera.fovDeg) {
+      this._dirty = true;
+    }
+  }
+
+  _tick(now) {
+    if (this._xrSession) return;  // The XR session drives frames.
+    this._raf = requestAnimationFrame((t) => this._tick(t));
+    const dt = Math.min(0.1, (now - this._lastTick) / 1000);
+    this._lastTick = now;
+    this._applyKeys(dt);
+    this._easeToLimits(now, dt);
+    const animated = this.effectsTime === null && (this.effects.lighting || this.effects.water);
+    if (!this._dirty && !animated) return;
+    this._dirty = false;
+    const { view, projection, eye } = this._currentView();
+    this.renderer.draw({ view, projection, eye, effects: this.effects, timeSec: this._effectsSeconds() });
     if (this._levelShown && this.stats.timeToFirstFrameMs === undefined) {
       this.stats.timeToFirstFrameMs = now - this.stats.loadStart;
       this.stats.bytesBeforeFirstFrame = this._bytesFetched();
@@ -349,16 +508,21 @@ export class Casual3dViewer extends EventTarget {
   _applyKeys(dt) {
     if (this._keys.size === 0) return;
     const o = this.options;
-    const c = this.camera.get();
     const k = (a) => (this._keys.has(a) ? 1 : 0);
-    const yaw = c.yawDeg + (k('ArrowRight') - k('ArrowLeft')) * o.keyRotateDegPerSec * dt;
-    const pitch = c.pitchDeg + (k('ArrowUp') - k('ArrowDown')) * o.keyRotateDegPerSec * dt;
+    const dYaw = (k('ArrowRight') - k('ArrowLeft')) * o.keyRotateDegPerSec * dt;
+    const dPitch = (k('ArrowUp') - k('ArrowDown')) * o.keyRotateDegPerSec * dt;
+    if (dYaw || dPitch) this._turn(dYaw, dPitch);
+    const c = this.camera.get();
+    const yaw = c.yawDeg;
     const f = [Math.sin(yaw * DEG), 0, -Math.cos(yaw * DEG)];
     const r = [Math.cos(yaw * DEG), 0, Math.sin(yaw * DEG)];
     const fwd = k('w') - k('s'), side = k('d') - k('a'), up = k('e') - k('q');
-    const step = o.keyMoveMPerSec * dt;
+    if (!fwd && !side && !up) return;
+    // Speed in radii of the viewing volume per second: the same feel at any scale.
+    const step = o.keyMoveRadiiPerSec * this.camera.maxOffset * dt;
     const p = c.position.map((v, i) => v + (f[i] * fwd + r[i] * side) * step + (i === 1 ? up * step : 0));
-    this.setCamera({ yawDeg: yaw, pitchDeg: pitch, position: p });
+    this.camera.set({ position: p });
+    this._dirty = true;
   }
 
   _bindInput() {
@@ -369,6 +533,7 @@ export class Casual3dViewer extends EventTarget {
       canvas.focus();
       canvas.setPointerCapture(e.pointerId);
       pointers.set(e.pointerId, { x: e.clientX, y: e.clientY });
+      this._pointers = pointers.size;
       if (pointers.size === 2) {
         const [a, b] = [...pointers.values()];
         pinchStart = { dist: Math.hypot(a.x - b.x, a.y - b.y), fov: this.camera.fovDeg };
@@ -391,21 +556,21 @@ export class Casual3dViewer extends EventTarget {
       if (pointers.size === 2 && pinchStart) {
         const [a, b] = [...pointers.values()];
         const dist = Math.hypot(a.x - b.x, a.y - b.y);
-        this.setCamera({ fovDeg: pinchStart.fov * (pinchStart.dist / Math.max(dist, 1)) });
+        this._zoom(pinchStart.fov * (pinchStart.dist / Math.max(dist, 1)));
       } else if (pointers.size === 1) {
         const s = this.options.dragDegPerPixel * (this.camera.fovDeg / 75);
-        const c = this.camera.get();
         // Dragging moves the photo with the pointer.
-        this.setCamera({ yawDeg: c.yawDeg - (e.clientX - prev.x) * s, pitchDeg: c.pitchDeg + (e.clientY - prev.y) * s });
+        this._turn(-(e.clientX - prev.x) * s, (e.clientY - prev.y) * s);
       }
     };
     const onUp = (e) => {
       pointers.delete(e.pointerId);
+      this._pointers = pointers.size;
       if (pointers.size < 2) pinchStart = null;
     };
     const onWheel = (e) => {
       e.preventDefault();
-      this.setCamera({ fovDeg: this.camera.fovDeg * Math.exp(e.deltaY * 0.001) });
+      this._zoom(this.camera.fovDeg * Math.exp(e.deltaY * 0.001));
     };
     const keys = new Set(['ArrowLeft', 'ArrowRight', 'ArrowUp', 'ArrowDown', 'w', 'a', 's', 'd', 'q', 'e']);
     const onKeyDown = (e) => {
@@ -416,9 +581,9 @@ export class Casual3dViewer extends EventTarget {
       } else if (key === 'r' || key === 'Home') {
         this.resetView();
       } else if (key === '+' || key === '=') {
-        this.setCamera({ fovDeg: this.camera.fovDeg / 1.1 });
+        this._zoom(this.camera.fovDeg / 1.1);
       } else if (key === '-') {
-        this.setCamera({ fovDeg: this.camera.fovDeg * 1.1 });
+        this._zoom(this.camera.fovDeg * 1.1);
       }
     };
     const onKeyUp = (e) => this._keys.delete(e.key.length === 1 ? e.key.toLowerCase() : e.key);
@@ -466,7 +631,7 @@ export class Casual3dViewer extends EventTarget {
       const yaw = -e.alpha;
       const pitch = (e.beta - 90) * Math.cos(screenAngle) + (e.gamma ?? 0) * Math.sin(screenAngle);
       if (!base) base = { yaw: yaw - this.camera.yawDeg };
-      this.setCamera({ yawDeg: yaw - base.yaw, pitchDeg: pitch });
+      this._turn(wrapDeg(yaw - base.yaw - this.camera.yawDeg), pitch - this.camera.pitchDeg);
       // Tilt sideways moves the eye sideways (motion parallax on a phone).
       const tilt = clamp((e.gamma ?? 0) / 45, -1, 1);
       this._mouseOffset = [tilt, 0];

@@ -7,15 +7,23 @@
 // Within a level, the tiles nearest the current view direction are fetched
 // first (the page reports the view with 'view' messages).
 //
+// With the first (coarsest) level shown it sends the view hints
+// (view-hints.js): the manifest's "view" member if valid, else hints derived
+// from that level, with the content narrowed to where that level has nodes;
+// and the soft background image (environment.js) built from that level.
+//
 // Messages in:  {type: 'load', id, url, yawDeg, maxLevelWidth, maxTriangles}
 //               {type: 'view', yawDeg}
 // Messages out: {type: 'progress', id, progress: {loadedBytes, totalBytes, level, levels}}
-//               {type: 'level', id, level, levels, width, height, mesh, atlas, timing}
+//               {type: 'level', id, level, levels, width, height, mesh, atlas, timing,
+//                view?: {hints, warning, environment}}   (first level only)
 //               {type: 'error', id, message}
 //               {type: 'done', id, levels, bytes}
 
 import { FormatModule } from './format-module.js';
 import { decodeImage } from './tile-decoder.js';
+import { buildEnvironment } from './environment.js';
+import { deriveViewHints, narrowContent, parseViewHints, presenceFromMesh } from './view-hints.js';
 
 const FETCH_CONCURRENCY = 6;
 let formatPromise = null;
@@ -90,6 +98,14 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
   const manifestBytes = await fetchBytes(url, 'manifest.json');
   check();
   const reader = format.openPackage(manifestBytes);
+  // The reader accepted the bytes, so they are JSON; the optional "view"
+  // member is checked here (a bad one is ignored with a warning).
+  let packageView;
+  try {
+    packageView = parseViewHints(JSON.parse(new TextDecoder().decode(manifestBytes)).view);
+  } catch (err) {
+    packageView = { hints: null, warning: `manifest.json: "view" ignored: ${err.message || err}` };
+  }
   // The farthest depth of the panorama (the package's depth code range), so
   // that the camera's far plane never clips the scene: a model in COLMAP
   // units can lie thousands of units away.
@@ -159,14 +175,17 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
         }
         timing.meshMs = performance.now() - t1;
         check();
+        const view = shown === 0 ? viewOfLevel(packageView, mesh, atlas, info.width, info.height) : undefined;
         progress(level, true);
+        const transfer = [mesh.positions.buffer, mesh.normals.buffer, mesh.uvs.buffer, mesh.indices.buffer, atlas.data.buffer];
+        if (view) transfer.push(view.environment.data.buffer);
         self.postMessage(
           {
             type: 'level', id, level, levels: numLevels, width: info.width, height: info.height, depthFarM,
             mesh: { positions: mesh.positions, normals: mesh.normals, uvs: mesh.uvs, indices: mesh.indices },
-            atlas, timing,
+            atlas, timing, view,
           },
-          [mesh.positions.buffer, mesh.normals.buffer, mesh.uvs.buffer, mesh.indices.buffer, atlas.data.buffer],
+          transfer,
         );
         ++shown;
       } catch (err) {
@@ -181,4 +200,16 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
   } finally {
     reader.free();
   }
+}
+
+/**
+ * The view hints and soft background of the first level shown: the package's
+ * hints (narrowed to the level's content) or, without valid ones, hints
+ * derived from the level (view-hints.js).
+ */
+function viewOfLevel(packageView, mesh, atlas, width, height) {
+  const { presence, depths } = presenceFromMesh(mesh, width, height);
+  const measured = deriveViewHints({ presence, depths, width, height });
+  const hints = packageView.hints ? narrowContent(packageView.hints, measured) : measured;
+  return { hints, warning: packageView.warning, environment: buildEnvironment(atlas, presence) };
 }

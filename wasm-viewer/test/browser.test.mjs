@@ -18,7 +18,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { after, before, test } from 'node:test';
 
-import { BINARY_DIR, DIST_DIR, runTool } from './node-support.mjs';
+import { BINARY_DIR, DIST_DIR, copyPackageWithView, runTool } from './node-support.mjs';
 import { chromiumArgs, startServer, viewerPage } from './static-server.mjs';
 
 const CHROMIUM = process.env.CASUAL3D_CHROMIUM ?? '/usr/bin/chromium';
@@ -91,7 +91,15 @@ before(async () => {
   fs.mkdirSync(OUT, { recursive: true });
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-browser-'));
   const good = path.join(tmp, 'room');
-  metrics.package = JSON.parse(runTool('viewer_test_tool', ['package', 'room', '1024', '512', good, '256', '3']));
+  // The room with view hints (spec/package.md 1.1): the whole sphere, a 0.3 m
+  // viewing volume, so that the cameras below stay where they are put.
+  const plain = path.join(tmp, 'room-1.0');
+  metrics.package = JSON.parse(runTool('viewer_test_tool', ['package', 'room', '1024', '512', plain, '256', '3']));
+  copyPackageWithView(plain, good, {
+    yaw_deg: 0, pitch_deg: 0, fov_deg: 75, content_yaw_deg: [-180, 180], content_pitch_deg: [-90, 90],
+    volume_radius: 0.3, metric: true,
+  });
+  metrics.package.total_bytes += fs.statSync(path.join(good, 'manifest.json')).size - metrics.package.manifest_bytes;
   // A copy whose finest level has one damaged colour tile (bytes flipped mid-file).
   const bad = path.join(tmp, 'bad');
   fs.cpSync(good, bad, { recursive: true });

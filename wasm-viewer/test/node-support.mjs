@@ -72,3 +72,18 @@ export function compareArrays(a, b) {
   }
   return { sameLength: true, differing, maxAbs };
 }
+
+/**
+ * Copies the package folder `from` to `to` and sets its manifest's "view"
+ * member (spec/package.md 1.1) to `view`, or removes it (undefined). The
+ * manifest is not covered by the package's checksums.
+ */
+export function copyPackageWithView(from, to, view) {
+  fs.cpSync(from, to, { recursive: true });
+  const file = path.join(to, 'manifest.json');
+  const manifest = JSON.parse(fs.readFileSync(file, 'utf8'));
+  if (view === undefined) delete manifest.view;
+  else manifest.view = view;
+  if (view !== undefined) manifest.version = '1.1';
+  fs.writeFileSync(file, JSON.stringify(manifest));
+}

@@ -1,6 +1,6 @@
 // Compile-only check of js/casual3d-viewer.d.ts (ctest viewer_types_test runs
 // tsc --noEmit --strict on it): typical embedding code must type-check.
-import { Casual3dViewer, Casual3dViewerElement, CameraState } from '../js/casual3d-viewer.js';
+import { Casual3dViewer, Casual3dViewerElement, CameraState, ViewHints } from '../js/casual3d-viewer.js';
 
 export async function embed(container: HTMLElement): Promise<number> {
   const viewer = new Casual3dViewer(container, { maxLevelWidth: 2048, maxOffset: 0.2 });
@@ -9,10 +9,17 @@ export async function embed(container: HTMLElement): Promise<number> {
   await viewer.load('scene/manifest.json');
   const camera: CameraState = viewer.getCamera();
   viewer.setCamera({ yawDeg: camera.yawDeg + 10, position: [0.1, 0, 0] });
+  const hints: ViewHints | null = viewer.getViewHints();
+  if (hints) viewer.setCamera({ position: [hints.volumeRadius / 2, 0, 0], fovDeg: hints.fovDeg });
+  const void_: number = viewer.measureBackground() + viewer.maxOffset;
+  const unbounded = new Casual3dViewer(container, { maxOffset: null, keepInContent: false, softBackground: false });
+  unbounded.dispose();
   viewer.setEffects({ lighting: true, water: true, waterMinY: -1.5 });
   await viewer.nextFrame();
   const element: Casual3dViewerElement = document.querySelector('casual3d-viewer')!;
   element.addEventListener('firstframe', (e) => console.log(e.detail.timeToFirstFrameMs));
   element.setCamera({ fovDeg: 60 });
-  return viewer.stats.triangles ?? 0;
+  element.resetView();
+  const contentYaw = element.getViewHints()?.contentYawDeg[1] ?? void_;
+  return (viewer.stats.triangles ?? 0) + contentYaw;
 }

@@ -22,7 +22,7 @@ import { after, before, test } from 'node:test';
 import zlib from 'node:zlib';
 
 import { directionFromYawPitch, lookAlong, multiply, perspective } from '../js/camera.js';
-import { BINARY_DIR, DIST_DIR, runTool } from './node-support.mjs';
+import { BINARY_DIR, DIST_DIR, copyPackageWithView, runTool } from './node-support.mjs';
 import { chromiumArgs, startServer, viewerPage } from './static-server.mjs';
 import { installWebXRMock } from './webxr-mock.mjs';
 
@@ -45,7 +45,7 @@ const EYE = 400;                             // Each eye's viewport: EYE x EYE p
 const XR = { eyeWidth: EYE, eyeHeight: EYE, fovYDeg: 90, ipdM: 0.064 };
 const VIEWER_YAW = 10;                       // The viewer's yaw when VR starts (deg).
 const HEAD_PITCH = -10;                      // The head looks slightly down (deg).
-const MAX_OFFSET = 0.3;                      // The viewer's parallax ball (m).
+const MAX_OFFSET = 0.3;                      // The package's viewing volume (m): its manifest's "view".
 // The room package (format/testing/test_panoramas.h): the sphere's centre and
 // radius, and a point of the back wall (z = -4 m) that no object hides.
 const SPHERE_CENTRE = [0.4, -0.3, -1.6];
@@ -273,7 +273,13 @@ before(async () => {
   fs.rmSync(OUT, { recursive: true, force: true });
   fs.mkdirSync(OUT, { recursive: true });
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-xr-'));
-  runTool('viewer_test_tool', ['package', 'room', '1024', '512', path.join(tmp, 'room'), '256', '3']);
+  // The room with view hints (spec/package.md 1.1): the whole sphere and a
+  // viewing volume of MAX_OFFSET metres, which holds the head.
+  runTool('viewer_test_tool', ['package', 'room', '1024', '512', path.join(tmp, 'room-1.0'), '256', '3']);
+  copyPackageWithView(path.join(tmp, 'room-1.0'), path.join(tmp, 'room'), {
+    yaw_deg: 0, pitch_deg: 0, fov_deg: 75, content_yaw_deg: [-180, 180], content_pitch_deg: [-90, 90],
+    volume_radius: MAX_OFFSET, metric: true,
+  });
   renderReferences();
   server = await startServer({ '/viewer/': DIST_DIR, '/pkg/': path.join(tmp, 'room') }, {
     '/xr.html': viewerPage('/pkg/manifest.json', { width: W, height: H, maxLevelWidth: 1024, attributes: 'controls' }),

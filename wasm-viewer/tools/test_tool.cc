@@ -1,8 +1,10 @@
 // viewer_test_tool: native helpers of the viewer's browser test and benchmark.
 //
-//   viewer_test_tool package <room|room-nosphere|sphere|test> <width> <height> <out_dir>
-//                            [tile_size] [levels]
+//   viewer_test_tool package <room|room-nosphere|room-partial|sphere|test> <width> <height>
+//                            <out_dir> [tile_size] [levels]
 //     Writes a web package of a procedural two-layer panorama (encoder/).
+//     room-partial: the room with nodes only at longitudes [-75, 45] and
+//     latitudes [-40, 50] degrees, like a capture of part of the sphere.
 //   viewer_test_tool render <package_dir> <level> <width> <height> <out_prefix>
 //                           <yaw,pitch,fov,x,y,z>...
 //     Reads the package natively (libwebp), builds the mesh of `level` and
@@ -41,9 +43,52 @@ int Fail(const std::string& message) {
   return 1;
 }
 
+// Removes every node whose pixel centre lies outside the longitudes
+// [lon0, lon1] or latitudes [lat0, lat1] (degrees), and the links to them.
+void KeepLonLatBox(double lon0, double lon1, double lat0, double lat1, casual3d::TwoLayerPanorama* pano) {
+  const int w = pano->width(), h = pano->height();
+  for (int y = 0; y < h; ++y) {
+    const double lat = 90.0 - (y + 0.5) / h * 180.0;
+    for (int x = 0; x < w; ++x) {
+      const double lon = ((x + 0.5) / w - 0.5) * 360.0;
+      if (lon >= lon0 && lon <= lon1 && lat >= lat0 && lat <= lat1) continue;
+      const size_t i = pano->index(x, y);
+      for (int l = 0; l < 2; ++l) {
+        casual3d::LayerData& d = pano->layer(l);
+        d.present[i] = 0;
+        d.rgb[3 * i] = d.rgb[3 * i + 1] = d.rgb[3 * i + 2] = 0;
+        d.depth_m[i] = 0;
+        d.normal[3 * i] = d.normal[3 * i + 1] = d.normal[3 * i + 2] = 0;
+        d.label[i] = 0;
+        d.links[i] = 0;
+      }
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int l = 0; l < 2; ++l) {
+        uint8_t& links = pano->layer(l).links[pano->index(x, y)];
+        for (int d = 0; d < 4; ++d) {
+          const auto dir = static_cast<casual3d::Direction>(d);
+          const casual3d::Link link = casual3d::GetLink(links, dir);
+          if (link == casual3d::Link::kNone) continue;
+          int nx, ny;
+          const int nl = link == casual3d::Link::kFront ? 0 : 1;
+          if (!pano->Neighbour(x, y, dir, &nx, &ny) || !pano->present(nl, nx, ny)) {
+            links = casual3d::SetLink(links, dir, casual3d::Link::kNone);
+          }
+        }
+      }
+    }
+  }
+}
+
 bool MakePanorama(const std::string& kind, int w, int h, casual3d::TwoLayerPanorama* pano) {
   namespace t = casual3d::testing;
-  if (kind == "room") {
+  if (kind == "room-partial") {
+    *pano = t::MakeRoomPanorama(w, h);
+    KeepLonLatBox(-75, 45, -40, 50, pano);
+  } else if (kind == "room") {
     *pano = t::MakeRoomPanorama(w, h);
   } else if (kind == "room-nosphere") {
     t::RoomOptions options;
