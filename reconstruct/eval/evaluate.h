@@ -23,6 +23,10 @@
 // Held-out views: ROOT/report.json may list "holdout" (names of photos that
 // were registered but not used to build the 3D photo); by default exactly
 // those are evaluated. Without such a list every registered photo is.
+//
+// What a viewer sees (EvaluateOptions::viewer_views, on by default): the 3D
+// photo's mesh from 17 viewer cameras over its viewing volume, with tears and
+// stretched fill (viewer_views.h); it needs the 3D photo only.
 
 #include <map>
 #include <optional>
