@@ -13,6 +13,7 @@ StatusOr<TwoLayerPanorama> HalvePanorama(const TwoLayerPanorama& fine) {
   const int w = fine.width() / 2, h = fine.height() / 2;
   TwoLayerPanorama coarse(w, h);
   coarse.frame() = fine.frame();
+  coarse.view_hints() = fine.view_hints();
   for (int l = 0; l < kNumLayers; ++l) {
     const LayerData& F = fine.layer(l);
     LayerData& C = coarse.layer(l);

@@ -93,6 +93,8 @@ void WriteExr(const TwoLayerPanorama& pano, const std::string& path) {
   const double* r = f.rotation;
   header.insert("casual3d.rotation", Imf::M33dAttribute(Imath::M33d(
                                          r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8])));
+  if (pano.view_hints())
+    header.insert("casual3d.view", Imf::StringAttribute(SerializeViewHints(*pano.view_hints())));
   for (int l = 0; l < kNumLayers; ++l) {
     for (const ByteChannel& c : kByteChannels)
       header.channels().insert(std::string(kLayerPrefix[l]) + c.name, Imf::Channel(Imf::UINT));
@@ -200,6 +202,12 @@ StatusOr<TwoLayerPanorama> ReadExr(const std::string& path) {
     for (int i = 0; i < 9; ++i) frame.rotation[i] = a->value()[i / 3][i % 3];
   } else {
     return InvalidData(path + ": attribute casual3d.rotation (m33d) is missing");
+  }
+  if (const auto* a = header.findTypedAttribute<Imf::StringAttribute>("casual3d.view")) {
+    StatusOr<ViewHints> hints = ParseViewHints(a->value());
+    if (!hints.ok())
+      return InvalidData(path + ": attribute casual3d.view: " + hints.status().message());
+    pano.view_hints() = *hints;
   }
 
   const size_t strip_pixels = static_cast<size_t>(w) * kStripRows;

@@ -16,6 +16,8 @@
 //     casual3d.version  string "1.0" (major.minor; unknown majors are refused)
 //     casual3d.centre   v3d    PanoramaFrame::centre
 //     casual3d.rotation m33d   PanoramaFrame::rotation (row-major)
+//     casual3d.view     string OPTIONAL: the view hints (format/view_hints.h)
+//                              as the JSON object of the manifest's "view"
 // Float values are stored as 32-bit floats, so a write followed by a read gives
 // back exactly the same panorama (bit for bit).
 

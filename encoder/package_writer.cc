@@ -125,6 +125,9 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
   manifest.width = pano.width();
   manifest.height = pano.height();
   manifest.frame = pano.frame();
+  // The lowest minor version whose members the manifest uses.
+  manifest.view = pano.view_hints();
+  manifest.version_minor = manifest.view ? 1 : 0;
   manifest.tile_size = options.tile_size;
   manifest.depth = DepthRange(pano);
   manifest.depth.bits = options.depth_bits;

@@ -172,6 +172,10 @@ Status Manifest::Validate() const {
   for (double r : frame.rotation)
     if (!std::isfinite(r) || std::fabs(r) > 1.000001)
       return InvalidData("frame.rotation: entries must be finite and within [-1, 1]");
+  if (view) {
+    Status hints = view->Validate();
+    if (!hints.ok()) return Status(hints.code(), "view." + hints.message());
+  }
   if (tile_size < kMinTileSize || tile_size > kMaxTileSize)
     return LimitExceeded("tile_size " + std::to_string(tile_size) + " is outside [" +
                          std::to_string(kMinTileSize) + ", " + std::to_string(kMaxTileSize) + "]");
@@ -302,6 +306,12 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes) {
   Reader fr(*frame, "frame");
   C3D_CHECK(fr.NumberArray("centre", 3, m.frame.centre));
   C3D_CHECK(fr.NumberArray("rotation", 9, m.frame.rotation));
+  if (const Value* view = root.Find("view"); view != nullptr) {
+    ViewHints h;
+    Status ok = ViewHintsFromJson(*view, &h);
+    if (!ok.ok()) return fail(Status(ok.code(), "view." + ok.message()));
+    m.view = h;
+  }
   C3D_CHECK(r.Int("tile_size", kMinTileSize, kMaxTileSize, &m.tile_size));
   const Value* enc;
   C3D_CHECK(r.Get("depth_encoding", json::Type::kObject, &enc));
@@ -389,6 +399,7 @@ std::string SerializeManifest(const Manifest& m) {
   frame.Set("centre", NumberArray(m.frame.centre, 3));
   frame.Set("rotation", NumberArray(m.frame.rotation, 9));
   root.Set("frame", std::move(frame));
+  if (m.view) root.Set("view", ViewHintsToJson(*m.view));
   root.Set("tile_size", Value::Number(m.tile_size));
   Value depth = Value::Object();
   depth.Set("type", Value::String(kDepthType));

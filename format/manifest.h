@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,12 +19,15 @@
 #include "format/equirect.h"
 #include "format/status.h"
 #include "format/tile_codec.h"
+#include "format/view_hints.h"
 
 namespace casual3d {
 
 constexpr const char* kPackageFormatName = "casual3d";
 constexpr int kPackageVersionMajor = 1;
-constexpr int kPackageVersionMinor = 0;
+// The newest minor version this reader knows. Writers write the lowest minor
+// version whose members they use: 1.0 without "view", 1.1 with it.
+constexpr int kPackageVersionMinor = 1;
 constexpr const char* kManifestFileName = "manifest.json";
 
 // Limits of spec/package.md, "Limits".
@@ -62,11 +66,13 @@ struct FileEntry {
 
 struct Manifest {
   int version_major = kPackageVersionMajor;
-  int version_minor = kPackageVersionMinor;
+  int version_minor = 0;  // Writers: the lowest minor whose members they use.
   std::string generator;  // Free text naming the writing program (optional).
   int width = 0;          // Full-resolution panorama size, pixels.
   int height = 0;
   PanoramaFrame frame;
+  // "view" (version 1.1, optional): how to look at the 3D photo.
+  std::optional<ViewHints> view;
   int tile_size = 512;    // Pixels per tile side at every level.
   DepthQuantization depth;    // depth_encoding
   NormalQuantization normal;  // normal_encoding

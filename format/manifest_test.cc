@@ -117,5 +117,44 @@ TEST(ManifestTest, SafePaths) {
   EXPECT_TRUE(IsSafePackagePath(std::string(255, 'a')));
 }
 
+TEST(ManifestTest, ViewHintsRoundTripAndChecks) {
+  Manifest m = SmallManifest();
+  ViewHints h;
+  h.yaw_deg = -12.5;
+  h.pitch_deg = 3.0;
+  h.fov_deg = 62.0;
+  h.content_yaw_min_deg = 150.0;  // Across the seam.
+  h.content_yaw_max_deg = 215.0;
+  h.content_pitch_min_deg = -40.0;
+  h.content_pitch_max_deg = 45.0;
+  h.volume_radius = 0.12;
+  h.metric = true;
+  m.view = h;
+  m.version_minor = 1;
+  const std::string text = SerializeManifest(m);
+  EXPECT_NE(text.find("\"version\": \"1.1\""), std::string::npos);
+  StatusOr<Manifest> back = ParseManifest(text);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  ASSERT_TRUE(back->view.has_value());
+  EXPECT_TRUE(*back->view == h);
+  EXPECT_EQ(SerializeManifest(*back), text);
+
+  // Each member is checked and named.
+  auto refused = [&](const std::string& from, const std::string& to, const std::string& names) {
+    StatusOr<Manifest> r = ParseManifest(Replace(text, from, to));
+    ASSERT_FALSE(r.ok()) << to;
+    EXPECT_NE(r.status().message().find(names), std::string::npos) << r.status().message();
+  };
+  refused("\"fov_deg\": 62", "\"fov_deg\": 170", "view.fov_deg");
+  refused("\"volume_radius\": 0.12", "\"volume_radius\": 0", "view.volume_radius");
+  refused("\"volume_radius\": 0.12", "\"volume_radius\": \"big\"", "view.volume_radius");
+  refused("\"metric\": true", "\"metric\": 1", "view.metric");
+  refused("\"yaw_deg\": -12.5", "\"yaw_deg\": 200", "view.yaw_deg");
+  refused("\"content_pitch_deg\": [\n      -40,\n      45\n    ]", "\"content_pitch_deg\": [45, -40]",
+          "view.content_pitch_deg");
+  // Without "view", a 1.0 manifest parses with no hints.
+  EXPECT_FALSE(ParseManifest(SerializeManifest(SmallManifest()))->view.has_value());
+}
+
 }  // namespace
 }  // namespace casual3d

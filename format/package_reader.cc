@@ -52,6 +52,7 @@ Status PackageReader::BeginLevel(int level, int64_t max_pixels) {
   // tile, whose decoding writes every field of every node.
   pano_ = TwoLayerPanorama::Unfilled(L.width, L.height);
   pano_.frame() = manifest_.frame;
+  pano_.view_hints() = manifest_.view;
   received_.assign(L.tiles.size() * kNumTileImageKinds, 0);
   return Status::Ok();
 }

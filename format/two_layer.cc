@@ -273,6 +273,10 @@ Status TwoLayerPanorama::Check(bool nodes, int num_threads) const {
                          std::to_string(kMaxHeight));
   }
   CASUAL3D_RETURN_IF_ERROR(ValidateFrame(frame_));
+  if (view_hints_) {
+    const Status hints = view_hints_->Validate();
+    if (!hints.ok()) return Status(hints.code(), "view hints: " + hints.message());
+  }
   const size_t n = static_cast<size_t>(width_) * height_;
   for (int l = 0; l < kNumLayers; ++l) {
     const LayerData& d = layers_[l];
@@ -377,6 +381,7 @@ bool TwoLayerPanorama::operator==(const TwoLayerPanorama& o) const {
   for (int i = 0; i < 9; ++i) {
     if (frame_.rotation[i] != o.frame_.rotation[i]) return false;
   }
+  if (view_hints_ != o.view_hints_) return false;
   for (int l = 0; l < kNumLayers; ++l) {
     const LayerData& a = layers_[l];
     const LayerData& b = o.layers_[l];

@@ -8,11 +8,13 @@
 #include <cstdint>
 #include <memory>
 #include <new>
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include "format/equirect.h"
 #include "format/status.h"
+#include "format/view_hints.h"
 
 namespace casual3d {
 
@@ -105,6 +107,10 @@ class TwoLayerPanorama {
 
   PanoramaFrame& frame() { return frame_; }
   const PanoramaFrame& frame() const { return frame_; }
+  // How the 3D photo should be looked at (format/view_hints.h); empty when
+  // unknown (packages of version 1.0, panoramas made by hand).
+  std::optional<ViewHints>& view_hints() { return view_hints_; }
+  const std::optional<ViewHints>& view_hints() const { return view_hints_; }
 
   // Checks sizes, value ranges, and that every link is mutual and points at an
   // existing node. Returns the first problem found, naming layer and pixel.
@@ -136,6 +142,7 @@ class TwoLayerPanorama {
   int height_ = 0;
   LayerData layers_[kNumLayers];
   PanoramaFrame frame_;
+  std::optional<ViewHints> view_hints_;
 };
 
 }  // namespace casual3d
