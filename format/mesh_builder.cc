@@ -179,7 +179,30 @@ void QuadTriangles(const TwoLayerPanorama& p, int x, int y, bool use_back, unsig
   }
 }
 
+// Records which corner's triangles a quad emits (the first vertex of each
+// corner triangle is its corner node).
+struct CornerRecorder {
+  size_t corner_pixel[4];
+  unsigned corners = 0;
+  void AddTriangle(NodeRef a, NodeRef, NodeRef) {
+    const size_t pixel = (a & ~kSeamBit) >> 1;
+    for (int c = 0; c < 4; ++c)
+      if (corner_pixel[c] == pixel) corners |= 1u << c;
+  }
+};
+
 }  // namespace
+
+unsigned QuadCoverage(const TwoLayerPanorama& pano, int x, int y, bool use_back) {
+  const int xb = x + 1 == pano.width() ? 0 : x + 1;
+  CornerRecorder r{{pano.index(x, y), pano.index(xb, y), pano.index(x, y + 1), pano.index(xb, y + 1)}};
+  QuadTriangles(pano, x, y, use_back, 0u, &r);
+  // Corner A's triangle covers the top and left quarters, B's top and right,
+  // C's left and bottom, D's right and bottom.
+  const bool a = r.corners & 1u, b = r.corners & 2u, c = r.corners & 4u, d = r.corners & 8u;
+  return ((a || b) ? kQuarterTop : 0u) | ((a || c) ? kQuarterLeft : 0u) |
+         ((b || d) ? kQuarterRight : 0u) | ((c || d) ? kQuarterBottom : 0u);
+}
 
 void AddQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back,
                       unsigned skip_layers, MeshAssembler* out) {

@@ -124,6 +124,16 @@ void AddQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back,
 int CountQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back,
                        unsigned skip_layers);
 
+// Which part of pixel quad (x, y) its triangles cover seen from the centre.
+// Every triangle's vertices lie on the rays of the quad's corner pixels, so
+// seen from the centre a corner triangle covers one half of the quad; the
+// diagonals cut the quad into four quarters, returned as bits: kQuarterTop
+// (towards A-B), kQuarterLeft (A-C), kQuarterRight (B-D), kQuarterBottom (C-D).
+// 0xF: the quad is closed; anything less is a tear seen from the centre.
+// Precondition as AddQuadTriangles.
+constexpr unsigned kQuarterTop = 1, kQuarterLeft = 2, kQuarterRight = 4, kQuarterBottom = 8;
+unsigned QuadCoverage(const TwoLayerPanorama& pano, int x, int y, bool use_back = true);
+
 // sin and cos of `angle_rad` in [-4 pi, 4 pi] computed with + and * only, so
 // that native and wasm builds agree bit for bit. Absolute error below 1e-15.
 void DeterministicSinCos(double angle_rad, double* sin_out, double* cos_out);
