@@ -33,7 +33,11 @@ void AddPanoramaCommand(CLI::App& app) {
                   "itself (ground-truth depth of a synthetic capture)");
   cmd->add_option("-o,--output", args->output, "Output folder")->required();
   cmd->add_option("--pano-width", args->options.pano_width,
-                  "Panorama width in pixels (height = width / 2)")
+                  "Panorama width in pixels (height = width / 2); 0 = from the photos' angular "
+                  "resolution, at most --max-pano-width")
+      ->capture_default_str();
+  cmd->add_option("--max-pano-width", args->options.max_auto_width,
+                  "Largest automatic panorama width, a multiple of 1024 in 2048..16384")
       ->capture_default_str();
   cmd->add_option("--solve-width", args->options.stitch.solve_width,
                   "Width at which the stitching MRF is solved (height = width / 2)")
@@ -42,6 +46,8 @@ void AddPanoramaCommand(CLI::App& app) {
       ->each([args](const std::string&) { args->options.fill_front_gaps = false; });
   cmd->add_flag("--front-only", "Front layer only (no back layer)")
       ->each([args](const std::string&) { args->options.back_layer = false; });
+  cmd->add_flag("--no-seal", "Leave the quads fusion leaves open (tears seen from the centre)")
+      ->each([args](const std::string&) { args->options.seal_tears = false; });
   cmd->add_flag("--no-gc", "Stitch without the geometric-consistency cost")
       ->each([args](const std::string&) { args->options.stitch.lambda_gc = 0.0; });
   cmd->add_option("--sky-depth", args->options.sky_depth_m,

@@ -19,7 +19,7 @@ void AddReconstructCommand(CLI::App& app) {
     std::string to = "encode";
     pipeline::PipelineOptions options;
     double working_megapixels = 1.2;
-    int pano_width = 4096;
+    int pano_width = 0;
     bool no_near_envelope = false;
     bool no_gc_filter = false;
     bool front_only = false;
@@ -42,7 +42,11 @@ void AddReconstructCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--force", args->options.force, "Recompute the selected stages even if cached");
   cmd->add_option("--pano-width", args->pano_width,
-                  "Panorama width in pixels (height = width / 2), even, 64..16384")
+                  "Panorama width in pixels (height = width / 2), even, 64..16384; 0 = from the "
+                  "photos' angular resolution, at most --max-pano-width")
+      ->capture_default_str();
+  cmd->add_option("--max-pano-width", args->options.panorama.max_auto_width,
+                  "Largest automatic panorama width, a multiple of 1024 in 2048..16384")
       ->capture_default_str();
   cmd->add_option("--working-megapixels", args->working_megapixels,
                   "Photos are downscaled to about this size before matching and depth")
@@ -55,6 +59,8 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_flag("--no-gc-filter", args->no_gc_filter,
                 "Ablation: without the geometric-consistency filter and stitching cost");
   cmd->add_flag("--front-only", args->front_only, "Ablation: front layer only, no back layer");
+  cmd->add_flag("--no-seal", "Ablation: leave the quads fusion leaves open (tears seen from the centre)")
+      ->each([args](const std::string&) { args->options.panorama.seal_tears = false; });
   cmd->add_flag("--debug", args->debug, "Write colour-mapped PNGs of the dense intermediates");
   cmd->add_option("--holdout-every", args->options.holdout_every,
                   "Register every photo but build the 3D photo without photos 0, N, 2N, ... "

@@ -36,72 +36,52 @@ class Sealer {
   }
   bool Open(int x, int y) const { return AllFront(x, y) && QuadCoverage(p_, x, y) != 0xFu; }
 
-  // Tries the edits of quad (x, y); true if one was kept.
-  bool SealQuad(int x, int y, SealStats* stats) {
-    const int W = p_.width();
-    const int xb = x + 1 == W ? 0 : x + 1;
-    struct Edge {
-      int px, py, qx, qy;
-      Direction d;
-    };
-    const Edge edges[4] = {{x, y, xb, y, kRight}, {x, y + 1, xb, y + 1, kRight},
-                           {x, y, x, y + 1, kDown}, {xb, y, xb, y + 1, kDown}};
-    const int corner_x[4] = {x, xb, x, xb}, corner_y[4] = {y, y, y + 1, y + 1};
-    int best_kind = -1, best_gain = 0, best_pref = -1;
-    int best_a = 0, best_b = 0, best_c = 0;  // Edit parameters.
-    // Links across the quad's edges.
-    for (int e = 0; e < 4; ++e) {
-      const Edge& E = edges[e];
-      for (int lp = 0; lp < kNumLayers; ++lp) {
-        for (int lq = 0; lq < kNumLayers; ++lq) {
-          if (!Present(lp, E.px, E.py) || !Present(lq, E.qx, E.qy)) continue;
-          if (Linked(lp, E.px, E.py, E.d, lq)) continue;
-          const float r = Ratio(Depth(lp, E.px, E.py), Depth(lq, E.qx, E.qy));
-          if (!(r > min_ratio_)) continue;
-          if (lp != lq && Linked(1 - lp, E.px, E.py, E.d, 1 - lq)) continue;  // Would cross.
-          Begin(E.px, E.py, E.qx, E.qy);
-          MakeLink(E.px, E.py, lp, E.d, lq);
-          const int gain = Score(E.px, E.py, E.qx, E.qy) - before_;
-          Undo();
-          const int pref = r > tau_ ? 3 : r > 0.9f ? 2 : 0;
-          if (Better(gain, pref, best_gain, best_pref)) {
-            best_kind = 0, best_gain = gain, best_pref = pref;
-            best_a = e, best_b = lp, best_c = lq;
+  // Tries the edits of quad (x, y); true if some were kept. `behind`: also
+  // links across any depth step between two nodes that both lie clearly
+  // behind the quad's nearest front node, and pairs of edits (where three
+  // surfaces meet behind a foreground edge, two layers cannot hold them
+  // all, and closing the quad can take two links).
+  bool SealQuad(int x, int y, bool behind, SealStats* stats) {
+    const size_t base_mark = log_.size();
+    const int base = WindowScore(x, y);
+    std::vector<Edit> first;
+    Candidates(x, y, behind, &first);
+    Edit best[2];
+    int best_count = 0, best_gain = 0, best_pref = -1000;
+    std::vector<Edit> kept_for_pairs;
+    for (const Edit& e : first) {
+      Apply(e);
+      const int gain = WindowScore(x, y) - base;
+      Restore(base_mark);
+      if (Better(gain, e.pref, best_gain, best_pref)) {
+        best[0] = e, best_count = 1, best_gain = gain, best_pref = e.pref;
+      }
+      if (gain >= 0) kept_for_pairs.push_back(e);
+    }
+    if (best_count == 0 && behind) {
+      std::vector<Edit> second;
+      for (const Edit& e1 : kept_for_pairs) {
+        Apply(e1);
+        const size_t mark = log_.size();
+        Candidates(x, y, behind, &second);
+        for (const Edit& e2 : second) {
+          Apply(e2);
+          const int gain = WindowScore(x, y) - base;
+          Restore(mark);
+          if (Better(gain, e1.pref + e2.pref, best_gain, best_pref)) {
+            best[0] = e1, best[1] = e2, best_count = 2, best_gain = gain, best_pref = e1.pref + e2.pref;
           }
         }
+        Restore(base_mark);
       }
     }
-    // A back node at corner k extending a farther node of the quad.
-    for (int k = 0; k < 4; ++k) {
-      if (Present(kBack, corner_x[k], corner_y[k])) continue;
-      const float dk = Depth(kFront, corner_x[k], corner_y[k]);
-      for (int m = 0; m < 4; ++m) {
-        if (m == k || (m ^ k) == 3) continue;  // 4-neighbours only (not the diagonal).
-        for (int lm = 0; lm < kNumLayers; ++lm) {
-          if (!Present(lm, corner_x[m], corner_y[m])) continue;
-          const float dm = Depth(lm, corner_x[m], corner_y[m]);
-          if (!(dm > dk && Ratio(dk, dm) <= tau_)) continue;
-          Begin(corner_x[k], corner_y[k], corner_x[k], corner_y[k]);
-          AddBackNode(corner_x[k], corner_y[k], corner_x[m], corner_y[m], lm);
-          const int gain = ScoreAround(corner_x[k], corner_y[k]) - before_;
-          Undo();
-          if (Better(gain, 1, best_gain, best_pref)) {
-            best_kind = 1, best_gain = gain, best_pref = 1;
-            best_a = k, best_b = m, best_c = lm;
-          }
-        }
-      }
+    for (int i = 0; i < best_count; ++i) {
+      Apply(best[i]);
+      if (best[i].kind == Edit::kLink) ++stats->links_made;
+      else ++stats->back_nodes_added;
     }
-    if (best_kind < 0) return false;
-    if (best_kind == 0) {
-      const Edge& E = edges[best_a];
-      MakeLink(E.px, E.py, best_b, E.d, best_c);
-      ++stats->links_made;
-    } else {
-      AddBackNode(corner_x[best_a], corner_y[best_a], corner_x[best_b], corner_y[best_b], best_c);
-      ++stats->back_nodes_added;
-    }
-    return true;
+    log_.resize(base_mark);  // Kept: forget the undo entries.
+    return best_count > 0;
   }
 
  private:
@@ -180,23 +160,86 @@ class Sealer {
     }
   }
 
-  // Undo log: the four nodes of two pixels (may be the same pixel).
-  void Begin(int x0, int y0, int x1, int y1) {
-    saved_.clear();
-    for (auto [x, y] : {std::pair{x0, y0}, std::pair{x1, y1}}) {
-      // The pixel and its four neighbours: links of neighbours change too.
-      Save(x, y);
-      for (int d = 0; d < kNumDirections; ++d) {
-        int nx, ny;
-        if (p_.Neighbour(x, y, static_cast<Direction>(d), &nx, &ny)) Save(nx, ny);
+  // One edit: a link from node (la, ax, ay) towards d to the neighbour's
+  // node of layer lb; or a back node at (ax, ay) extending node (lb, bx, by).
+  struct Edit {
+    enum Kind { kLink, kBackNode } kind = kLink;
+    int ax = 0, ay = 0, la = 0, bx = 0, by = 0, lb = 0;
+    Direction d = kRight;
+    int pref = 0;
+  };
+
+  // The edits of quad (x, y) in its current state.
+  void Candidates(int x, int y, bool behind, std::vector<Edit>* out) const {
+    out->clear();
+    const int xb = x + 1 == p_.width() ? 0 : x + 1;
+    struct Side {
+      int px, py;
+      Direction d;
+    };
+    const Side sides[4] = {{x, y, kRight}, {x, y + 1, kRight}, {x, y, kDown}, {xb, y, kDown}};
+    const int cx[4] = {x, xb, x, xb}, cy[4] = {y, y, y + 1, y + 1};
+    float nearest = Depth(kFront, cx[0], cy[0]);
+    for (int k = 1; k < 4; ++k) nearest = std::min(nearest, Depth(kFront, cx[k], cy[k]));
+    const float behind_depth = nearest / tau_;
+    for (const Side& S : sides) {
+      int qx, qy;
+      if (!p_.Neighbour(S.px, S.py, S.d, &qx, &qy)) continue;
+      for (int lp = 0; lp < kNumLayers; ++lp) {
+        for (int lq = 0; lq < kNumLayers; ++lq) {
+          if (!Present(lp, S.px, S.py) || !Present(lq, qx, qy)) continue;
+          if (Linked(lp, S.px, S.py, S.d, lq)) continue;
+          if (lp != lq && Linked(1 - lp, S.px, S.py, S.d, 1 - lq)) continue;  // Would cross.
+          const float dp = Depth(lp, S.px, S.py), dq = Depth(lq, qx, qy);
+          const float r = Ratio(dp, dq);
+          const bool step = !(r > min_ratio_);
+          if (step && !(behind && dp >= behind_depth && dq >= behind_depth)) continue;
+          Edit e;
+          e.kind = Edit::kLink;
+          e.ax = S.px, e.ay = S.py, e.la = lp, e.bx = qx, e.by = qy, e.lb = lq, e.d = S.d;
+          e.pref = step ? -1 : r > tau_ ? 3 : r > 0.9f ? 2 : 0;
+          out->push_back(e);
+        }
       }
     }
-    before_ = x0 == x1 && y0 == y1 ? ScoreAround(x0, y0) : Score(x0, y0, x1, y1);
+    // A back node at corner k extending a farther 4-neighbour node of the quad.
+    for (int k = 0; k < 4; ++k) {
+      if (Present(kBack, cx[k], cy[k])) continue;
+      const float dk = Depth(kFront, cx[k], cy[k]);
+      for (int m = 0; m < 4; ++m) {
+        if (m == k || (m ^ k) == 3) continue;  // Not the diagonal.
+        for (int lm = 0; lm < kNumLayers; ++lm) {
+          if (!Present(lm, cx[m], cy[m])) continue;
+          const float dm = Depth(lm, cx[m], cy[m]);
+          if (!(dm > dk && Ratio(dk, dm) <= tau_)) continue;
+          Edit e;
+          e.kind = Edit::kBackNode;
+          e.ax = cx[k], e.ay = cy[k], e.bx = cx[m], e.by = cy[m], e.lb = lm;
+          e.pref = 1;
+          out->push_back(e);
+        }
+      }
+    }
   }
+
+  // Applies `e`, logging what it changes.
+  void Apply(const Edit& e) {
+    if (e.kind == Edit::kLink) {
+      Save(e.ax, e.ay);
+      Save(e.bx, e.by);
+      MakeLink(e.ax, e.ay, e.la, e.d, e.lb);
+    } else {
+      Save(e.ax, e.ay);
+      for (int d = 0; d < kNumDirections; ++d) {
+        int nx, ny;
+        if (p_.Neighbour(e.ax, e.ay, static_cast<Direction>(d), &nx, &ny)) Save(nx, ny);
+      }
+      AddBackNode(e.ax, e.ay, e.bx, e.by, e.lb);
+    }
+  }
+
   void Save(int x, int y) {
     const size_t i = p_.index(x, y);
-    for (const SavedPixel& s : saved_)
-      if (s.index == i) return;
     SavedPixel entry;
     entry.index = i;
     for (int l = 0; l < kNumLayers; ++l) {
@@ -211,10 +254,12 @@ class Sealer {
         c.normal[k] = L.normal[3 * i + k];
       }
     }
-    saved_.push_back(entry);
+    log_.push_back(entry);
   }
-  void Undo() {
-    for (const SavedPixel& s : saved_) {
+  // Undoes everything logged after `mark`, newest first.
+  void Restore(size_t mark) {
+    while (log_.size() > mark) {
+      const SavedPixel& s = log_.back();
       const size_t i = s.index;
       for (int l = 0; l < kNumLayers; ++l) {
         LayerData& L = p_.layer(l);
@@ -228,6 +273,7 @@ class Sealer {
           L.normal[3 * i + k] = c.normal[k];
         }
       }
+      log_.pop_back();
     }
   }
 
@@ -239,29 +285,18 @@ class Sealer {
     if (!AllFront(qx, qy)) return 0;
     return __builtin_popcount(QuadCoverage(p_, qx, qy));
   }
-  int ScoreAround(int x, int y) const {
-    // Pixel (x, y) and its 4-neighbours change: quads within one pixel.
+  // Closed quarters of the quads within two of quad (x, y): every quad
+  // that touches a pixel an edit of (x, y) can change.
+  int WindowScore(int x, int y) const {
     int s = 0;
-    for (int qy = y - 2; qy <= y + 1; ++qy)
-      for (int qx = x - 2; qx <= x + 1; ++qx) s += QuadScore(qx, qy);
-    return s;
-  }
-  int Score(int x0, int y0, int x1, int y1) const {
-    // Quads touching either pixel (links of both change) and their partners.
-    int s = 0;
-    const int xl = std::min(x0, x1), yl = std::min(y0, y1);
-    const int xr = xl + (x0 != x1 ? 1 : 0), yr = yl + (y0 != y1 ? 1 : 0);
-    const bool wrapped = (x0 == 0 && x1 == p_.width() - 1) || (x1 == 0 && x0 == p_.width() - 1);
-    if (wrapped) return ScoreAround(x0, y0) + ScoreAround(x1, y1);
-    for (int qy = yl - 1; qy <= yr; ++qy)
-      for (int qx = xl - 1; qx <= xr; ++qx) s += QuadScore(qx, qy);
+    for (int qy = y - 2; qy <= y + 2; ++qy)
+      for (int qx = x - 2; qx <= x + 2; ++qx) s += QuadScore(qx, qy);
     return s;
   }
 
   TwoLayerPanorama& p_;
   float min_ratio_, tau_;
-  std::vector<SavedPixel> saved_;
-  int before_ = 0;
+  std::vector<SavedPixel> log_;
 };
 
 }  // namespace
@@ -299,17 +334,21 @@ SealStats SealTears(TwoLayerPanorama* pano, const SealOptions& options) {
     for (int x = 0; x < W; ++x)
       if (sealer.Open(x, y)) open.push_back(y * W + x);
   stats.open_quads_before = static_cast<int64_t>(open.size());
-  for (int pass = 0; pass < options.max_passes && !open.empty(); ++pass) {
-    bool changed = false;
-    std::vector<int> still;
-    for (int q : open) {
-      const int x = q % W, y = q / W;
-      if (!sealer.Open(x, y)) continue;
-      if (sealer.SealQuad(x, y, &stats)) changed = true;
-      if (sealer.Open(x, y)) still.push_back(q);
+  // Local edits within one surface first; then, for what is left, links
+  // between surfaces behind the foreground.
+  for (const bool behind : {false, true}) {
+    for (int pass = 0; pass < options.max_passes && !open.empty(); ++pass) {
+      bool changed = false;
+      std::vector<int> still;
+      for (int q : open) {
+        const int x = q % W, y = q / W;
+        if (!sealer.Open(x, y)) continue;
+        if (sealer.SealQuad(x, y, behind, &stats)) changed = true;
+        if (sealer.Open(x, y)) still.push_back(q);
+      }
+      open.swap(still);
+      if (!changed) break;
     }
-    open.swap(still);
-    if (!changed) break;
   }
   stats.open_quads_after = CountOpenQuads(*pano);
   return stats;

@@ -16,6 +16,12 @@
 //   - extend the farther surface behind a nearer corner: a back node at that
 //     corner (where it has none) with the depth and colour of a farther node
 //     of the quad, linked to every node of its neighbours within tau_dratio.
+// Where three surfaces meet behind a foreground edge (a near branch over a
+// wall and the sky), two layers cannot hold them all and no such edit closes
+// the quad; a second round then also links two nodes across any depth step
+// if both lie clearly behind the quad's nearest front node (depth above
+// nearest / tau_dratio): a thin sheet hidden behind the foreground from the
+// centre, instead of a hole seen from everywhere.
 // An edit is kept when it closes more quarters of the quads around the
 // changed pixels than it opens; the best edit of each quad is kept, links of
 // nearly equal depth and back-layer extensions preferred to links across

@@ -82,6 +82,38 @@ TEST(SealTears, DepthEdgeWithoutBackLayerGetsTheFarSurfaceBehind) {
   }
 }
 
+TEST(SealTears, ThreeSurfacesBehindAnEdgeAreClosed) {
+  // A near bar (1 m) in front of the junction of a wall (2 m) and a far
+  // wall (6 m): behind the bar's border three surfaces meet, which two
+  // layers cannot hold; the second round links the two walls behind the bar.
+  const int W = 64, H = 32;
+  Input in = Flat(W, H);
+  for (int y = 2; y < 30; ++y)
+    for (int x = 0; x < W; ++x) {
+      const bool bar = y >= 8 && y < 24 && x >= 28 && x < 36;
+      in.front_depth.at(x, y) = bar ? 1.0f : (y < 16 ? 2.0f : 6.0f);
+    }
+  TwoLayerPanorama pano = FuseInputs(in);
+  ASSERT_GT(CountOpenQuads(pano), 0);
+  SealStats stats = SealTears(&pano);
+  EXPECT_EQ(stats.open_quads_after, 0);
+  EXPECT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
+  // No link ever joins the bar to anything behind it.
+  const LayerData& F = pano.layer(kFront);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = pano.index(x, y);
+      if (!F.present[i] || F.depth_m[i] != 1.0f) continue;
+      for (int d = 0; d < kNumDirections; ++d) {
+        const Link l = GetLink(F.links[i], static_cast<Direction>(d));
+        if (l == Link::kNone) continue;
+        int nx, ny;
+        ASSERT_TRUE(pano.Neighbour(x, y, static_cast<Direction>(d), &nx, &ny));
+        EXPECT_FLOAT_EQ(pano.layer(l == Link::kFront ? kFront : kBack).depth_m[pano.index(nx, ny)], 1.0f);
+      }
+    }
+}
+
 TEST(SealTears, ClosedPanoramaIsUnchanged) {
   const int W = 64, H = 32;
   Input in = Flat(W, H);

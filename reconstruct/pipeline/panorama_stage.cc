@@ -14,6 +14,7 @@
 #include "reconstruct/io/colour_map.h"
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
+#include "reconstruct/pipeline/view_volume.h"
 #include "reconstruct/io/image_io.h"
 #include "reconstruct/sfm/scene_setup.h"
 #include "reconstruct/util/log.h"
@@ -103,22 +104,41 @@ void WriteHolesPreview(const Image8& fov, const Image8& holes, const std::string
 }  // namespace
 
 std::string PanoramaStageOptions::Check() const {
-  if (pano_width < 64 || pano_width > 16384 || pano_width % 2 != 0) {
-    return "pano_width " + std::to_string(pano_width) + ": must be even and in [64, 16384]";
+  if (pano_width != 0 && (pano_width < 64 || pano_width > 16384 || pano_width % 2 != 0)) {
+    return "pano_width " + std::to_string(pano_width) +
+           ": must be 0 (automatic) or even and in [64, 16384]";
   }
-  if (stitch.solve_width > pano_width) {
+  if (max_auto_width < 2048 || max_auto_width > 16384 || max_auto_width % 1024 != 0) {
+    return "max_auto_width " + std::to_string(max_auto_width) +
+           ": must be a multiple of 1024 in [2048, 16384]";
+  }
+  if (pano_width != 0 && stitch.solve_width > pano_width) {
     return "stitch.solve_width " + std::to_string(stitch.solve_width) +
            ": must not exceed pano_width " + std::to_string(pano_width);
   }
   if (!(sky_depth_m >= 0)) return "sky_depth_m: must be >= 0";
   if (num_threads < 0) return "num_threads: must be >= 0";
   warp::WarpOptions w = warp;
-  w.pano_width = pano_width;
-  w.pano_height = pano_width / 2;
-  for (const std::string& why : {w.Check(), stitch.Check(), fuse.Check(), normals.Check()}) {
+  w.pano_width = pano_width != 0 ? pano_width : max_auto_width;
+  w.pano_height = w.pano_width / 2;
+  for (const std::string& why :
+       {w.Check(), stitch.Check(), fuse.Check(), seal.Check(), normals.Check(), view.Check()}) {
     if (!why.empty()) return why;
   }
   return "";
+}
+
+int AutoPanoramaWidth(const std::vector<geometry::Camera>& cameras, int max_width) {
+  std::vector<double> focal;
+  for (const geometry::Camera& c : cameras) {
+    const double f = std::sqrt(c.FocalX() * c.FocalY());
+    if (std::isfinite(f) && f > 0) focal.push_back(f);
+  }
+  if (focal.empty()) return std::min(4096, max_width);
+  std::nth_element(focal.begin(), focal.begin() + focal.size() / 2, focal.end());
+  const double around = 2.0 * kPi * focal[focal.size() / 2];
+  const int width = static_cast<int>(std::ceil(around / 1024.0)) * 1024;
+  return std::clamp(width, 2048, max_width);
 }
 
 PanoramaFrame LoadOrComputeFrame(const std::string& sparse_dir) {
@@ -149,14 +169,29 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   if (!why.empty()) throw std::invalid_argument("panorama options: " + why);
   const auto start = Clock::now();
   PanoramaStageReport report;
-  const int W = options.pano_width, H = W / 2;
-  report.width = W;
-  report.height = H;
 
   // Load photos, cameras and depth maps.
   auto t = Clock::now();
   const geometry::SparseModel model =
       geometry::ReadModel((fs::path(sparse_dir) / "sparse").string());
+  int W = options.pano_width;
+  if (W == 0) {
+    std::vector<geometry::Camera> cameras;
+    for (const auto& [id, image] : model.images) {
+      const auto cam = model.cameras.find(image.camera_id);
+      if (cam != model.cameras.end()) cameras.push_back(cam->second);
+    }
+    W = AutoPanoramaWidth(cameras, options.max_auto_width);
+    util::LogInfo("panorama: " + std::to_string(W) + "x" + std::to_string(W / 2) +
+                  " from the photos' angular resolution");
+  }
+  if (options.stitch.solve_width > W)
+    throw std::invalid_argument("panorama options: stitch.solve_width " +
+                                std::to_string(options.stitch.solve_width) +
+                                " exceeds the panorama width " + std::to_string(W));
+  const int H = W / 2;
+  report.width = W;
+  report.height = H;
   const PanoramaFrame frame = LoadOrComputeFrame(sparse_dir);
   struct Loaded {
     Image8 rgb;
@@ -278,6 +313,14 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   if (!options.back_layer) fuse_options.expansion_fraction = 0;
   TwoLayerPanorama pano = fuse::Fuse({&front.rgb, &front.depth_m, &back.rgb, &back.depth_m, frame},
                                      fuse_options, &report.fuse);
+  if (options.seal_tears) {
+    report.seal = fuse::SealTears(&pano, options.seal);
+    util::LogInfo("panorama: sealed " +
+                  std::to_string(report.seal.open_quads_before - report.seal.open_quads_after) +
+                  " of " + std::to_string(report.seal.open_quads_before) + " open quads (" +
+                  std::to_string(report.seal.links_made) + " links, " +
+                  std::to_string(report.seal.back_nodes_added) + " back nodes)");
+  }
   report.seconds_fuse = Seconds(t);
   t = Clock::now();
   report.normals = normals::ComputeNormals(&pano, options.normals);
@@ -288,6 +331,14 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   report.front_fov = MeasureHoles(pano, kFront, fov, &holes);
   report.front_fov.reference_depth_m = reference_depth;
   report.front_footprint = MeasureHoles(pano, kFront, footprint);
+  // Synthetic captures (capture.json) are in metres; COLMAP's models are not.
+  const bool metric = fs::exists(fs::path(sparse_dir) / "capture.json");
+  pano.view_hints() = ComputeViewHints(pano, fov, coverage_views, frame, metric, options.view);
+  const ViewHints& hints = *pano.view_hints();
+  util::LogInfo("panorama: opens at yaw " + std::to_string(hints.yaw_deg) + ", pitch " +
+                std::to_string(hints.pitch_deg) + ", field of view " + std::to_string(hints.fov_deg) +
+                " deg; viewing volume radius " + std::to_string(hints.volume_radius) +
+                (metric ? " m" : " (model units)"));
   for (const auto& [what, c] : {std::pair{"field of view", &report.front_fov},
                                 std::pair{"footprint", &report.front_footprint}}) {
     util::LogInfo("panorama: front layer covers " + std::to_string(100.0 * c->covered_fraction) +
@@ -329,6 +380,7 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
                           {"reference_depth_m", c.reference_depth_m}};
   };
   j["front_fov"] = coverage_json(report.front_fov);
+  j["view"] = nlohmann::json::parse(SerializeViewHints(*pano.view_hints()));
   j["front_gaps_filled"] = report.front_gaps_filled;
   j["front_footprint"] = coverage_json(report.front_footprint);
   j["fuse"] = {{"front_nodes", report.fuse.front_nodes},
@@ -337,6 +389,11 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
                {"back_nodes_hallucinated", report.fuse.back_nodes_hallucinated},
                {"front_nodes_relabelled", report.fuse.front_nodes_relabelled},
                {"links", report.fuse.links}};
+  j["seal"] = {{"enabled", options.seal_tears},
+               {"open_quads_before", report.seal.open_quads_before},
+               {"open_quads_after", report.seal.open_quads_after},
+               {"links_made", report.seal.links_made},
+               {"back_nodes_added", report.seal.back_nodes_added}};
   j["normals"] = {{"nodes", report.normals.nodes}, {"sky_nodes", report.normals.sky_nodes}};
   j["seconds"] = {{"load", report.seconds_load},
                   {"warp", report.seconds_warp},

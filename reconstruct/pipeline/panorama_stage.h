@@ -21,22 +21,33 @@
 #include <vector>
 
 #include "format/two_layer.h"
+#include "reconstruct/geometry/camera.h"
 #include "reconstruct/fuse/fuse.h"
+#include "reconstruct/fuse/seal.h"
 #include "reconstruct/normals/normals.h"
 #include "reconstruct/pipeline/coverage.h"
+#include "reconstruct/pipeline/view_volume.h"
 #include "reconstruct/stitch/stitch.h"
 #include "reconstruct/warp/warp.h"
 
 namespace casual3d::pipeline {
 
 struct PanoramaStageOptions {
-  // Output panorama width (height = width / 2); even, [64, 16384]. The paper
-  // uses 8192; 4096 is the default on 2-core machines.
-  int pano_width = 4096;
+  // Output panorama width (height = width / 2); even, [64, 16384]; 0 =
+  // from the photos' angular resolution (AutoPanoramaWidth), at most
+  // max_auto_width. The paper uses 8192.
+  int pano_width = 0;
+  // Largest automatic width: a multiple of 1024 in [2048, 16384].
+  int max_auto_width = 8192;
   warp::WarpOptions warp;        // pano_width/height are set from pano_width.
   stitch::StitchOptions stitch;
   fuse::FuseOptions fuse;
+  // Close the quads fusion leaves open (fuse/seal.h); false: the ablation.
+  bool seal_tears = true;
+  fuse::SealOptions seal;
   normals::NormalOptions normals;
+  // The view hints written with the panorama (view_volume.h).
+  ViewVolumeOptions view;
   // false: front layer only (the ablation of the paper's Fig. 15).
   bool back_layer = true;
   // Fill the front layer's gaps inside the photos' field of view
@@ -56,10 +67,11 @@ struct PanoramaStageReport {
   int num_photos = 0;
   int width = 0, height = 0;
   double sky_depth_m = 0.0;
-  // seconds_fuse includes the field-of-view mask and the gap filling.
+  // seconds_fuse includes the field-of-view mask, the gap filling and sealing.
   double seconds_load = 0, seconds_warp = 0, seconds_stitch_front = 0, seconds_stitch_back = 0,
          seconds_fuse = 0, seconds_normals = 0, seconds_write = 0, seconds_total = 0;
   fuse::FuseStats fuse;
+  fuse::SealStats seal;
   normals::NormalStats normals;
   double front_coverage = 0.0;  // Fraction of pixels with a front node.
   // The front layer inside the photos' field of view: coverage and holes
@@ -80,6 +92,12 @@ struct PanoramaStageReport {
 TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::string& depth_dir,
                                   const std::string& out_dir, const PanoramaStageOptions& options,
                                   PanoramaStageReport* report = nullptr);
+
+// The panorama width that matches the photos' angular resolution: the
+// median focal length f (pixels) of `cameras` gives 2 pi f pixels around the
+// circle; rounded up to a multiple of 1024 and kept within [2048,
+// max_width] (coarser levels are halved from it by the encoder).
+int AutoPanoramaWidth(const std::vector<geometry::Camera>& cameras, int max_width);
 
 // The 3D photo's frame for a workspace: SPARSE/frame.json if present, else the
 // "frame" of SPARSE/capture.json (synthetic captures), else computed from the

@@ -85,11 +85,14 @@ std::string DenseOptionsText(const depth::DenseOptions& o) {
 
 std::string PanoramaOptionsText(const PanoramaStageOptions& o) {
   std::ostringstream s;
-  s << "pano_width=" << o.pano_width << " solve=" << o.stitch.solve_width
+  s << "pano_width=" << o.pano_width << " max_auto_width=" << o.max_auto_width << " solve=" << o.stitch.solve_width
     << " back_layer=" << o.back_layer << " fill_front_gaps=" << o.fill_front_gaps
     << " tau_stretch=" << o.warp.tau_stretch_deg
     << " lambda_gc=" << o.stitch.lambda_gc << " tau_dratio=" << o.fuse.tau_dratio
-    << " expansion=" << o.fuse.expansion_fraction << " sky_depth=" << o.sky_depth_m;
+    << " expansion=" << o.fuse.expansion_fraction << " sky_depth=" << o.sky_depth_m
+    << " seal=" << o.seal_tears << " seal_min_link_ratio=" << o.seal.min_link_ratio
+    << " view_hints=1 near_percentile=" << o.view.near_percentile
+    << " radius_over_near=" << o.view.min_radius_over_near << "," << o.view.max_radius_over_near;
   return s.str();
 }
 

@@ -1,0 +1,205 @@
+#include "reconstruct/pipeline/view_volume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "format/equirect.h"
+
+namespace casual3d::pipeline {
+namespace {
+
+constexpr double kDeg = 180.0 / kPi;
+
+// Longitude (degrees) of the left edge of column x.
+double ColumnLonDeg(int x, int width) { return (static_cast<double>(x) / width - 0.5) * 360.0; }
+
+// The angle t (degrees) moved into [lo, hi] modulo 360, or to the nearer end.
+double IntoInterval(double t, double lo, double hi) {
+  if (hi - lo >= 360.0) return t;
+  double best = lo, best_distance = 1e30;
+  for (double k : {-720.0, -360.0, 0.0, 360.0, 720.0}) {
+    const double u = t + k;
+    if (u >= lo && u <= hi) return u;
+    for (double end : {lo, hi}) {
+      if (std::abs(u - end) < best_distance) {
+        best_distance = std::abs(u - end);
+        best = end;
+      }
+    }
+  }
+  return best;
+}
+
+double WrapDeg(double t) {
+  t = std::fmod(t + 180.0, 360.0);
+  if (t < 0) t += 360.0;
+  return t - 180.0;
+}
+
+// Vertical field of view (degrees) of a view `aspect` wide whose horizontal
+// field of view is `horizontal_deg`.
+double VerticalFromHorizontal(double horizontal_deg, double aspect) {
+  const double h = std::min(horizontal_deg, 179.0) / 2.0 / kDeg;
+  return 2.0 * std::atan(std::tan(h) / aspect) * kDeg;
+}
+
+}  // namespace
+
+std::string ViewVolumeOptions::Check() const {
+  if (!(near_percentile >= 0 && near_percentile <= 0.5)) return "near_percentile: must be in [0, 0.5]";
+  if (!(min_radius_over_near > 0 && min_radius_over_near <= max_radius_over_near &&
+        max_radius_over_near <= 1))
+    return "min_radius_over_near, max_radius_over_near: need 0 < min <= max <= 1";
+  if (!(frame_aspect >= 0.25 && frame_aspect <= 4)) return "frame_aspect: must be in [0.25, 4]";
+  return "";
+}
+
+bool ContentExtent(const Image8& fov_mask, ViewHints* hints) {
+  const int W = fov_mask.width(), H = fov_mask.height();
+  std::vector<uint8_t> column(W, 0);
+  int top = H, bottom = -1;
+  for (int y = 0; y < H; ++y) {
+    const uint8_t* row = &fov_mask.at(0, y);
+    bool any = false;
+    for (int x = 0; x < W; ++x) {
+      if (row[x]) {
+        column[x] = 1;
+        any = true;
+      }
+    }
+    if (any) {
+      top = std::min(top, y);
+      bottom = y;
+    }
+  }
+  if (bottom < 0) return false;
+  // The largest circular run of empty columns.
+  int best_start = 0, best_length = 0;
+  int first_full = -1;
+  for (int x = 0; x < W; ++x)
+    if (column[x]) {
+      first_full = x;
+      break;
+    }
+  for (int k = 0, run_start = -1, run = 0; k <= W; ++k) {
+    const int x = (first_full + k) % W;
+    if (k < W && !column[x]) {
+      if (run == 0) run_start = x;
+      ++run;
+    } else if (run > 0) {
+      if (run > best_length) {
+        best_length = run;
+        best_start = run_start;
+      }
+      run = 0;
+    }
+  }
+  if (best_length == 0) {
+    hints->content_yaw_min_deg = -180.0;
+    hints->content_yaw_max_deg = 180.0;
+  } else {
+    // Content runs from the column after the gap to the column before it.
+    const int first = (best_start + best_length) % W;
+    const int content_columns = W - best_length;
+    double lo = ColumnLonDeg(first, W);
+    double hi = lo + 360.0 * content_columns / W;
+    if (hi > 360.0) {
+      lo -= 360.0;
+      hi -= 360.0;
+    }
+    hints->content_yaw_min_deg = lo;
+    hints->content_yaw_max_deg = hi;
+  }
+  hints->content_pitch_max_deg = 90.0 - 180.0 * top / H;
+  hints->content_pitch_min_deg = 90.0 - 180.0 * (bottom + 1) / H;
+  return true;
+}
+
+ViewHints ComputeViewHints(const TwoLayerPanorama& pano, const Image8& fov_mask,
+                           const std::vector<CoverageView>& views, const PanoramaFrame& frame,
+                           bool metric, const ViewVolumeOptions& options) {
+  const std::string why = options.Check();
+  if (!why.empty()) throw std::invalid_argument("view volume options: " + why);
+  if (fov_mask.width() != pano.width() || fov_mask.height() != pano.height())
+    throw std::invalid_argument("view volume: the field-of-view mask is not the panorama's size");
+  ViewHints hints;
+  hints.metric = metric;
+  ContentExtent(fov_mask, &hints);
+
+  // Frame rotation and centre.
+  Eigen::Matrix3d R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = frame.rotation[3 * r + c];
+  const Eigen::Vector3d centre(frame.centre[0], frame.centre[1], frame.centre[2]);
+
+  // Mean optical axis, median short-side field of view, camera spread.
+  Eigen::Vector3d axis_sum = Eigen::Vector3d::Zero();
+  std::vector<double> fovs;
+  double spread = 0.0;
+  for (const CoverageView& v : views) {
+    const Eigen::Matrix3d Rwc = v.pose.R();  // World to camera.
+    axis_sum += R * Rwc.row(2).transpose();
+    const double short_fov = std::min(v.camera.FovXDeg(), v.camera.FovYDeg());
+    if (std::isfinite(short_fov) && short_fov > 0) fovs.push_back(short_fov);
+    spread = std::max(spread, (R * (v.pose.Center() - centre)).norm());
+  }
+  double yaw = 0.5 * (hints.content_yaw_min_deg + hints.content_yaw_max_deg);
+  double pitch = 0.5 * (hints.content_pitch_min_deg + hints.content_pitch_max_deg);
+  if (axis_sum.norm() > 1e-9) {
+    double lon, lat;
+    DirectionToLonLat({axis_sum.x(), axis_sum.y(), axis_sum.z()}, &lon, &lat);
+    yaw = lon * kDeg;
+    pitch = lat * kDeg;
+  }
+  double fov = 60.0;
+  if (!fovs.empty()) {
+    std::nth_element(fovs.begin(), fovs.begin() + fovs.size() / 2, fovs.end());
+    fov = fovs[fovs.size() / 2];
+  }
+  // Narrow the opening view to the content: vertically within its
+  // latitudes, horizontally (at the frame's aspect) within its longitudes.
+  const double yaw_span = hints.content_yaw_max_deg - hints.content_yaw_min_deg;
+  const double pitch_span = hints.content_pitch_max_deg - hints.content_pitch_min_deg;
+  fov = std::min(fov, 0.95 * pitch_span);
+  if (yaw_span < 360.0) fov = std::min(fov, VerticalFromHorizontal(0.95 * yaw_span, options.frame_aspect));
+  fov = std::clamp(fov, 10.0, 120.0);
+  // Keep the view's edges inside the content where it is wide enough.
+  const double half_v = 0.5 * fov;
+  const double half_h = 0.5 * 2.0 * std::atan(std::tan(half_v / kDeg) * options.frame_aspect) * kDeg;
+  if (pitch_span > fov)
+    pitch = std::clamp(pitch, hints.content_pitch_min_deg + half_v, hints.content_pitch_max_deg - half_v);
+  else
+    pitch = 0.5 * (hints.content_pitch_min_deg + hints.content_pitch_max_deg);
+  if (yaw_span < 360.0) {
+    if (yaw_span > 2.0 * half_h)
+      yaw = IntoInterval(yaw, hints.content_yaw_min_deg + half_h, hints.content_yaw_max_deg - half_h);
+    else
+      yaw = 0.5 * (hints.content_yaw_min_deg + hints.content_yaw_max_deg);
+  }
+  hints.yaw_deg = WrapDeg(yaw);
+  hints.pitch_deg = std::clamp(pitch, -90.0, 90.0);
+  hints.fov_deg = fov;
+
+  // Near depth: a low percentile of the front depths inside the field of view.
+  const LayerData& front = pano.layer(kFront);
+  std::vector<float> depths;
+  const size_t n = static_cast<size_t>(pano.width()) * pano.height();
+  const uint8_t* mask = &fov_mask.at(0, 0);
+  for (size_t i = 0; i < n; ++i)
+    if (front.present[i] && mask[i]) depths.push_back(front.depth_m[i]);
+  if (depths.empty())
+    for (size_t i = 0; i < n; ++i)
+      if (front.present[i]) depths.push_back(front.depth_m[i]);
+  double near = 1.0;
+  if (!depths.empty()) {
+    const size_t k = static_cast<size_t>(options.near_percentile * (depths.size() - 1));
+    std::nth_element(depths.begin(), depths.begin() + k, depths.end());
+    near = depths[k];
+  }
+  hints.volume_radius = std::clamp(spread, options.min_radius_over_near * near,
+                                   options.max_radius_over_near * near);
+  return hints;
+}
+
+}  // namespace casual3d::pipeline

@@ -1,0 +1,59 @@
+#pragma once
+
+// The view hints of a 3D photo (format/view_hints.h) from its capture: where
+// the viewer opens, the captured content's angular extent, and the viewing
+// volume the capture supports (spec/package.md Sec. 3.1; spec/stage-panorama.md,
+// "View hints").
+//
+//   direction  the mean of the photos' optical axes in the panorama frame,
+//              moved inside the content's extent.
+//   fov        the photos' median short-side field of view, narrowed so that
+//              a 16:9 view at that direction stays inside the content.
+//   content    the longitudes and latitudes of the field-of-view mask's
+//              pixels; the longitudes are the circle minus its largest run of
+//              empty columns (so content across +-180 degrees stays one
+//              interval).
+//   volume     a ball around the centre whose radius is the largest distance
+//              of a camera centre from it, kept within
+//              [min_radius_over_near, max_radius_over_near] times the near
+//              depth (a low percentile of the front depths in the field of
+//              view): beyond about a tenth of the nearest depth the back
+//              layer's disocclusion fill (expansion_fraction) runs out.
+
+#include <vector>
+
+#include "format/image.h"
+#include "format/two_layer.h"
+#include "format/view_hints.h"
+#include "reconstruct/pipeline/coverage.h"
+
+namespace casual3d::pipeline {
+
+struct ViewVolumeOptions {
+  // Percentile of the front depths inside the field of view taken as the
+  // near depth; [0, 0.5].
+  double near_percentile = 0.05;
+  // Bounds of the volume's radius, as fractions of the near depth;
+  // 0 < min <= max <= 1.
+  double min_radius_over_near = 0.02;
+  double max_radius_over_near = 0.1;
+  // Aspect ratio (width / height) of the view the opening field of view must
+  // fit; [0.25, 4].
+  double frame_aspect = 16.0 / 9.0;
+
+  std::string Check() const;  // Empty if valid, else "field: reason".
+};
+
+// Content extent of a field-of-view mask (width x height x 1, non-zero
+// inside): sets the content_* members of `hints`; false, leaving them, when
+// the mask is empty.
+bool ContentExtent(const Image8& fov_mask, ViewHints* hints);
+
+// The hints for panorama `pano` whose photos are `views` (world poses) in
+// `frame`; `fov_mask` is the photos' field of view (coverage.h) at the
+// panorama's size. `metric`: whether the frame's unit is the metre.
+ViewHints ComputeViewHints(const TwoLayerPanorama& pano, const Image8& fov_mask,
+                           const std::vector<CoverageView>& views, const PanoramaFrame& frame,
+                           bool metric, const ViewVolumeOptions& options = ViewVolumeOptions());
+
+}  // namespace casual3d::pipeline
