@@ -37,7 +37,6 @@ Grid Morph(const Grid& in, int w, int h, int r, bool dilate) {
   return out;
 }
 
-
 // Median front depth of each cell (0 where it has no front node).
 std::vector<float> CellDepths(const TwoLayerPanorama& pano, int cell, int gw, int gh) {
   std::vector<float> out(size_t(gw) * gh, 0.0f), values;

@@ -19,9 +19,9 @@ struct EyeOffset {
 
 // The 16 boundary eyes of the header, in order.
 const EyeOffset kBoundary[kNumViews - 1] = {
-    {"level", 0, 0},    {"level", 0, 45},   {"level", 0, 90},   {"level", 0, 135},
-    {"level", 0, 180},  {"level", 0, 225},  {"level", 0, 270},  {"level", 0, 315},
-    {"above", 45, 45},  {"above", 45, 135}, {"above", 45, 225}, {"above", 45, 315},
+    {"level", 0, 0},    {"level", 0, 45},    {"level", 0, 90},    {"level", 0, 135},
+    {"level", 0, 180},  {"level", 0, 225},   {"level", 0, 270},   {"level", 0, 315},
+    {"above", 45, 45},  {"above", 45, 135},  {"above", 45, 225},  {"above", 45, 315},
     {"below", -45, 45}, {"below", -45, 135}, {"below", -45, 225}, {"below", -45, 315}};
 
 double Radians(double deg) { return deg * kPi / 180.0; }
@@ -49,7 +49,8 @@ double TriangleScreenSize(const Mesh& mesh, size_t t, const Eigen::Vector3d& eye
 }  // namespace
 
 std::string ViewerViewsOptions::Check() const {
-  if (width < 16 || width > 4096) return "width: " + std::to_string(width) + " is outside [16, 4096]";
+  if (width < 16 || width > 4096)
+    return "width: " + std::to_string(width) + " is outside [16, 4096]";
   if (height < 16 || height > 4096)
     return "height: " + std::to_string(height) + " is outside [16, 4096]";
   if (!(stretch_factor >= 1 && stretch_factor <= 1000))
@@ -69,7 +70,8 @@ std::vector<render::GlCamera> ViewerCameras(const ViewHints& hints) {
   std::vector<render::GlCamera> cameras(kNumViews, base);
   for (int k = 1; k < kNumViews; ++k) {
     const EyeOffset& e = kBoundary[k - 1];
-    const Vec3d d = LonLatToDirection(Radians(hints.yaw_deg + e.azimuth_deg), Radians(e.latitude_deg));
+    const Vec3d d =
+        LonLatToDirection(Radians(hints.yaw_deg + e.azimuth_deg), Radians(e.latitude_deg));
     cameras[k].position[0] = hints.volume_radius * d.x;
     cameras[k].position[1] = hints.volume_radius * d.y;
     cameras[k].position[2] = hints.volume_radius * d.z;
@@ -90,8 +92,9 @@ ViewerViewResult MeasureViewerView(const Mesh& mesh, const render::GlCamera& cam
   const int w = r.mask.width(), h = r.mask.height();
   if (r.triangle_ids.width() != w || r.triangle_ids.height() != h || field.width() != w ||
       field.height() != h)
-    throw std::invalid_argument("viewer view: the rendering needs triangle ids and a field mask of " +
-                                std::to_string(w) + "x" + std::to_string(h) + " pixels");
+    throw std::invalid_argument(
+        "viewer view: the rendering needs triangle ids and a field mask of " + std::to_string(w) +
+        "x" + std::to_string(h) + " pixels");
   ViewerViewResult out;
   out.camera = camera;
   const render::PinholeView view = render::ViewFromGlCamera(camera, w, h);
@@ -147,7 +150,7 @@ ViewerViewsEvaluation EvaluateViewerViews(const TwoLayerPanorama& pano, const Me
     throw std::invalid_argument("viewer views: " + why);
   ViewerViewsEvaluation eval;
   eval.hints = render::ResolveViewHints(pano, options.derive_hints ? std::nullopt : hints,
-                                       &eval.hints_derived);
+                                        &eval.hints_derived);
   eval.width = options.width;
   eval.height = options.height;
   eval.stretch_factor = options.stretch_factor;
@@ -170,9 +173,8 @@ ViewerViewsEvaluation EvaluateViewerViews(const TwoLayerPanorama& pano, const Me
     const render::PinholeView view =
         render::ViewFromGlCamera(cameras[k], options.width, options.height);
     render::RenderResult r = render::RenderMesh(mesh, atlas, view, render_options);
-    ViewerViewResult v =
-        MeasureViewerView(mesh, cameras[k], r, field.Mask(view, render_options),
-                          options.stretch_factor);
+    ViewerViewResult v = MeasureViewerView(mesh, cameras[k], r, field.Mask(view, render_options),
+                                           options.stretch_factor);
     v.name = names[k];
     if (options.keep_images) {
       v.render = std::move(r.color);

@@ -110,44 +110,43 @@ std::string ViewerViewsSummary(const ViewerViewsEvaluation& e) {
 
 std::string ViewerViewsJson(const ViewerViewsEvaluation& e) {
   const ViewHints& h = e.hints;
-  nlohmann::json j = {
-      {"width", e.width},
-      {"height", e.height},
-      {"stretch_factor", e.stretch_factor},
-      {"hints_derived", e.hints_derived},
-      {"hints",
-       {{"yaw_deg", h.yaw_deg},
-        {"pitch_deg", h.pitch_deg},
-        {"fov_deg", h.fov_deg},
-        {"content_yaw_deg", {h.content_yaw_min_deg, h.content_yaw_max_deg}},
-        {"content_pitch_deg", {h.content_pitch_min_deg, h.content_pitch_max_deg}},
-        {"volume_radius", h.volume_radius},
-        {"metric", h.metric}}},
-      {"centre_tears", e.centre_tears},
-      {"boundary_tears_mean", e.boundary_tears_mean},
-      {"boundary_tears_max", e.boundary_tears_max},
-      {"centre_stretched", e.centre_stretched},
-      {"boundary_stretched_mean", e.boundary_stretched_mean},
-      {"boundary_stretched_max", e.boundary_stretched_max},
-      {"views", nlohmann::json::array()}};
+  nlohmann::json j = {{"width", e.width},
+                      {"height", e.height},
+                      {"stretch_factor", e.stretch_factor},
+                      {"hints_derived", e.hints_derived},
+                      {"hints",
+                       {{"yaw_deg", h.yaw_deg},
+                        {"pitch_deg", h.pitch_deg},
+                        {"fov_deg", h.fov_deg},
+                        {"content_yaw_deg", {h.content_yaw_min_deg, h.content_yaw_max_deg}},
+                        {"content_pitch_deg", {h.content_pitch_min_deg, h.content_pitch_max_deg}},
+                        {"volume_radius", h.volume_radius},
+                        {"metric", h.metric}}},
+                      {"centre_tears", e.centre_tears},
+                      {"boundary_tears_mean", e.boundary_tears_mean},
+                      {"boundary_tears_max", e.boundary_tears_max},
+                      {"centre_stretched", e.centre_stretched},
+                      {"boundary_stretched_mean", e.boundary_stretched_mean},
+                      {"boundary_stretched_max", e.boundary_stretched_max},
+                      {"views", nlohmann::json::array()}};
   for (const ViewerViewResult& v : e.views)
-    j["views"].push_back({{"name", v.name},
-                          {"position", {v.camera.position[0], v.camera.position[1],
-                                        v.camera.position[2]}},
-                          {"captured_pixels", v.captured_pixels},
-                          {"tear_pixels", v.tear_pixels},
-                          {"stretched_pixels", v.stretched_pixels},
-                          {"tear_fraction", v.tear_fraction},
-                          {"stretched_fraction", v.stretched_fraction},
-                          {"median_triangle_px", v.median_triangle_px}});
+    j["views"].push_back(
+        {{"name", v.name},
+         {"position", {v.camera.position[0], v.camera.position[1], v.camera.position[2]}},
+         {"captured_pixels", v.captured_pixels},
+         {"tear_pixels", v.tear_pixels},
+         {"stretched_pixels", v.stretched_pixels},
+         {"tear_fraction", v.tear_fraction},
+         {"stretched_fraction", v.stretched_fraction},
+         {"median_triangle_px", v.median_triangle_px}});
   return j.dump();
 }
 
 std::string ViewerViewsHtml(const ViewerViewsEvaluation& e, int thumbnail_width) {
   const ViewHints& h = e.hints;
   std::ostringstream s;
-  s << "<h3>What a viewer sees</h3>\n<p>The mesh rendered at " << e.width << "&times;"
-    << e.height << " from 17 eyes: the centre and 16 on the viewing volume's surface (radius "
+  s << "<h3>What a viewer sees</h3>\n<p>The mesh rendered at " << e.width << "&times;" << e.height
+    << " from 17 eyes: the centre and 16 on the viewing volume's surface (radius "
     << Fmt("%.4g", h.volume_radius) << (h.metric ? " m" : " depth units")
     << "; 8 level, 4 at 45&deg; above, 4 at 45&deg; below), all looking at yaw "
     << Fmt("%.1f", h.yaw_deg) << "&deg;, pitch " << Fmt("%.1f", h.pitch_deg)

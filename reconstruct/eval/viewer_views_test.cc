@@ -173,9 +173,9 @@ TEST(ViewerViewsTest, HoleInsideTheContentTearsTheCentreView) {
   double expected = 0, half = 0;
   for (int j = 0; j < 200; ++j)
     for (int i = 0; i < 320; ++i) {
-      const Eigen::Vector3d d = view.rotation.transpose() *
-                                Eigen::Vector3d((i + 0.5 - view.cx) / view.fx,
-                                                (j + 0.5 - view.cy) / view.fy, 1.0);
+      const Eigen::Vector3d d =
+          view.rotation.transpose() *
+          Eigen::Vector3d((i + 0.5 - view.cx) / view.fx, (j + 0.5 - view.cy) / view.fy, 1.0);
       double u, v;
       DirectionToEquirectPixel({d.x(), d.y(), d.z()}, w, h, &u, &v);
       const int qx = int(std::floor(u - 0.5)), qy = int(std::floor(v - 0.5));
@@ -206,7 +206,8 @@ TEST(ViewerViewsTest, BlackBeyondTheCapturedContentIsNotATear) {
   const MeshAndAtlas m = Build(pano);
   ViewHints h = render::DeriveViewHints(pano);
   h.yaw_deg = -140;  // Looking at the content's edge: half the view is empty.
-  const ViewerViewsEvaluation e = EvaluateViewerViews(pano, m.mesh, m.atlas.view(), h, SmallViews());
+  const ViewerViewsEvaluation e =
+      EvaluateViewerViews(pano, m.mesh, m.atlas.view(), h, SmallViews());
   const ViewerViewResult& centre = e.views[0];
   EXPECT_GT(centre.captured_pixels, 0.3 * 320 * 200);
   EXPECT_LT(centre.captured_pixels, 0.6 * 320 * 200);

@@ -47,9 +47,8 @@ ViewHints DeriveViewHints(const TwoLayerPanorama& pano) {
     hints.volume_radius = kDerivedVolumeFraction * low_depth;
   } else {
     double near_m = 0, far_m = 0;
-    hints.volume_radius = pano.NodeDepthRange(&near_m, &far_m) && near_m > 0
-                              ? kDerivedVolumeFraction * near_m
-                              : 0.1;
+    hints.volume_radius =
+        pano.NodeDepthRange(&near_m, &far_m) && near_m > 0 ? kDerivedVolumeFraction * near_m : 0.1;
   }
   if (content_columns == 0) return hints;
 
