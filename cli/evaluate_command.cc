@@ -72,8 +72,7 @@ void AddEvaluateCommand(CLI::App& app) {
   cmd->add_flag("--no-viewer-views", args->no_viewer_views,
                 "Skip the viewer-side measure (tears and stretched fill seen from 17 eyes over "
                 "the viewing volume)");
-  cmd->add_option("--viewer-width", args->options.viewer.width,
-                  "Width of the viewer views, pixels")
+  cmd->add_option("--viewer-width", args->options.viewer.width, "Width of the viewer views, pixels")
       ->capture_default_str();
   cmd->add_option("--viewer-height", args->options.viewer.height,
                   "Height of the viewer views, pixels")
