@@ -193,10 +193,11 @@ struct CornerRecorder {
 
 }  // namespace
 
-unsigned QuadCoverage(const TwoLayerPanorama& pano, int x, int y, bool use_back) {
+unsigned QuadCoverage(const TwoLayerPanorama& pano, int x, int y, bool use_back,
+                      unsigned skip_layers) {
   const int xb = x + 1 == pano.width() ? 0 : x + 1;
   CornerRecorder r{{pano.index(x, y), pano.index(xb, y), pano.index(x, y + 1), pano.index(xb, y + 1)}};
-  QuadTriangles(pano, x, y, use_back, 0u, &r);
+  QuadTriangles(pano, x, y, use_back, skip_layers, &r);
   // Corner A's triangle covers the top and left quarters, B's top and right,
   // C's left and bottom, D's right and bottom.
   const bool a = r.corners & 1u, b = r.corners & 2u, c = r.corners & 4u, d = r.corners & 8u;

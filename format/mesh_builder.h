@@ -130,9 +130,11 @@ int CountQuadTriangles(const TwoLayerPanorama& pano, int x, int y, bool use_back
 // diagonals cut the quad into four quarters, returned as bits: kQuarterTop
 // (towards A-B), kQuarterLeft (A-C), kQuarterRight (B-D), kQuarterBottom (C-D).
 // 0xF: the quad is closed; anything less is a tear seen from the centre.
-// Precondition as AddQuadTriangles.
+// `skip_layers` as for AddQuadTriangles (1u << kFront: only the triangles
+// whose corner node is a back node). Precondition as AddQuadTriangles.
 constexpr unsigned kQuarterTop = 1, kQuarterLeft = 2, kQuarterRight = 4, kQuarterBottom = 8;
-unsigned QuadCoverage(const TwoLayerPanorama& pano, int x, int y, bool use_back = true);
+unsigned QuadCoverage(const TwoLayerPanorama& pano, int x, int y, bool use_back = true,
+                      unsigned skip_layers = 0);
 
 // sin and cos of `angle_rad` in [-4 pi, 4 pi] computed with + and * only, so
 // that native and wasm builds agree bit for bit. Absolute error below 1e-15.

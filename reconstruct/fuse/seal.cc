@@ -34,7 +34,21 @@ class Sealer {
     return f.present[p_.index(x, y)] && f.present[p_.index(xb, y)] && f.present[p_.index(x, y + 1)] &&
            f.present[p_.index(xb, y + 1)];
   }
+  bool AllBack(int x, int y) const {
+    const int xb = x + 1 == p_.width() ? 0 : x + 1;
+    const LayerData& b = p_.layer(kBack);
+    return b.present[p_.index(x, y)] && b.present[p_.index(xb, y)] && b.present[p_.index(x, y + 1)] &&
+           b.present[p_.index(xb, y + 1)];
+  }
   bool Open(int x, int y) const { return AllFront(x, y) && QuadCoverage(p_, x, y) != 0xFu; }
+  // A quad whose four corners have back nodes that the back layer's own
+  // triangles leave open: a tear in a disocclusion, seen from off-centre.
+  bool BackOpen(int x, int y) const {
+    return AllBack(x, y) && QuadCoverage(p_, x, y, true, 1u << kFront) != 0xFu;
+  }
+  // Whether closed back quads count in the score (the back-layer round);
+  // closed front quarters always weigh more.
+  void set_score_back(bool on) { score_back_ = on; }
 
   // Tries the edits of quad (x, y); true if some were kept. `behind`: also
   // links across any depth step between two nodes that both lie clearly
@@ -282,8 +296,11 @@ class Sealer {
   int QuadScore(int qx, int qy) const {
     if (qy < 0 || qy > p_.height() - 2) return 0;
     qx = WrapColumn(qx, p_.width());
-    if (!AllFront(qx, qy)) return 0;
-    return __builtin_popcount(QuadCoverage(p_, qx, qy));
+    int s = 0;
+    if (AllFront(qx, qy)) s += 4 * __builtin_popcount(QuadCoverage(p_, qx, qy));
+    if (score_back_ && AllBack(qx, qy))
+      s += __builtin_popcount(QuadCoverage(p_, qx, qy, true, 1u << kFront));
+    return s;
   }
   // Closed quarters of the quads within two of quad (x, y): every quad
   // that touches a pixel an edit of (x, y) can change.
@@ -297,6 +314,7 @@ class Sealer {
   TwoLayerPanorama& p_;
   float min_ratio_, tau_;
   std::vector<SavedPixel> log_;
+  bool score_back_ = false;
 };
 
 }  // namespace
@@ -351,6 +369,28 @@ SealStats SealTears(TwoLayerPanorama* pano, const SealOptions& options) {
     }
   }
   stats.open_quads_after = CountOpenQuads(*pano);
+
+  // Then tears of the back layer (noisy depth behind an edge), within one
+  // surface, without opening anything seen from the centre.
+  sealer.set_score_back(true);
+  open.clear();
+  for (int y = 0; y + 1 < H; ++y)
+    for (int x = 0; x < W; ++x)
+      if (sealer.BackOpen(x, y)) open.push_back(y * W + x);
+  stats.back_open_quads_before = static_cast<int64_t>(open.size());
+  for (int pass = 0; pass < options.max_passes && !open.empty(); ++pass) {
+    bool changed = false;
+    std::vector<int> still;
+    for (int q : open) {
+      const int x = q % W, y = q / W;
+      if (!sealer.BackOpen(x, y)) continue;
+      if (sealer.SealQuad(x, y, false, &stats)) changed = true;
+      if (sealer.BackOpen(x, y)) still.push_back(q);
+    }
+    open.swap(still);
+    if (!changed) break;
+  }
+  stats.back_open_quads_after = static_cast<int64_t>(open.size());
   return stats;
 }
 

@@ -22,6 +22,10 @@
 // if both lie clearly behind the quad's nearest front node (depth above
 // nearest / tau_dratio): a thin sheet hidden behind the foreground from the
 // centre, instead of a hole seen from everywhere.
+// A last round does the same for the back layer: quads whose four corners
+// have back nodes that its own triangles leave open (noisy depth behind an
+// edge) get links within one surface, scored so that nothing seen from the
+// centre opens.
 // An edit is kept when it closes more quarters of the quads around the
 // changed pixels than it opens; the best edit of each quad is kept, links of
 // nearly equal depth and back-layer extensions preferred to links across
@@ -50,6 +54,9 @@ struct SealOptions {
 struct SealStats {
   int64_t open_quads_before = 0;  // Quads with four front corners, not closed.
   int64_t open_quads_after = 0;
+  // Quads with four back corners that the back layer leaves open.
+  int64_t back_open_quads_before = 0;
+  int64_t back_open_quads_after = 0;
   int64_t links_made = 0;
   int64_t back_nodes_added = 0;
 };

@@ -319,7 +319,9 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
                   std::to_string(report.seal.open_quads_before - report.seal.open_quads_after) +
                   " of " + std::to_string(report.seal.open_quads_before) + " open quads (" +
                   std::to_string(report.seal.links_made) + " links, " +
-                  std::to_string(report.seal.back_nodes_added) + " back nodes)");
+                  std::to_string(report.seal.back_nodes_added) + " back nodes); back layer: " +
+                  std::to_string(report.seal.back_open_quads_before) + " -> " +
+                  std::to_string(report.seal.back_open_quads_after) + " open quads");
   }
   report.seconds_fuse = Seconds(t);
   t = Clock::now();
@@ -333,7 +335,13 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   report.front_footprint = MeasureHoles(pano, kFront, footprint);
   // Synthetic captures (capture.json) are in metres; COLMAP's models are not.
   const bool metric = fs::exists(fs::path(sparse_dir) / "capture.json");
-  pano.view_hints() = ComputeViewHints(pano, fov, coverage_views, frame, metric, options.view);
+  // The eye stays where the back layer's growth fills the disocclusions it
+  // opens (0.8 of the angle the growth's rings span).
+  ViewVolumeOptions view_options = options.view;
+  view_options.max_radius_over_near =
+      std::max(view_options.min_radius_over_near,
+               std::min(view_options.max_radius_over_near, 0.8 * 2.0 * kPi * fuse_options.expansion_fraction));
+  pano.view_hints() = ComputeViewHints(pano, fov, coverage_views, frame, metric, view_options);
   const ViewHints& hints = *pano.view_hints();
   util::LogInfo("panorama: opens at yaw " + std::to_string(hints.yaw_deg) + ", pitch " +
                 std::to_string(hints.pitch_deg) + ", field of view " + std::to_string(hints.fov_deg) +
@@ -392,6 +400,8 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   j["seal"] = {{"enabled", options.seal_tears},
                {"open_quads_before", report.seal.open_quads_before},
                {"open_quads_after", report.seal.open_quads_after},
+               {"back_open_quads_before", report.seal.back_open_quads_before},
+               {"back_open_quads_after", report.seal.back_open_quads_after},
                {"links_made", report.seal.links_made},
                {"back_nodes_added", report.seal.back_nodes_added}};
   j["normals"] = {{"nodes", report.normals.nodes}, {"sky_nodes", report.normals.sky_nodes}};

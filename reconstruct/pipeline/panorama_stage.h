@@ -38,7 +38,7 @@ struct PanoramaStageOptions {
   // max_auto_width. The paper uses 8192.
   int pano_width = 0;
   // Largest automatic width: a multiple of 1024 in [2048, 16384].
-  int max_auto_width = 8192;
+  int max_auto_width = 4096;
   warp::WarpOptions warp;        // pano_width/height are set from pano_width.
   stitch::StitchOptions stitch;
   fuse::FuseOptions fuse;

@@ -17,8 +17,10 @@
 //              of a camera centre from it, kept within
 //              [min_radius_over_near, max_radius_over_near] times the near
 //              depth (a low percentile of the front depths in the field of
-//              view): beyond about a tenth of the nearest depth the back
-//              layer's disocclusion fill (expansion_fraction) runs out.
+//              view): a head moved by r opens a gap of up to r / near
+//              radians beside a near object, which the back layer's growth
+//              (fuse expansion_fraction) must fill; the panorama stage
+//              lowers the bound to what that growth covers.
 
 #include <vector>
 
@@ -36,7 +38,7 @@ struct ViewVolumeOptions {
   // Bounds of the volume's radius, as fractions of the near depth;
   // 0 < min <= max <= 1.
   double min_radius_over_near = 0.02;
-  double max_radius_over_near = 0.1;
+  double max_radius_over_near = 0.06;
   // Aspect ratio (width / height) of the view the opening field of view must
   // fit; [0.25, 4].
   double frame_aspect = 16.0 / 9.0;

@@ -84,12 +84,12 @@ TEST(ComputeViewHints, DirectionFieldOfViewAndVolume) {
   EXPECT_NEAR(h.yaw_deg, 10.0, 0.5);  // Mean of the axes' directions.
   EXPECT_NEAR(h.pitch_deg, 0.0, 1e-9);
   EXPECT_NEAR(h.fov_deg, 2 * std::atan(240.0 / 400.0) * 180 / kPi, 1e-6);
-  // Cameras 0.05 from the centre; the near depth is 2: radius within [0.04, 0.2].
+  // Cameras 0.05 from the centre; the near depth is 2: radius within [0.04, 0.12].
   EXPECT_NEAR(h.volume_radius, 0.05, 1e-9);
 
-  // Cameras far apart: the radius is capped at a tenth of the near depth.
+  // Cameras far apart: the radius is capped at 0.06 of the near depth.
   views = {CameraAt(-1.0, 0), CameraAt(1.0, 0)};
-  EXPECT_NEAR(ComputeViewHints(pano, fov, views, PanoramaFrame(), false).volume_radius, 0.2, 1e-6);
+  EXPECT_NEAR(ComputeViewHints(pano, fov, views, PanoramaFrame(), false).volume_radius, 0.12, 1e-6);
   // Cameras at one point (a pure rotation): the smallest radius.
   views = {CameraAt(0, -10), CameraAt(0, 10)};
   EXPECT_NEAR(ComputeViewHints(pano, fov, views, PanoramaFrame(), false).volume_radius, 0.04, 1e-6);
