@@ -48,7 +48,7 @@ export function wrapDeg(a) {
  * Checks the manifest's "view" member (spec/package.md 1.1). Returns
  * {hints, warning}: hints null when the member is absent (warning null) or
  * malformed or out of range (warning names the field and the range). Never
- * throws. Unknown members are ignored; `metric` may be omitted (false).
+ * throws. Every member of the table is required; unknown members are ignored.
  */
 export function parseViewHints(view) {
   if (view === undefined) return { hints: null, warning: null };
@@ -85,10 +85,8 @@ export function parseViewHints(view) {
     nearDepth: 0,
     source: 'package',
   };
-  if (view.metric !== undefined) {
-    if (typeof view.metric !== 'boolean') problems.push('metric is not a boolean');
-    else hints.metric = view.metric;
-  }
+  if (typeof view.metric !== 'boolean') problems.push('metric is not a boolean');
+  else hints.metric = view.metric;
   if (problems.length > 0) return refuse(problems.join('; '));
   return { hints, warning: null };
 }

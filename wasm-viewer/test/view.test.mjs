@@ -69,13 +69,18 @@ const viewer = (fn, arg) => page.evaluate(([f, a]) => {
   return new Function('v', 'a', `return (${f})(v, a);`)(v, a);
 }, [fn.toString(), arg]);
 
-/** Waits until the camera has stopped moving (the ease back has settled). */
+/**
+ * Waits until the camera has stopped moving: past the 200 ms after the last
+ * input before the ease back starts (viewer-core.js), then three frames still
+ * (the ease moves the view once per frame).
+ */
 async function settle() {
-  let last = null;
-  for (let i = 0; i < 60; ++i) {
-    await page.waitForTimeout(100);
-    const c = await viewer((v) => v.getCamera());
-    if (last && ['yawDeg', 'pitchDeg', 'fovDeg'].every((k) => Math.abs(c[k] - last[k]) < 1e-6)) return c;
+  await page.waitForTimeout(300);
+  let last = null, still = 0;
+  for (let i = 0; i < 200; ++i) {
+    const c = await viewer(async (v) => { await v.nextFrame(); return v.getCamera(); });
+    still = last && ['yawDeg', 'pitchDeg', 'fovDeg'].every((k) => Math.abs(c[k] - last[k]) < 1e-6) ? still + 1 : 0;
+    if (still >= 3) return c;
     last = c;
   }
   throw new Error('the view did not settle');

@@ -29,8 +29,6 @@ test('parseViewHints accepts the spec example and maps it to camelCase', () => {
     volumeRadius: 0.12, metric: false, nearDepth: 0, source: 'package',
   });
   assert.equal(parseViewHints({ ...VIEW, metric: true }).hints.metric, true);
-  const { metric, ...noMetric } = VIEW;
-  assert.equal(parseViewHints(noMetric).hints.metric, false, 'metric may be omitted');
   assert.deepEqual(parseViewHints({ ...VIEW, content_yaw_deg: [-360, 0] }).hints.contentYawDeg, [-360, 0]);
 });
 
@@ -58,6 +56,7 @@ test('parseViewHints ignores malformed or out-of-range members with a warning na
     [{ ...VIEW, volume_radius: -1 }, /volume_radius/],
     [{ ...VIEW, volume_radius: Infinity }, /volume_radius is not a finite number/],
     [{ ...VIEW, metric: 'yes' }, /metric is not a boolean/],
+    [{ ...VIEW, metric: undefined }, /metric is not a boolean/],
     [{ pitch_deg: 0 }, /yaw_deg is not a finite number.*fov_deg/],
   ];
   for (const [view, pattern] of cases) {
