@@ -46,6 +46,10 @@ void AddPanoramaCommand(CLI::App& app) {
       ->each([args](const std::string&) { args->options.fill_front_gaps = false; });
   cmd->add_flag("--front-only", "Front layer only (no back layer)")
       ->each([args](const std::string&) { args->options.back_layer = false; });
+  cmd->add_option("--min-edge-depth-ratio", args->options.warp.min_edge_depth_ratio,
+                  "Photo triangles whose depths differ by more (ratio min/max below this) are "
+                  "not warped: no rubber sheets across depth edges; 0 warps all")
+      ->capture_default_str();
   cmd->add_flag("--no-seal", "Leave the quads fusion leaves open (tears seen from the centre)")
       ->each([args](const std::string&) { args->options.seal_tears = false; });
   cmd->add_flag("--no-gc", "Stitch without the geometric-consistency cost")

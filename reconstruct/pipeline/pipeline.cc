@@ -90,7 +90,7 @@ std::string PanoramaOptionsText(const PanoramaStageOptions& o) {
     << " tau_stretch=" << o.warp.tau_stretch_deg
     << " lambda_gc=" << o.stitch.lambda_gc << " tau_dratio=" << o.fuse.tau_dratio
     << " expansion=" << o.fuse.expansion_fraction << " sky_depth=" << o.sky_depth_m
-    << " seal=" << o.seal_tears << " seal_min_link_ratio=" << o.seal.min_link_ratio
+    << " min_edge_depth_ratio=" << o.warp.min_edge_depth_ratio << " seal=" << o.seal_tears << " seal_min_link_ratio=" << o.seal.min_link_ratio
     << " view_hints=1 near_percentile=" << o.view.near_percentile
     << " radius_over_near=" << o.view.min_radius_over_near << "," << o.view.max_radius_over_near;
   return s.str();

@@ -164,6 +164,9 @@ std::string WarpOptions::Check() const {
   if (!(max_triangle_width_fraction > 0 && max_triangle_width_fraction <= 0.5)) {
     return "max_triangle_width_fraction: must be in (0, 0.5]";
   }
+  if (!(min_edge_depth_ratio >= 0 && min_edge_depth_ratio < 1)) {
+    return "min_edge_depth_ratio: must be in [0, 1)";
+  }
   return "";
 }
 
@@ -268,12 +271,17 @@ WarpedView WarpView(const SourceView& view, const PanoramaFrame& frame,
   LayerRasterizer raster(W, H, x0, y0, crop_w, std::max(1, y1 - y0), rgb, options.near_m);
   const double tau_rad = options.tau_stretch_deg * kDegToRad;
   const double max_span = options.max_triangle_width_fraction * W;
+  const double min_ratio = options.min_edge_depth_ratio;
   auto emit = [&](const GridVertex& a, const GridVertex& b, const GridVertex& c) {
     if (!a.valid || !b.valid || !c.valid) return;
     const double ua = a.u;
     const double ub = ua + WrapSigned(b.u - ua, W);
     const double uc = ua + WrapSigned(c.u - ua, W);
     if (std::max({ua, ub, uc}) - std::min({ua, ub, uc}) > max_span) return;
+    if (min_ratio > 0) {
+      const double da = a.cam.norm(), db = b.cam.norm(), dc = c.cam.norm();
+      if (std::min({da, db, dc}) < min_ratio * std::max({da, db, dc})) return;
+    }
     // Eq. 6: grazing angle between the triangle and the ray from the photo's camera.
     const Eigen::Vector3d n = (b.cam - a.cam).cross(c.cam - a.cam);
     const Eigen::Vector3d ray = a.cam + b.cam + c.cam;

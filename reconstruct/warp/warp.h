@@ -39,6 +39,14 @@ struct WarpOptions {
   // Triangles whose projection spans more than this fraction of the panorama
   // width are dropped (they wrap around a pole); (0, 0.5].
   double max_triangle_width_fraction = 0.125;
+  // Triangles whose vertices' depths (along the photo's rays) have a ratio
+  // min / max below this span a depth edge of the photo: they are not drawn,
+  // so that no ramp of made-up depths between the two sides (a rubber sheet)
+  // reaches the panorama; the gap is filled by other photos, the gap filling
+  // and the back layer. [0, 1); 0 draws every triangle. 0.9: on the demo
+  // capture it halves the stretched fill seen from the viewing volume's
+  // boundary against 0.75 (docs/DECISIONS.md, "Warp across depth edges").
+  double min_edge_depth_ratio = 0.9;
 
   // Returns an empty string if valid, else "field value: reason".
   std::string Check() const;

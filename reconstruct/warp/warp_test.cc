@@ -49,7 +49,17 @@ TEST(WarpTest, CentredViewReproducesRadialDepthAndColour) {
   EXPECT_FALSE(warped.front.ToCrop(0, 256, 1024, &cx, &cy) && warped.front.depth_m.at(cx, cy) > 0);
 }
 
+void CheckStretchedTriangles(double min_edge_depth_ratio);
+
 TEST(WarpTest, StretchedTrianglesLoseToBackgroundAndBackWarpSeesBehind) {
+  CheckStretchedTriangles(0.0);  // Every triangle drawn: rubber sheets reach the strip.
+}
+
+TEST(WarpTest, TrianglesAcrossDepthEdgesAreNotDrawn) {
+  CheckStretchedTriangles(WarpOptions().min_edge_depth_ratio);
+}
+
+void CheckStretchedTriangles(double min_edge_depth_ratio) {
   // Seen from a camera 0.3 m to the right of the centre, the near square's
   // left edge produces stretched triangles that, from the centre, would cover
   // background. The front warp must prefer the unstretched background there,
@@ -64,6 +74,7 @@ TEST(WarpTest, StretchedTrianglesLoseToBackgroundAndBackWarpSeesBehind) {
   WarpOptions options;
   options.pano_width = 2048;
   options.pano_height = 1024;
+  options.min_edge_depth_ratio = min_edge_depth_ratio;
   SourceView view{&rgb, &depth, cam, pose};
   const WarpedView warped = WarpView(view, PanoramaFrame(), options);
 
@@ -101,8 +112,14 @@ TEST(WarpTest, StretchedTrianglesLoseToBackgroundAndBackWarpSeesBehind) {
   EXPECT_EQ(right_covered, rows * (col(15) - col(5) + 1));
   EXPECT_EQ(right_stretched, 0);
   EXPECT_GT(right_back_behind, right_covered * 9 / 10);
-  EXPECT_GT(left_covered, rows * 10);
-  EXPECT_EQ(left_stretched, left_covered);
+  if (options.min_edge_depth_ratio == 0) {
+    EXPECT_GT(left_covered, rows * 10);
+    EXPECT_EQ(left_stretched, left_covered);
+  } else {
+    // Triangles across the square's edge (depths 1 and 4) are not drawn:
+    // nothing of the photo reaches the strip it could not see.
+    EXPECT_EQ(left_covered, 0);
+  }
 }
 
 TEST(WarpTest, SeamIsContinuous) {
