@@ -248,9 +248,10 @@ void AddExportCommand(CLI::App& app) {
                 "hold the scene's lighting)");
   cmd->add_flag("--double-sided", opts->gltf.double_sided, "Render both sides of triangles");
   cmd->add_option("--draco-position-bits", opts->gltf.draco_position_bits,
-                  "Draco position quantization bits (1..30)")
+                  "Draco position quantization bits (1..30); 0 = enough for 0.05% of the nearest "
+                  "vertex's distance over the mesh's extent")
       ->capture_default_str()
-      ->check(CLI::Range(1, 30));
+      ->check(CLI::Range(0, 30));
   cmd->add_option("--draco-normal-bits", opts->gltf.draco_normal_bits,
                   "Draco normal quantization bits (1..30)")
       ->capture_default_str()

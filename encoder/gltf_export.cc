@@ -250,7 +250,7 @@ std::vector<float> UnitNormals(const Mesh& mesh) {
 // what the glTF accessors' counts and bounds must describe.
 Status DracoCompress(const ExportMesh& in, const GltfExportOptions& options,
                      std::vector<uint8_t>* bitstream, ExportMesh* out,
-                     std::map<std::string, int>* attribute_ids) {
+                     std::map<std::string, int>* attribute_ids, int* position_bits_used) {
   const size_t n = in.positions.size() / 3;
   draco::Mesh mesh;
   mesh.set_num_points(static_cast<uint32_t>(n));
@@ -280,7 +280,10 @@ Status DracoCompress(const ExportMesh& in, const GltfExportOptions& options,
   draco::Encoder encoder;
   const int speed = 10 - options.draco_compression_level;
   encoder.SetSpeedOptions(speed, speed);
-  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, options.draco_position_bits);
+  const int position_bits = options.draco_position_bits > 0 ? options.draco_position_bits
+                                                            : DracoPositionBits(in.positions);
+  *position_bits_used = position_bits;
+  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, position_bits);
   encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.draco_normal_bits);
   encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD,
                                    options.draco_texcoord_bits);
@@ -373,6 +376,25 @@ int AddFloatAccessor(tinygltf::Model* model, int view, const std::vector<float>&
 
 }  // namespace
 
+int DracoPositionBits(const std::vector<float>& positions, double relative_step) {
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  double nearest = 1e300;
+  for (size_t i = 0; i + 2 < positions.size(); i += 3) {
+    double r2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double v = positions[i + k];
+      lo[k] = std::min(lo[k], v);
+      hi[k] = std::max(hi[k], v);
+      r2 += v * v;
+    }
+    if (r2 > 0) nearest = std::min(nearest, std::sqrt(r2));
+  }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  if (!(extent > 0) || !(nearest < 1e300) || !(relative_step > 0)) return 14;
+  const double bits = std::ceil(std::log2(extent / (relative_step * nearest)));
+  return static_cast<int>(std::clamp(bits, 14.0, 30.0));
+}
+
 // The one atlas of format/colour_atlas.h, whose fill rule the mesh's uvs rely on.
 Image8 BuildColourAtlas(const TwoLayerPanorama& pano) { return ::casual3d::BuildColourAtlas(pano, 3); }
 
@@ -387,8 +409,8 @@ Status GltfExportOptions::Check() const {
     return InvalidArgument(
         Range("max_texture_size", max_texture_size, kMinTextureSize, kMaxTextureSize));
   }
-  if (draco_position_bits < 1 || draco_position_bits > 30) {
-    return InvalidArgument(Range("draco_position_bits", draco_position_bits, 1, 30));
+  if (draco_position_bits < 0 || draco_position_bits > 30) {
+    return InvalidArgument(Range("draco_position_bits", draco_position_bits, 0, 30));
   }
   if (draco_normal_bits < 1 || draco_normal_bits > 30) {
     return InvalidArgument(Range("draco_normal_bits", draco_normal_bits, 1, 30));
@@ -481,8 +503,10 @@ StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
   ExportMesh stored;
   std::vector<uint8_t> draco_bytes;
   std::map<std::string, int> draco_ids;
+  int position_bits = 0;
   if (options.draco) {
-    CASUAL3D_RETURN_IF_ERROR(DracoCompress(plain, options, &draco_bytes, &stored, &draco_ids));
+    CASUAL3D_RETURN_IF_ERROR(
+        DracoCompress(plain, options, &draco_bytes, &stored, &draco_ids, &position_bits));
   } else {
     stored = std::move(plain);
   }
@@ -607,6 +631,7 @@ StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
     stats->texture_width = texture->width();
     stats->texture_height = texture->height();
     stats->texture_bytes = image_bytes.size();
+    stats->draco_position_bits = position_bits;
     stats->mesh_bytes = mesh_bytes;
     stats->file_bytes = glb.size();
   }

@@ -74,11 +74,14 @@ struct GltfExportOptions {
   // Compress the mesh with Draco (KHR_draco_mesh_compression, required by the
   // file then). The texture is stored as without Draco.
   bool draco = false;
-  // Draco quantization bits, 1..30 each. Positions: 14 bits over the mesh's
-  // bounding box (about 1 mm over 16 m). Normals: 10 bits (octahedral, under
-  // 0.2 degrees). Texture coordinates: 14 bits over their range, enough for a
-  // quarter-texel precision on an 4096-texel-wide atlas.
-  int draco_position_bits = 14;
+  // Draco quantization bits, 1..30 each. Positions: 0 = automatic
+  // (DracoPositionBits): a 3D photo spans from near objects to the sky, and
+  // a uniform grid over its bounding box must still place the nearest
+  // vertices within 0.05% of their distance (14 bits over a box 1000 times
+  // the nearest distance would move them by 12%). Normals: 10 bits
+  // (octahedral, under 0.2 degrees). Texture coordinates: 14 bits over their
+  // range, enough for a quarter-texel precision on an 4096-texel-wide atlas.
+  int draco_position_bits = 0;
   int draco_normal_bits = 10;
   int draco_texcoord_bits = 14;
   // Draco compression level, 0..10 (Draco's encoding speed is 10 - level).
@@ -91,6 +94,12 @@ struct GltfExportOptions {
   Status Check() const;
 };
 
+// Position bits for Draco such that the quantization step over the
+// positions' bounding box (its largest side / 2^bits) is at most
+// `relative_step` times the smallest non-zero distance of a vertex from the
+// origin (the 3D photo's centre); within [14, 30].
+int DracoPositionBits(const std::vector<float>& positions, double relative_step = 5e-4);
+
 // Facts about a written GLB, for logs and tests.
 struct GltfExportStats {
   size_t num_vertices = 0;   // As stored (after Draco's decoding, if any).
@@ -98,6 +107,7 @@ struct GltfExportStats {
   int texture_width = 0;     // Stored texture size in pixels.
   int texture_height = 0;
   size_t texture_bytes = 0;  // Encoded PNG/JPEG size.
+  int draco_position_bits = 0;  // As used (0 without Draco).
   size_t mesh_bytes = 0;     // Vertex and index data (or the Draco bitstream).
   size_t file_bytes = 0;     // The whole GLB.
 };

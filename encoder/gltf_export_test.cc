@@ -443,6 +443,52 @@ TEST(GltfExportTest, DracoGlbDecodesToTheMeshWithinQuantization) {
   }
 }
 
+TEST(GltfExportTest, AutomaticDracoPositionBitsKeepNearVerticesWithinTheirDepthBound) {
+  // Near vertices at 1 m and a far one at 1000 m: 14 bits over the box
+  // would move the near ones by about 12 cm; the automatic bits keep them
+  // within 0.05% of their distance.
+  std::vector<float> positions = {1, 0, 0, 0, 1, 0, 0, 0, -1, -1000, 0, 0, 0, 0, 1000};
+  const int bits = DracoPositionBits(positions);
+  EXPECT_EQ(bits, 21);  // log2(1001 / 5e-4) = 20.9.
+  EXPECT_LE(bits, 30);
+  EXPECT_EQ(DracoPositionBits({1, 0, 0, 0, 1, 0}), 14);  // A small box: the floor.
+
+  Mesh mesh = MakeSphereBand(40, 20, 4);
+  for (size_t v = 0; v < mesh.num_vertices(); ++v) {
+    // Scale the band's first row out to 500 times the rest.
+    if (v % 41 == 0)
+      for (int k = 0; k < 3; ++k) mesh.positions[3 * v + k] *= 500.0f;
+  }
+  const Image8 atlas = MakeAtlas(41, 42);
+  GltfExportOptions options;
+  options.draco = true;
+  GltfExportStats stats;
+  auto glb = EncodeGlb(mesh, atlas, options, &stats);
+  ASSERT_TRUE(glb.ok()) << glb.status().ToString();
+  EXPECT_EQ(stats.draco_position_bits, DracoPositionBits(mesh.positions));
+  EXPECT_GT(stats.draco_position_bits, 14);
+  const Parsed p = ParseGlb(*glb);
+  ASSERT_TRUE(p.ok) << p.error;
+  std::map<std::string, int> ids;
+  const std::unique_ptr<draco::Mesh> decoded =
+      DecodeDraco(p.model, p.model.meshes[0].primitives[0], &ids);
+  ASSERT_NE(decoded, nullptr);
+  const draco::PointAttribute* dpos = decoded->GetAttributeByUniqueId(ids.at("POSITION"));
+  double worst = 0;
+  for (uint32_t i = 0; i < decoded->num_points(); ++i) {
+    float xyz[3];
+    dpos->GetMappedValue(draco::PointIndex(i), xyz);
+    double best = 1e30;
+    for (size_t v = 0; v < mesh.num_vertices(); ++v) {
+      const float* q = &mesh.positions[3 * v];
+      best = std::min<double>(best, std::hypot(q[0] - xyz[0], q[1] - xyz[1], q[2] - xyz[2]) /
+                                std::hypot(q[0], q[1], q[2]));
+    }
+    worst = std::max(worst, best);
+  }
+  EXPECT_LE(worst, 5e-4);
+}
+
 TEST(GltfExportTest, LargeMeshUsesUnsignedIntIndices) {
   const Mesh mesh = MakeSphereBand(300, 250, 0);  // 75,551 vertices.
   ASSERT_GT(mesh.num_vertices(), 65535u);
@@ -553,6 +599,8 @@ TEST(GltfExportTest, RejectsBadOptionsMeshesAndAtlases) {
   o.max_texture_size = 20000;
   expect_invalid(mesh, atlas, o, "max_texture_size 20000");
   o = GltfExportOptions();
+  o.draco_position_bits = -1;
+  expect_invalid(mesh, atlas, o, "draco_position_bits -1");
   o.draco_position_bits = 31;
   expect_invalid(mesh, atlas, o, "draco_position_bits 31");
   o = GltfExportOptions();
