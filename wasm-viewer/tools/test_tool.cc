@@ -45,7 +45,8 @@ int Fail(const std::string& message) {
 
 // Removes every node whose pixel centre lies outside the longitudes
 // [lon0, lon1] or latitudes [lat0, lat1] (degrees), and the links to them.
-void KeepLonLatBox(double lon0, double lon1, double lat0, double lat1, casual3d::TwoLayerPanorama* pano) {
+void KeepLonLatBox(double lon0, double lon1, double lat0, double lat1,
+                   casual3d::TwoLayerPanorama* pano) {
   const int w = pano->width(), h = pano->height();
   for (int y = 0; y < h; ++y) {
     const double lat = 90.0 - (y + 0.5) / h * 180.0;
