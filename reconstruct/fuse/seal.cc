@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "format/mesh_builder.h"
@@ -341,56 +343,55 @@ int64_t CountOpenQuads(const TwoLayerPanorama& pano) {
   return open;
 }
 
+namespace {
+
+// The quads `is_open` says are open, sealed pass by pass until a pass
+// changes nothing (at most max_passes); returns how many were open before
+// and stay open after.
+template <typename IsOpen>
+std::pair<int64_t, int64_t> SealPasses(Sealer* sealer, int width, int height, int max_passes,
+                                       bool behind, IsOpen is_open, SealStats* stats) {
+  std::vector<int> open;  // Quad indices y * width + x.
+  for (int y = 0; y + 1 < height; ++y)
+    for (int x = 0; x < width; ++x)
+      if (is_open(x, y)) open.push_back(y * width + x);
+  const int64_t before = static_cast<int64_t>(open.size());
+  for (int pass = 0; pass < max_passes && !open.empty(); ++pass) {
+    bool changed = false;
+    std::vector<int> still;
+    for (int q : open) {
+      const int x = q % width, y = q / width;
+      if (!is_open(x, y)) continue;
+      if (sealer->SealQuad(x, y, behind, stats)) changed = true;
+      if (is_open(x, y)) still.push_back(q);
+    }
+    open.swap(still);
+    if (!changed) break;
+  }
+  return {before, static_cast<int64_t>(open.size())};
+}
+
+}  // namespace
+
 SealStats SealTears(TwoLayerPanorama* pano, const SealOptions& options) {
   const std::string why = options.Check();
   if (!why.empty()) throw std::invalid_argument("seal options: " + why);
   SealStats stats;
   Sealer sealer(pano, options);
   const int W = pano->width(), H = pano->height();
-  std::vector<int> open;  // Quad indices y * W + x.
-  for (int y = 0; y + 1 < H; ++y)
-    for (int x = 0; x < W; ++x)
-      if (sealer.Open(x, y)) open.push_back(y * W + x);
-  stats.open_quads_before = static_cast<int64_t>(open.size());
+  const auto front_open = [&](int x, int y) { return sealer.Open(x, y); };
   // Local edits within one surface first; then, for what is left, links
-  // between surfaces behind the foreground.
-  for (const bool behind : {false, true}) {
-    for (int pass = 0; pass < options.max_passes && !open.empty(); ++pass) {
-      bool changed = false;
-      std::vector<int> still;
-      for (int q : open) {
-        const int x = q % W, y = q / W;
-        if (!sealer.Open(x, y)) continue;
-        if (sealer.SealQuad(x, y, behind, &stats)) changed = true;
-        if (sealer.Open(x, y)) still.push_back(q);
-      }
-      open.swap(still);
-      if (!changed) break;
-    }
-  }
+  // between surfaces behind the foreground and pairs of edits.
+  stats.open_quads_before =
+      SealPasses(&sealer, W, H, options.max_passes, false, front_open, &stats).first;
+  SealPasses(&sealer, W, H, options.max_passes, true, front_open, &stats);
   stats.open_quads_after = CountOpenQuads(*pano);
-
   // Then tears of the back layer (noisy depth behind an edge), within one
   // surface, without opening anything seen from the centre.
   sealer.set_score_back(true);
-  open.clear();
-  for (int y = 0; y + 1 < H; ++y)
-    for (int x = 0; x < W; ++x)
-      if (sealer.BackOpen(x, y)) open.push_back(y * W + x);
-  stats.back_open_quads_before = static_cast<int64_t>(open.size());
-  for (int pass = 0; pass < options.max_passes && !open.empty(); ++pass) {
-    bool changed = false;
-    std::vector<int> still;
-    for (int q : open) {
-      const int x = q % W, y = q / W;
-      if (!sealer.BackOpen(x, y)) continue;
-      if (sealer.SealQuad(x, y, false, &stats)) changed = true;
-      if (sealer.BackOpen(x, y)) still.push_back(q);
-    }
-    open.swap(still);
-    if (!changed) break;
-  }
-  stats.back_open_quads_after = static_cast<int64_t>(open.size());
+  std::tie(stats.back_open_quads_before, stats.back_open_quads_after) =
+      SealPasses(&sealer, W, H, options.max_passes, false,
+                 [&](int x, int y) { return sealer.BackOpen(x, y); }, &stats);
   return stats;
 }
 
