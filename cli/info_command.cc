@@ -32,6 +32,17 @@ void RunInfo(const std::string& path) {
               m->depth.bits, m->depth.near_m, m->depth.far_m,
               100.0 * m->depth.MaxRelativeError());
   std::printf("normals      octahedral, %d bits per coordinate\n", m->normal.bits);
+  if (m->view) {
+    const ViewHints& v = *m->view;
+    const char* unit = v.metric ? " m" : " (the capture's units)";
+    std::printf("view         opens at yaw %.1f, pitch %.1f, field of view %.1f deg\n", v.yaw_deg,
+                v.pitch_deg, v.fov_deg);
+    std::printf("content      yaw %.1f .. %.1f, pitch %.1f .. %.1f deg\n", v.content_yaw_min_deg,
+                v.content_yaw_max_deg, v.content_pitch_min_deg, v.content_pitch_max_deg);
+    std::printf("volume       radius %.6g%s\n", v.volume_radius, unit);
+  } else {
+    std::printf("view         none (version 1.0): viewers choose\n");
+  }
   std::printf("tiles        %d px\n", m->tile_size);
   for (size_t l = 0; l < m->levels.size(); ++l) {
     const LevelEntry& L = m->levels[l];

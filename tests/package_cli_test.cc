@@ -57,6 +57,37 @@ class PackageCliTest : public ::testing::Test {
   std::string master_;
 };
 
+TEST_F(PackageCliTest, ViewHintsGoFromTheMasterFileToThePackage) {
+  TwoLayerPanorama pano = testing::MakePackageTestPanorama(256, 128);
+  ViewHints hints;
+  hints.yaw_deg = 12.5;
+  hints.fov_deg = 48.0;
+  hints.content_yaw_min_deg = -40.0;
+  hints.content_yaw_max_deg = 60.0;
+  hints.content_pitch_min_deg = -30.0;
+  hints.content_pitch_max_deg = 35.0;
+  hints.volume_radius = 0.07;
+  pano.view_hints() = hints;
+  const std::string master = (dir_ / "hinted.exr").string(), pkg = (dir_ / "hinted").string();
+  ASSERT_TRUE(encoder::WriteMasterFile(pano, master).ok());
+  CommandResult encode = Casual3d("encode " + master + " -o " + pkg + " --no-viewer");
+  ASSERT_EQ(encode.exit_code, 0) << encode.output;
+  CommandResult info = Casual3d("info " + pkg);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("casual3d 1.1"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("opens at yaw 12.5, pitch 0.0, field of view 48.0 deg"),
+            std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("radius 0.07 (the capture's units)"), std::string::npos) << info.output;
+  CommandResult validate = Casual3d("validate " + pkg);
+  EXPECT_EQ(validate.exit_code, 0) << validate.output;
+  EXPECT_NE(validate.output.find("valid casual3d 1.1 package"), std::string::npos) << validate.output;
+  // Without hints the package stays 1.0 and says so.
+  CommandResult plain = Casual3d("encode " + master_ + " -o " + (dir_ / "plain").string() + " --no-viewer");
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  info = Casual3d("info " + (dir_ / "plain").string());
+  EXPECT_NE(info.output.find("view         none (version 1.0)"), std::string::npos) << info.output;
+}
+
 TEST_F(PackageCliTest, EncodeInfoValidate) {
   const std::string pkg = (dir_ / "pkg").string(), c3d = (dir_ / "pkg.c3d").string();
   CommandResult encode = Casual3d("encode " + master_ + " -o " + pkg + " --tile-size 64 --levels 3 "

@@ -389,9 +389,9 @@ SealStats SealTears(TwoLayerPanorama* pano, const SealOptions& options) {
   // Then tears of the back layer (noisy depth behind an edge), within one
   // surface, without opening anything seen from the centre.
   sealer.set_score_back(true);
+  const auto back_open = [&](int x, int y) { return sealer.BackOpen(x, y); };
   std::tie(stats.back_open_quads_before, stats.back_open_quads_after) =
-      SealPasses(&sealer, W, H, options.max_passes, false,
-                 [&](int x, int y) { return sealer.BackOpen(x, y); }, &stats);
+      SealPasses(&sealer, W, H, options.max_passes, false, back_open, &stats);
   return stats;
 }
 

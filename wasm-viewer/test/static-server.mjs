@@ -65,6 +65,26 @@ export function chromiumArgs() {
   ];
 }
 
+/**
+ * The Chromium binary and playwright-core's `chromium` for a browser test
+ * (`what` names it in the messages). Exits 77 (ctest's skip) when the browser
+ * is not installed and 1 when playwright-core is missing.
+ */
+export async function chromiumOrSkip(what) {
+  const executable = process.env.CASUAL3D_CHROMIUM ?? '/usr/bin/chromium';
+  if (!fs.existsSync(executable)) {
+    console.log(`SKIP: ${executable} is not installed (apt-get install chromium); ${what} needs it`);
+    process.exit(77);
+  }
+  try {
+    const { chromium } = await import('playwright-core');
+    return { chromium, executable };
+  } catch {
+    console.error('error: the npm package playwright-core is missing; run `npm ci` in wasm-viewer/ (scripts/setup.sh does)');
+    process.exit(1);
+  }
+}
+
 /** A page embedding one viewer element; events are recorded in window.__events. */
 export function viewerPage(src, { width = 640, height = 400, maxLevelWidth = 4096, attributes = '' } = {}) {
   return `<!DOCTYPE html><html><head><meta charset="utf-8">

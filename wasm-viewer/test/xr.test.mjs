@@ -23,21 +23,10 @@ import zlib from 'node:zlib';
 
 import { directionFromYawPitch, lookAlong, multiply, perspective } from '../js/camera.js';
 import { BINARY_DIR, DIST_DIR, copyPackageWithView, runTool } from './node-support.mjs';
-import { chromiumArgs, startServer, viewerPage } from './static-server.mjs';
+import { chromiumArgs, chromiumOrSkip, startServer, viewerPage } from './static-server.mjs';
 import { installWebXRMock } from './webxr-mock.mjs';
 
-const CHROMIUM = process.env.CASUAL3D_CHROMIUM ?? '/usr/bin/chromium';
-if (!fs.existsSync(CHROMIUM)) {
-  console.log(`SKIP: ${CHROMIUM} is not installed (apt-get install chromium); the XR browser test needs it`);
-  process.exit(77);
-}
-let chromium;
-try {
-  ({ chromium } = await import('playwright-core'));
-} catch {
-  console.error('error: the npm package playwright-core is missing; run `npm ci` in wasm-viewer/ (scripts/setup.sh does)');
-  process.exit(1);
-}
+const { chromium, executable: CHROMIUM } = await chromiumOrSkip('the XR browser test');
 
 const DEG = Math.PI / 180;
 const W = 640, H = 400;                      // The page's canvas.
