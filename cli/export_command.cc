@@ -196,6 +196,9 @@ void RunExport(ExportOptions& opts) {
   progress.Finish();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  char draco[64] = "";
+  if (opts.gltf.draco)
+    std::snprintf(draco, sizeof(draco), " (Draco, %d-bit positions)", stats.draco_position_bits);
   char line[512];
   std::snprintf(line, sizeof(line),
                 "wrote %s: %zu vertices, %zu triangles, %dx%d %s texture (%s), mesh %s%s, "
@@ -203,7 +206,7 @@ void RunExport(ExportOptions& opts) {
                 opts.glb.c_str(), stats.num_vertices, stats.num_triangles, stats.texture_width,
                 stats.texture_height, opts.texture == "png" ? "PNG" : "JPEG",
                 Megabytes(stats.texture_bytes).c_str(), Megabytes(stats.mesh_bytes).c_str(),
-                opts.gltf.draco ? " (Draco)" : "", Megabytes(stats.file_bytes).c_str(), seconds);
+                draco, Megabytes(stats.file_bytes).c_str(), seconds);
   // The result goes to stdout (logs and progress go to stderr).
   std::printf("%s\n", line);
 }
@@ -248,7 +251,7 @@ void AddExportCommand(CLI::App& app) {
                 "hold the scene's lighting)");
   cmd->add_flag("--double-sided", opts->gltf.double_sided, "Render both sides of triangles");
   cmd->add_option("--draco-position-bits", opts->gltf.draco_position_bits,
-                  "Draco position quantization bits (1..30); 0 = enough for 0.05% of the nearest "
+                  "Draco position quantization bits (1..30); 0 = enough for 0.1% of the nearest "
                   "vertex's distance over the mesh's extent")
       ->capture_default_str()
       ->check(CLI::Range(0, 30));

@@ -77,7 +77,7 @@ struct GltfExportOptions {
   // Draco quantization bits, 1..30 each. Positions: 0 = automatic
   // (DracoPositionBits): a 3D photo spans from near objects to the sky, and
   // a uniform grid over its bounding box must still place the nearest
-  // vertices within 0.05% of their distance (14 bits over a box 1000 times
+  // vertices within 0.1% of their distance (14 bits over a box 1000 times
   // the nearest distance would move them by 12%). Normals: 10 bits
   // (octahedral, under 0.2 degrees). Texture coordinates: 14 bits over their
   // range, enough for a quarter-texel precision on an 4096-texel-wide atlas.
@@ -98,7 +98,7 @@ struct GltfExportOptions {
 // positions' bounding box (its largest side / 2^bits) is at most
 // `relative_step` times the smallest non-zero distance of a vertex from the
 // origin (the 3D photo's centre); within [14, 30].
-int DracoPositionBits(const std::vector<float>& positions, double relative_step = 5e-4);
+int DracoPositionBits(const std::vector<float>& positions, double relative_step = 1e-3);
 
 // Facts about a written GLB, for logs and tests.
 struct GltfExportStats {
