@@ -167,13 +167,40 @@ int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<i
       for (int dx = -1; dx <= 1; ++dx)
         if (dx != 0 || yy != y) visit(static_cast<int64_t>(yy) * W + WrapColumn(x + dx, W));
   };
-  // The farthest filled 8-neighbour of i, or -1.
+  // The farthest filled 8-neighbour of i, or -1; of equally far ones a
+  // 4-neighbour (so that the mirrored colours below continue straight).
   const auto farthest_neighbour = [&](int64_t i) {
     int64_t best = -1;
+    bool best_straight = false;
     for_each_neighbour(i, [&](int64_t j) {
-      if (depth[j] > 0 && (best < 0 || depth[j] > depth[best])) best = j;
+      if (!(depth[j] > 0)) return;
+      const bool straight = j / W == i / W || j % W == i % W;
+      if (best < 0 || depth[j] > depth[best] || (depth[j] == depth[best] && straight && !best_straight)) {
+        best = j;
+        best_straight = straight;
+      }
     });
     return best;
+  };
+  // Pixels with content before the filling, and for each filled pixel the
+  // pixel of its rim its chain of sources started from.
+  std::vector<uint8_t> original(static_cast<size_t>(W) * H, 0);
+  for (int64_t i = 0; i < static_cast<int64_t>(W) * H; ++i) original[i] = depth[i] > 0;
+  std::vector<int64_t> origin(static_cast<size_t>(W) * H, -1);
+  // The original pixel mirrored from i through its rim pixel o, if it shows
+  // the surface i continues (within 5% of depth d), else -1: the texture
+  // beside the rim continues into the gap instead of streaks of one colour.
+  const auto mirrored = [&](int64_t i, int64_t o, float d) -> int64_t {
+    const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
+    const int ox = static_cast<int>(o % W), oy = static_cast<int>(o / W);
+    int dx = ox - x;
+    if (dx > W / 2) dx -= W;
+    if (dx < -W / 2) dx += W;
+    const int my = oy + (oy - y);
+    if (my < 0 || my >= H) return -1;
+    const int64_t m = static_cast<int64_t>(my) * W + WrapColumn(ox + dx, W);
+    if (!original[m] || std::abs(depth[m] - d) > 0.05f * d) return -1;
+    return m;
   };
 
   // Ring 0: gap pixels next to a filled one, each with its source.
@@ -194,6 +221,12 @@ int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<i
     // pixel's colour).
     fills.clear();
     for (const auto& [i, source] : ring) {
+      const int64_t rim = original[source] ? source : origin[source];
+      origin[i] = rim;
+      if (const int64_t m = rim >= 0 ? mirrored(i, rim, depth[source]) : -1; m >= 0) {
+        fills.push_back({colour[3 * m], colour[3 * m + 1], colour[3 * m + 2]});
+        continue;
+      }
       const float limit = 0.95f * depth[source];
       float sum[3] = {0, 0, 0};
       int count = 0;

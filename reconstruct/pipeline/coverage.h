@@ -77,8 +77,12 @@ Image8 FootprintMask(const std::vector<warp::WarpedView>& warps, int width, int 
 // Fills the gaps of a stitched layer inside `mask` (same size; 255 inside)
 // ring by ring from their rims: each ring's pixels take the depth and label
 // of their farthest already filled 8-neighbour (where a ring touches a nearer
-// and a farther surface, the farther one, the background, continues) and the
-// mean colour of the filled neighbours within 5% of that depth. A gap between
+// and a farther surface, the farther one, the background, continues; of
+// equally far ones a 4-neighbour). Colour: the pixel mirrored through the
+// rim pixel the chain of sources started from, if that pixel had content at
+// the filled depth (within 5%), so that the texture beside the rim continues
+// into the gap; else the mean colour of the filled neighbours within 5% of
+// that depth. A gap between
 // two surfaces closes from both sides. Columns wrap. Gaps
 // outside the mask, or with no filled pixel around them, stay empty.
 // `label` may be empty. Returns the number of pixels filled.

@@ -221,10 +221,16 @@ TEST(CoverageTest, GapsInsideTheMaskCloseRingByRingFromTheirRims) {
     EXPECT_FLOAT_EQ(depth.at(14, y), 10.0f) << y;
     EXPECT_FLOAT_EQ(depth.at(15, y), 1.0f) << y;
   }
-  // Colour: the mean of the filled neighbours at the chosen depth (the
-  // wall's greys 80, 60, 80 next to (7, 3)).
-  EXPECT_EQ(rgb.at(7, 3, 0), 73);
+  // Colour: the wall's texture mirrored through the rim (rows alternate 60
+  // and 80): (7, 3) mirrors (9, 3), (6, 2) mirrors (10, 2); the object's
+  // side is uniform.
+  EXPECT_EQ(rgb.at(7, 3, 0), 60);
+  EXPECT_EQ(rgb.at(6, 2, 0), 80);
+  EXPECT_EQ(rgb.at(6, 3, 0), 60);
   EXPECT_EQ(rgb.at(5, 3, 0), 200);
+  // (14, 2): from the wall two rings away (column 12); its mirror, column 10,
+  // is wall: 80.
+  EXPECT_EQ(rgb.at(14, 2, 0), 80);
   EXPECT_FLOAT_EQ(depth.at(13, 5), 0.0f);
   // Rows outside the mask stay empty.
   for (int x = 0; x < W; ++x) EXPECT_FLOAT_EQ(depth.at(x, 0), 0.0f);
