@@ -128,7 +128,7 @@ TEST(DeriveViewHintsTest, ContentAcrossTheSeamGivesAWrappedExtent) {
   EXPECT_NEAR(h.pitch_deg, 0, 1e-9);
   // The widest 4:3 view inside 70 x 60 degrees: 2 atan(tan(35) / (4/3)).
   EXPECT_NEAR(h.fov_deg, 2 * std::atan(std::tan(35 * kPi / 180) * 0.75) * 180 / kPi, 1e-9);
-  EXPECT_NEAR(h.volume_radius, 0.3, 1e-6);
+  EXPECT_NEAR(h.volume_radius, render::kDerivedVolumeFraction * 3.0, 1e-6);  // Front depth 3.
   EXPECT_FALSE(h.metric);
 
   const CapturedField field(pano, h);

@@ -18,11 +18,12 @@
 //  * Field of view (vertical): the largest that keeps a 4:3 view centred on
 //    that direction within the extents, min(latitude extent,
 //    2 atan(tan(longitude extent / 2) / (4/3))), clamped to [10, 120].
-//  * Viewing volume: radius 0.1 times the 5th percentile of the front depths
-//    (an eye moving 10% of the near content's distance sees disocclusions of
-//    a size the back layer is made for); metric false.
+//  * Viewing volume: radius 0.06 times the 5th percentile of the front depths
+//    (the bound the panorama stage puts on its own hints: an eye moved by 6%
+//    of the near content's distance opens disocclusions the back layer's
+//    growth fills; spec/stage-panorama.md, "View hints"); metric false.
 // A panorama without front nodes gives the defaults of ViewHints with
-// volume_radius 0.1 times the nearest depth of any node (or 0.1).
+// volume_radius 0.06 times the nearest depth of any node (or 0.1).
 
 #include <optional>
 
@@ -32,7 +33,7 @@
 namespace casual3d::render {
 
 // Share of the 5th-percentile front depth used as the viewing volume's radius.
-constexpr double kDerivedVolumeFraction = 0.1;
+constexpr double kDerivedVolumeFraction = 0.06;
 
 // The hints derived from `pano` as described above; always valid
 // (ViewHints::Validate).

@@ -9,7 +9,7 @@
 // shows (deriveViewHints): the content is the part of the sphere where that
 // level has nodes, the volume a fixed fraction of its near depth (the rule of
 // reconstruct/render/derived_view_hints.h, which `casual3d evaluate` uses for
-// such packages: 0.1 x the 5th percentile of the front depths). Either way
+// such packages: 0.06 x the 5th percentile of the front depths). Either way
 // the content extent is narrowed to where the coarsest level really has
 // surface (narrowContent), so that a view kept inside it shows no void.
 //
@@ -25,7 +25,7 @@
 // nodes' depths), or 0 when not known.
 
 /** Fraction of the near depth taken as the viewing volume's radius when the package gives none. */
-export const DERIVED_VOLUME_FRACTION = 0.1;
+export const DERIVED_VOLUME_FRACTION = 0.06;
 /** Percentile of the front nodes' depths that stands for the scene's near depth. */
 export const NEAR_DEPTH_PERCENTILE = 0.05;
 /** Field of view (degrees) a derived view opens at, at most (the viewer's classic default). */
