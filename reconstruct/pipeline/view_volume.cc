@@ -5,14 +5,12 @@
 #include <stdexcept>
 
 #include "format/equirect.h"
+#include "reconstruct/render/derived_view_hints.h"
 
 namespace casual3d::pipeline {
 namespace {
 
 constexpr double kDeg = 180.0 / kPi;
-
-// Longitude (degrees) of the left edge of column x.
-double ColumnLonDeg(int x, int width) { return (static_cast<double>(x) / width - 0.5) * 360.0; }
 
 // The angle t (degrees) moved into [lo, hi] modulo 360, or to the nearer end.
 double IntoInterval(double t, double lo, double hi) {
@@ -73,44 +71,8 @@ bool ContentExtent(const Image8& fov_mask, ViewHints* hints) {
       bottom = y;
     }
   }
-  if (bottom < 0) return false;
-  // The largest circular run of empty columns.
-  int best_start = 0, best_length = 0;
-  int first_full = -1;
-  for (int x = 0; x < W; ++x)
-    if (column[x]) {
-      first_full = x;
-      break;
-    }
-  for (int k = 0, run_start = -1, run = 0; k <= W; ++k) {
-    const int x = (first_full + k) % W;
-    if (k < W && !column[x]) {
-      if (run == 0) run_start = x;
-      ++run;
-    } else if (run > 0) {
-      if (run > best_length) {
-        best_length = run;
-        best_start = run_start;
-      }
-      run = 0;
-    }
-  }
-  if (best_length == 0) {
-    hints->content_yaw_min_deg = -180.0;
-    hints->content_yaw_max_deg = 180.0;
-  } else {
-    // Content runs from the column after the gap to the column before it.
-    const int first = (best_start + best_length) % W;
-    const int content_columns = W - best_length;
-    double lo = ColumnLonDeg(first, W);
-    double hi = lo + 360.0 * content_columns / W;
-    if (hi > 360.0) {
-      lo -= 360.0;
-      hi -= 360.0;
-    }
-    hints->content_yaw_min_deg = lo;
-    hints->content_yaw_max_deg = hi;
-  }
+  if (!render::YawExtentOfColumns(column, &hints->content_yaw_min_deg, &hints->content_yaw_max_deg))
+    return false;
   hints->content_pitch_max_deg = 90.0 - 180.0 * top / H;
   hints->content_pitch_min_deg = 90.0 - 180.0 * (bottom + 1) / H;
   return true;
@@ -181,22 +143,11 @@ ViewHints ComputeViewHints(const TwoLayerPanorama& pano, const Image8& fov_mask,
   hints.pitch_deg = std::clamp(pitch, -90.0, 90.0);
   hints.fov_deg = fov;
 
-  // Near depth: a low percentile of the front depths inside the field of view.
-  const LayerData& front = pano.layer(kFront);
-  std::vector<float> depths;
-  const size_t n = static_cast<size_t>(pano.width()) * pano.height();
-  const uint8_t* mask = &fov_mask.at(0, 0);
-  for (size_t i = 0; i < n; ++i)
-    if (front.present[i] && mask[i]) depths.push_back(front.depth_m[i]);
-  if (depths.empty())
-    for (size_t i = 0; i < n; ++i)
-      if (front.present[i]) depths.push_back(front.depth_m[i]);
-  double near = 1.0;
-  if (!depths.empty()) {
-    const size_t k = static_cast<size_t>(options.near_percentile * (depths.size() - 1));
-    std::nth_element(depths.begin(), depths.begin() + k, depths.end());
-    near = depths[k];
-  }
+  // Near depth: a low percentile of the front depths inside the field of
+  // view (of all front depths if none is inside; 1 without any).
+  double near = render::FrontDepthQuantile(pano, options.near_percentile, &fov_mask);
+  if (!(near > 0)) near = render::FrontDepthQuantile(pano, options.near_percentile);
+  if (!(near > 0)) near = 1.0;
   hints.volume_radius = std::clamp(spread, options.min_radius_over_near * near,
                                    options.max_radius_over_near * near);
   return hints;

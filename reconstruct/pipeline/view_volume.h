@@ -11,8 +11,8 @@
 //              a 16:9 view at that direction stays inside the content.
 //   content    the longitudes and latitudes of the field-of-view mask's
 //              pixels; the longitudes are the circle minus its largest run of
-//              empty columns (so content across +-180 degrees stays one
-//              interval).
+//              empty columns (render::YawExtentOfColumns, so content across
+//              +-180 degrees stays one interval).
 //   volume     a ball around the centre whose radius is the largest distance
 //              of a camera centre from it, kept within
 //              [min_radius_over_near, max_radius_over_near] times the near

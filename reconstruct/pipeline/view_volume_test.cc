@@ -26,11 +26,12 @@ TEST(ContentExtent, FrontRegion) {
 }
 
 TEST(ContentExtent, AcrossTheSeamIsOneInterval) {
-  // Columns 240..271 wrap: longitudes 157.5 .. 202.5 (that is, to -157.5).
+  // Columns 240..271 wrap: longitudes 157.5 .. 202.5, written with the
+  // middle in [-180, 180): -202.5 .. -157.5.
   ViewHints h;
   ASSERT_TRUE(ContentExtent(MaskOfColumns(256, 128, 240, 272, 0, 128), &h));
-  EXPECT_DOUBLE_EQ(h.content_yaw_min_deg, 157.5);
-  EXPECT_DOUBLE_EQ(h.content_yaw_max_deg, 202.5);
+  EXPECT_DOUBLE_EQ(h.content_yaw_min_deg, -202.5);
+  EXPECT_DOUBLE_EQ(h.content_yaw_max_deg, -157.5);
   EXPECT_DOUBLE_EQ(h.content_pitch_min_deg, -90.0);
   EXPECT_DOUBLE_EQ(h.content_pitch_max_deg, 90.0);
   EXPECT_TRUE(h.Validate().ok());

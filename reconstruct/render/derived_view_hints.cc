@@ -12,23 +12,51 @@ constexpr double kDeg = 180.0 / kPi;
 // A 4:3 view is what the field of view is fitted to.
 constexpr double kFitAspect = 4.0 / 3.0;
 
-// 5th percentile of the present front depths, from at most about a million
-// evenly spaced nodes; 0 when there are none.
-double LowFrontDepth(const TwoLayerPanorama& pano) {
+}  // namespace
+
+bool YawExtentOfColumns(const std::vector<uint8_t>& column_has, double* yaw_min_deg,
+                        double* yaw_max_deg) {
+  const int w = static_cast<int>(column_has.size());
+  int content_columns = 0;
+  for (uint8_t c : column_has) content_columns += c != 0;
+  if (content_columns == 0) return false;
+  if (content_columns == w) {
+    *yaw_min_deg = -180.0;
+    *yaw_max_deg = 180.0;
+    return true;
+  }
+  int best_start = 0, best_length = 0;
+  for (int x = 0; x < w; ++x) {
+    // Runs starting right after a content column, scanned around the seam.
+    if (column_has[x] || !column_has[(x + w - 1) % w]) continue;
+    int length = 0;
+    while (length < w && !column_has[(x + length) % w]) ++length;
+    if (length > best_length) best_length = length, best_start = x;
+  }
+  const int first = (best_start + best_length) % w;  // First content column after the gap.
+  const double extent = 360.0 * (w - best_length) / w;
+  double middle = (double(first) / w - 0.5) * 360.0 + extent / 2;
+  if (middle >= 180) middle -= 360;
+  *yaw_min_deg = middle - extent / 2;
+  *yaw_max_deg = middle + extent / 2;
+  return true;
+}
+
+double FrontDepthQuantile(const TwoLayerPanorama& pano, double q, const Image8* mask) {
   const LayerData& front = pano.layer(kFront);
   const size_t n = front.present.size();
   const size_t step = std::max<size_t>(1, n / (1 << 20));
+  const uint8_t* inside = mask != nullptr ? mask->data() : nullptr;
   std::vector<float> depths;
   for (size_t i = 0; i < n; i += step)
-    if (front.present[i] && std::isfinite(front.depth_m[i]) && front.depth_m[i] > 0)
+    if (front.present[i] && (inside == nullptr || inside[i]) && std::isfinite(front.depth_m[i]) &&
+        front.depth_m[i] > 0)
       depths.push_back(front.depth_m[i]);
   if (depths.empty()) return 0.0;
-  const size_t k = depths.size() / 20;
+  const size_t k = static_cast<size_t>(std::clamp(q, 0.0, 1.0) * (depths.size() - 1));
   std::nth_element(depths.begin(), depths.begin() + k, depths.end());
   return depths[k];
 }
-
-}  // namespace
 
 ViewHints DeriveViewHints(const TwoLayerPanorama& pano) {
   ViewHints hints;
@@ -38,11 +66,11 @@ ViewHints DeriveViewHints(const TwoLayerPanorama& pano) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) column_count[x] += front.present[pano.index(x, y)] != 0;
   const int column_min = std::max(1, h / 200);
-  std::vector<bool> column(w);
+  std::vector<uint8_t> column(w);
   int content_columns = 0;
   for (int x = 0; x < w; ++x) content_columns += column[x] = column_count[x] >= column_min;
 
-  const double low_depth = LowFrontDepth(pano);
+  const double low_depth = FrontDepthQuantile(pano, 0.05);
   if (low_depth > 0) {
     hints.volume_radius = kDerivedVolumeFraction * low_depth;
   } else {
@@ -54,24 +82,8 @@ ViewHints DeriveViewHints(const TwoLayerPanorama& pano) {
 
   // Longitudes: the complement of the largest circular run of empty columns.
   double yaw_min = -180, yaw_max = 180;
-  if (content_columns < w) {
-    int best_start = 0, best_length = 0;
-    for (int x = 0; x < w; ++x) {
-      // Runs starting right after a content column, scanned around the seam.
-      if (column[x] || !column[(x + w - 1) % w]) continue;
-      int length = 0;
-      while (length < w && !column[(x + length) % w]) ++length;
-      if (length > best_length) best_length = length, best_start = x;
-    }
-    const int first = (best_start + best_length) % w;  // First content column after the gap.
-    const double extent = 360.0 * (w - best_length) / w;
-    const double start = (double(first) / w - 0.5) * 360.0;
-    double middle = start + extent / 2;
-    if (middle >= 180) middle -= 360;
-    yaw_min = middle - extent / 2;
-    yaw_max = middle + extent / 2;
-    hints.yaw_deg = middle;
-  }
+  YawExtentOfColumns(column, &yaw_min, &yaw_max);
+  if (content_columns < w) hints.yaw_deg = 0.5 * (yaw_min + yaw_max);
   hints.content_yaw_min_deg = yaw_min;
   hints.content_yaw_max_deg = yaw_max;
 

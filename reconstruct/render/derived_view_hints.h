@@ -25,8 +25,11 @@
 // A panorama without front nodes gives the defaults of ViewHints with
 // volume_radius 0.06 times the nearest depth of any node (or 0.1).
 
+#include <cstdint>
 #include <optional>
+#include <vector>
 
+#include "format/image.h"
 #include "format/two_layer.h"
 #include "format/view_hints.h"
 
@@ -34,6 +37,19 @@ namespace casual3d::render {
 
 // Share of the 5th-percentile front depth used as the viewing volume's radius.
 constexpr double kDerivedVolumeFraction = 0.06;
+
+// The longitudes of the columns flagged in `column_has` (one flag per
+// panorama column): the whole circle minus the largest circular run of
+// unflagged columns, as [min, max] degrees with the middle in [-180, 180)
+// (so content across the +-180 degree seam gives min < -180). False,
+// leaving both untouched, when no column is flagged.
+bool YawExtentOfColumns(const std::vector<uint8_t>& column_has, double* yaw_min_deg,
+                        double* yaw_max_deg);
+
+// The q-quantile (q in [0, 1]) of the present front depths, from at most
+// about a million evenly spaced nodes; only nodes where `mask` (same size,
+// non-zero inside) is set when it is given. 0 when there are none.
+double FrontDepthQuantile(const TwoLayerPanorama& pano, double q, const Image8* mask = nullptr);
 
 // The hints derived from `pano` as described above; always valid
 // (ViewHints::Validate).

@@ -279,7 +279,8 @@ WarpedView WarpView(const SourceView& view, const PanoramaFrame& frame,
     const double uc = ua + WrapSigned(c.u - ua, W);
     if (std::max({ua, ub, uc}) - std::min({ua, ub, uc}) > max_span) return;
     if (min_ratio > 0) {
-      const double da = a.cam.norm(), db = b.cam.norm(), dc = c.cam.norm();
+      // The depth-map values (z in the photo's camera frame).
+      const double da = a.cam.z(), db = b.cam.z(), dc = c.cam.z();
       if (std::min({da, db, dc}) < min_ratio * std::max({da, db, dc})) return;
     }
     // Eq. 6: grazing angle between the triangle and the ray from the photo's camera.

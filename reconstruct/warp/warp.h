@@ -39,7 +39,7 @@ struct WarpOptions {
   // Triangles whose projection spans more than this fraction of the panorama
   // width are dropped (they wrap around a pole); (0, 0.5].
   double max_triangle_width_fraction = 0.125;
-  // Triangles whose vertices' depths (along the photo's rays) have a ratio
+  // Triangles whose vertices' depth-map values have a ratio
   // min / max below this span a depth edge of the photo: they are not drawn,
   // so that no ramp of made-up depths between the two sides (a rubber sheet)
   // reaches the panorama; the gap is filled by other photos, the gap filling
