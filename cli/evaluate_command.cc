@@ -1,10 +1,13 @@
 // `casual3d evaluate <capture> <3d-photo> [more 3d photos] [-o report.html]
 // [--json out.json] [--width 900] [--photos names...] [--holdout-every N]
 // [--labels names...] [--reference NAME:PSNR:SSIM] [--no-viewer-views]
-// [--viewer-width 640] [--viewer-height 400] [--viewer-images DIR]`:
+// [--viewer-width 640] [--viewer-height 400] [--viewer-images DIR]
+// [--write-cameras cameras.json] [--rendered DIR]`:
 // virtual rephotography (paper Sec. 6.3) of one or more 3D photos of the same
 // capture and what a viewer sees of each (tears, stretched fill), with a
-// self-contained HTML report and a JSON summary.
+// self-contained HTML report and a JSON summary. --write-cameras and
+// --rendered score another renderer's images of the same 3D photo
+// (reconstruct/eval/external_renders.h).
 
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +17,7 @@
 
 #include "cli/command.h"
 #include "reconstruct/eval/evaluate.h"
+#include "reconstruct/eval/external_renders.h"
 #include "reconstruct/eval/report.h"
 #include "reconstruct/eval/viewer_views_report.h"
 #include "reconstruct/io/file_util.h"
@@ -32,6 +36,7 @@ void AddEvaluateCommand(CLI::App& app) {
     std::vector<std::string> references;
     bool no_viewer_views = false;
     std::string viewer_images;
+    std::string write_cameras;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -87,6 +92,14 @@ void AddEvaluateCommand(CLI::App& app) {
   cmd->add_option("--viewer-images", args->viewer_images,
                   "Also write each viewer view's heatmap and their grid as PNG files to this "
                   "folder (prefixed with the 3D photo's number)");
+  cmd->add_option("--write-cameras", args->write_cameras,
+                  "Also write the evaluated photos' cameras as JSON (OpenGL view and projection "
+                  "matrices in the panorama frame, which is glTF's) for rendering them elsewhere; "
+                  "one 3D photo only");
+  cmd->add_option("--rendered", args->options.rendered_dir,
+                  "Score renderings made elsewhere instead of rendering here: one PNG per photo "
+                  "(<photo stem>.png, RGBA, alpha 0 = nothing drawn) from the cameras of "
+                  "--write-cameras");
   cmd->callback([args] {
     args->options.viewer_views = !args->no_viewer_views;
     if (const std::string why = args->options.Check(); !why.empty())
@@ -113,6 +126,9 @@ void AddEvaluateCommand(CLI::App& app) {
     }
     if (const std::string why = args->report.Check(); !why.empty())
       throw std::invalid_argument("evaluate: --" + why);
+    if (!args->write_cameras.empty() && args->photo3d.size() != 1)
+      throw std::invalid_argument("--write-cameras: give exactly one 3D photo (got " +
+                                  std::to_string(args->photo3d.size()) + ")");
     const std::filesystem::path html(args->html);
     if (!html.parent_path().empty() && !std::filesystem::is_directory(html.parent_path()))
       throw std::runtime_error(args->html + ": the folder " + html.parent_path().string() +
@@ -147,6 +163,20 @@ void AddEvaluateCommand(CLI::App& app) {
             q.name.c_str(), q.metrics.width, q.metrics.height, q.metrics.error,
             q.metrics.completeness, q.metrics.psnr_db, q.metrics.ssim, q.metrics.psnr_filled_db,
             q.metrics.ssim_filled, q.held_out ? " (held out)" : "");
+    }
+    if (!args->write_cameras.empty()) {
+      std::vector<eval::NamedView> views;
+      for (const eval::PhotoEvaluation& q : evals.front().photos) {
+        if (q.has_distortion)
+          throw std::runtime_error("--write-cameras: photo " + q.name +
+                                   " has lens distortion, which the cameras file cannot carry "
+                                   "(evaluate the 3D photo's undistorted workspace)");
+        views.push_back({q.name, q.view});
+      }
+      io::WriteFileAtomic(args->write_cameras,
+                          eval::RephotoCamerasJson(views, evals.front().near_m,
+                                                   evals.front().far_m));
+      std::printf("cameras: %s\n", args->write_cameras.c_str());
     }
     io::WriteFileAtomic(args->html, eval::RenderHtmlReport(args->capture, evals, args->report));
     std::printf("report: %s\n", args->html.c_str());

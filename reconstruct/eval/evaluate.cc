@@ -17,6 +17,7 @@
 #include "format/file_source.h"
 #include "format/mesh_builder.h"
 #include "format/package_reader.h"
+#include "reconstruct/eval/external_renders.h"
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/io/cv_bridge.h"
 #include "reconstruct/io/exr_io.h"
@@ -286,6 +287,11 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     throw std::runtime_error(capture_dir +
                              ": not a folder (give the capture's photo or capture folder)");
 
+  if (!options.rendered_dir.empty() && !fs::is_directory(options.rendered_dir, ec))
+    throw std::runtime_error(options.rendered_dir +
+                             ": not a folder (give the folder holding the renderings made "
+                             "elsewhere, one PNG per photo)");
+
   PhotoModelEvaluation eval;
   eval.label = photo3d_path;
   const int threads = options.num_threads > 0 ? options.num_threads
@@ -331,7 +337,7 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
                 " triangles in " + std::to_string(SecondsSince(mesh_start)) + " s; " +
                 std::to_string(selected.size()) + " photos");
 
-  if (options.viewer_views) {
+  if (options.viewer_views && options.rendered_dir.empty()) {
     const auto viewer_start = std::chrono::steady_clock::now();
     ViewerViewsOptions viewer = options.viewer;
     viewer.num_threads = options.num_threads;
@@ -349,6 +355,8 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
   double near_m = 0.0, far_m = 0.0;
   if (photo3d.pano.NodeDepthRange(&near_m, &far_m))
     render_options.far_m = std::max(render_options.far_m, 1.5 * far_m);
+  eval.near_m = render_options.near_m;
+  eval.far_m = render_options.far_m;
   util::Progress progress("rephotography", static_cast<int64_t>(selected.size()));
   eval.error_histogram.assign(options.metrics.histogram_bins, 0);
   for (const int index : selected) {
@@ -382,16 +390,30 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
       cv::resize(io::ToMat(photo_full), dst, dst.size(), 0, 0,
                  scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
     }
+    pe.view = render::ViewFromPhoto(camera, image.pose, photo3d.pano.frame());
+    pe.has_distortion = camera.HasDistortion();
     const auto t = std::chrono::steady_clock::now();
-    render::RenderResult r = render::RenderPhotoView(*mesh, atlas.view(), photo3d.pano.frame(),
-                                                     camera, image.pose, render_options);
+    render::RenderResult r;
+    if (options.rendered_dir.empty()) {
+      r = render::RenderPhotoView(*mesh, atlas.view(), photo3d.pano.frame(), camera, image.pose,
+                                  render_options);
+    } else {
+      if (pe.has_distortion)
+        throw std::runtime_error("photo " + name + ": its camera has lens distortion, which " +
+                                 "renderings made elsewhere leave out (evaluate against the "
+                                 "undistorted workspace: the 3D photo's work/sparse)");
+      ExternalRender ext =
+          ReadExternalRender(options.rendered_dir, name, camera.width, camera.height);
+      r.color = std::move(ext.color);
+      r.mask = std::move(ext.mask);
+    }
     pe.seconds_render = SecondsSince(t);
     ImageF error_map;
     pe.metrics = ComputeRephotoMetrics(std::as_const(photo).view(), std::as_const(r.color).view(),
                                        std::as_const(r.mask).view(), options.metrics,
                                        options.keep_images ? &error_map : nullptr);
     const fs::path truth = capture / "depth" / (fs::path(name).stem().string() + ".exr");
-    if (fs::is_regular_file(truth, ec))
+    if (options.rendered_dir.empty() && fs::is_regular_file(truth, ec))
       pe.depth = CompareDepth(io::ReadExrChannels(truth.string(), {"Z"}), r,
                               options.depth_tolerance, depth_scale);
     if (options.keep_images) {

@@ -61,6 +61,11 @@ struct EvaluateOptions {
   // views over the viewing volume. Needs the 3D photo only.
   bool viewer_views = true;
   ViewerViewsOptions viewer;
+  // Renderings made elsewhere (external_renders.h): when not empty, each
+  // evaluated photo's rendering is read from this folder instead of rendered
+  // here, and the viewer views are skipped (they are this program's renders).
+  // Needs cameras without lens distortion (the undistorted workspace).
+  std::string rendered_dir;
 
   std::string Check() const;  // Empty if valid, else "field: reason".
 };
@@ -88,6 +93,10 @@ struct PhotoEvaluation {
   RephotoMetrics metrics;
   DepthComparison depth;
   double seconds_render = 0.0;
+  // The pinhole view of the photo at the evaluated size (panorama frame), and
+  // whether its camera has lens distortion that the view leaves out.
+  render::PinholeView view;
+  bool has_distortion = false;
   // When EvaluateOptions::keep_images: the photo as compared, the rendering
   // and the per-pixel error (rephoto_metrics.h; -1 uncovered).
   Image8 photo, render;
@@ -114,6 +123,8 @@ struct PhotoModelEvaluation {
   // the 3D photo's model units to the capture's (camera-centre spread ratio
   // when the poses come from the 3D photo's own model), else 1.
   double depth_scale = 1.0;
+  // Clip planes of the rephotography (RenderOptions::near_m, far_m).
+  double near_m = 0.0, far_m = 0.0;
   std::vector<int64_t> error_histogram;  // Sum over photos.
   int64_t total_pixels = 0;              // Sum of photo sizes.
   // With EvaluateOptions::viewer_views: the viewer-side measure.
