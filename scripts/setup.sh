@@ -20,6 +20,8 @@ packages=(
   colmap libsqlite3-dev libopencv-dev libeigen3-dev libmaxflow-dev libjpeg-dev libpng-dev libexif-dev
   # cli/, tests and benchmarks
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+  # python/: the module (import casual3d) and its tests
+  pybind11-dev python3-dev python3-numpy python3-pytest
   # wasm-viewer/ and its browser test
   emscripten chromium
 )
