@@ -1,10 +1,11 @@
 // <casual3d-viewer src="scene/manifest.json"></casual3d-viewer>: the embeddable
-// 3D photo viewer. One script (this module) and one element:
+// 3D photo viewer (src: a package folder's manifest.json or a .c3d file). One
+// script (this module) and one element:
 //
 //   <script type="module" src="viewer/casual3d-viewer.js"></script>
 //   <casual3d-viewer src="manifest.json" controls></casual3d-viewer>
 //
-// Attributes: src (manifest URL), controls (show the toolbar), effects (any of
+// Attributes: src (manifest.json or .c3d URL), controls (show the toolbar), effects (any of
 // "lighting water object", space separated), yaw, pitch, fov (degrees; without
 // them a package opens framed on its captured content), max-level-width
 // (finest level loaded, pixels).
@@ -14,6 +15,7 @@
 import { Casual3dViewer } from './viewer-core.js';
 
 export { Casual3dViewer } from './viewer-core.js';
+export { setAssetBase } from './assets.js';
 
 const STYLE = `
 :host { display: block; position: relative; width: 100%; height: 360px; background: #000; overflow: hidden;

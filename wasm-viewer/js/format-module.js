@@ -61,10 +61,12 @@ export class FormatModule {
    * Instantiates the wasm module. `threads`: true for the threaded build,
    * false for the single-threaded one, 'auto' (the default) for the threaded
    * one where threadsAvailable(), falling back to the single-threaded one if
-   * the threaded one fails to start. Other options go to the Emscripten
-   * factory (a `wasmBinary` must be the bytes of the build that is chosen).
+   * the threaded one fails to start. `baseUrl`: the folder holding
+   * casual3d-format*.{js,wasm} (default: this module's folder). Other options
+   * go to the Emscripten factory (a `wasmBinary` must be the bytes of the
+   * build that is chosen).
    */
-  static async create({ threads = 'auto', ...options } = {}) {
+  static async create({ threads = 'auto', baseUrl = import.meta.url, ...options } = {}) {
     if (!WebAssembly.validate(SIMD_PROBE)) {
       throw new Error('this browser lacks WebAssembly SIMD, which the viewer needs ' +
                       '(Chrome or Edge 91, Firefox 89, Safari 16.4 or later)');
@@ -73,7 +75,7 @@ export class FormatModule {
     let module;
     if (useThreads) {
       try {
-        const { default: factory } = await import('./casual3d-format-mt.js');
+        const { default: factory } = await import(/* @vite-ignore */ new URL('casual3d-format-mt.js', baseUrl).href);
         // A copy: the factory writes its module into the object it is given,
         // which the fallback below must not inherit.
         module = await factory({ ...options });
@@ -84,7 +86,7 @@ export class FormatModule {
       }
     }
     if (!module) {
-      const { default: factory } = await import('./casual3d-format.js');
+      const { default: factory } = await import(/* @vite-ignore */ new URL('casual3d-format.js', baseUrl).href);
       module = await factory(options);
     }
     // Under Node the threaded build's workers would keep the process alive
@@ -179,6 +181,26 @@ export class FormatModule {
     }
   }
 
+  /**
+   * The directory of a single-file container (.c3d, spec/package.md Sec. 8) of
+   * `totalSize` bytes from its first bytes `prefix`: {entries: [{path, offset,
+   * size}]} once the prefix holds the whole directory, else {needed}: how many
+   * bytes from the start to supply next. Throws on an invalid container.
+   */
+  singleFileDirectory(prefix, totalSize) {
+    const m = this.m;
+    const out = m._malloc(8);
+    try {
+      const p = m._c3d_single_file_directory(this._copyToScratch(prefix), prefix.length, totalSize, out);
+      const needed = new Float64Array(heapU8(m).buffer, out, 1)[0];
+      if (p) return { entries: JSON.parse(m.UTF8ToString(p)) };
+      if (needed > 0) return { needed };
+      throw this._error();
+    } finally {
+      m._free(out);
+    }
+  }
+
   /** Opens a package from the bytes of its manifest.json. */
   openPackage(manifestBytes) {
     const ptr = this._copyIn(manifestBytes);
@@ -222,6 +244,27 @@ export class Panorama {
     const w = this.width, h = this.height;
     const ptr = m._c3d_panorama_atlas_rgba(this.ptr);
     return { width: w, height: 2 * h, data: copyOut(m, Uint8Array, ptr, w * h * 2 * 4) };
+  }
+
+  /**
+   * The nodes of layer 0 (front) or 1 (back), copied out: {present, rgb,
+   * depth (metres), normal, label, links}, row-major, width * height elements
+   * (times 3 for rgb and normal), absent nodes zero (spec/data-model.md).
+   */
+  layer(layer) {
+    const m = this.format.m;
+    const n = this.width * this.height;
+    const field = (index, Type, count) => copyOut(m, Type, m._c3d_panorama_layer(this.ptr, layer, index), count);
+    if (layer !== 0 && layer !== 1) throw new Error(`layer ${layer}: 0 (front) or 1 (back)`);
+    return {
+      present: field(0, Uint8Array, n), rgb: field(1, Uint8Array, 3 * n), depth: field(2, Float32Array, n),
+      normal: field(3, Float32Array, 3 * n), label: field(4, Uint8Array, n), links: field(5, Uint8Array, n),
+    };
+  }
+
+  /** FormatModule.buildMesh of this panorama. */
+  mesh(options) {
+    return this.format.buildMesh(this, options);
   }
 
   free() {

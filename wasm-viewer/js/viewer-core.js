@@ -18,6 +18,7 @@
 // surface is (environment.js), and holds the eye inside the package's viewing
 // volume; key speed and mouse parallax scale with that volume.
 
+import { assetUrl } from './assets.js';
 import { Camera, clamp, lookAlong, multiply } from './camera.js';
 import { Renderer, DEFAULT_EFFECTS } from './renderer.js';
 import { wrapDeg } from './view-hints.js';
@@ -92,7 +93,7 @@ export class Casual3dViewer extends EventTarget {
     const id = ++this._loadId;
     const manifestUrl = new URL(url, document.baseURI).href;
     if (!this._worker) {
-      this._worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+      this._worker = new Worker(assetUrl('worker.js'), { type: 'module' });
       this._worker.onmessage = (e) => this._onWorkerMessage(e.data);
       this._worker.onerror = (e) => {
         e.preventDefault();

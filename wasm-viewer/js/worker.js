@@ -1,4 +1,5 @@
-// The viewer's decoding worker: fetches a package level by level (coarsest
+// The viewer's decoding worker: fetches a package (a folder's manifest.json or
+// a .c3d file, read in HTTP ranges; package-source.js) level by level (coarsest
 // first), checks every file against the manifest's size and SHA-256, decodes
 // tile images with the browser's decoder, assembles and validates each level's
 // two-layer panorama and builds its mesh with the wasm format library, then
@@ -21,6 +22,8 @@
 //               {type: 'done', id, levels, bytes}
 
 import { FormatModule } from './format-module.js';
+import { Casual3dPackage } from './format.js';
+import { openUrl } from './package-source.js';
 import { decodeImage } from './tile-decoder.js';
 import { buildEnvironment } from './environment.js';
 import { deriveViewHints, narrowContent, parseViewHints, presenceFromMesh } from './view-hints.js';
@@ -47,42 +50,6 @@ self.onmessage = (e) => {
   });
 };
 
-async function fetchBytes(url, name) {
-  let response;
-  try {
-    response = await fetch(url);
-  } catch {
-    throw new Error(`${name}: cannot be fetched (network error)`);
-  }
-  if (!response.ok) throw new Error(`${name}: HTTP ${response.status} ${response.statusText || ''}`.trim());
-  try {
-    return new Uint8Array(await response.arrayBuffer());
-  } catch {
-    throw new Error(`${name}: the download was interrupted`);
-  }
-}
-
-/**
- * Runs `task(item)` over `items` with at most `limit` in flight. On the first
- * failure no new task starts; it waits for the running ones to settle (so none
- * touches the reader afterwards) and then throws that failure.
- */
-async function forEachLimited(items, limit, task) {
-  let next = 0;
-  let failure = null;
-  const runners = Array.from({ length: Math.min(limit, items.length) }, async () => {
-    while (next < items.length && !failure) {
-      try {
-        await task(items[next++]);
-      } catch (err) {
-        failure ??= err;
-      }
-    }
-  });
-  await Promise.all(runners);
-  if (failure) throw failure;
-}
-
 async function load({ id, url, maxLevelWidth, maxTriangles }) {
   const check = () => {
     if (id !== currentId) throw new Superseded();
@@ -95,14 +62,16 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
   }
   const format = await formatPromise;
   check();
-  const manifestBytes = await fetchBytes(url, 'manifest.json');
+  const source = await openUrl(format, url);
   check();
-  const reader = format.openPackage(manifestBytes);
+  const { manifestBytes } = source;
+  const pkg = new Casual3dPackage(format, source, decodeImage);
+  const reader = pkg.reader;
   // The reader accepted the bytes, so they are JSON; the optional "view"
   // member is checked here (a bad one is ignored with a warning).
   let packageView;
   try {
-    packageView = parseViewHints(JSON.parse(new TextDecoder().decode(manifestBytes)).view);
+    packageView = parseViewHints(pkg.manifest.view);
   } catch (err) {
     packageView = { hints: null, warning: `manifest.json: "view" ignored: ${err.message || err}` };
   }
@@ -144,26 +113,19 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
           return Math.min(d, 360 - d);
         };
         const order = info.tiles.map((tile, t) => t).sort((a, b) => away(info.tiles[a]) - away(info.tiles[b]) || a - b);
-        const jobs = [];
-        for (const t of order) info.tiles[t].files.forEach((file, kind) => jobs.push({ t, kind, file }));
         // Fetch and check in parallel; decode in order of arrival. The reader
         // accepts images in any order.
-        await forEachLimited(jobs, FETCH_CONCURRENCY, async ({ t, kind, file }) => {
-          const bytes = await fetchBytes(new URL(file.path, url).href, file.path);
-          check();
-          reader.checkFile(file.path, bytes);
-          loadedBytes += bytes.length;
-          const image = await decodeImage(bytes, file.path);
-          check();
-          if (image.width !== file.width || image.height !== file.height) {
-            throw new Error(`${file.path}: ${image.width}x${image.height} pixels, expected ${file.width}x${file.height}`);
-          }
-          reader.addImage(level, t, kind, image.data, image.width, image.height, 4);
-          progress(level, false);
+        const pano = await pkg.readLevel(level, {
+          tiles: order,
+          concurrency: FETCH_CONCURRENCY,
+          onFile: (bytes) => {
+            check();
+            loadedBytes += bytes.length;
+            progress(level, false);
+          },
         });
         timing.fetchDecodeMs = performance.now() - t0;
         const t1 = performance.now();
-        const pano = reader.assemble(level);
         let mesh, atlas;
         try {
           // The full mesh has about 2 triangles per node; simplify above the budget.
@@ -198,7 +160,7 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
     }
     if (shown > 0) self.postMessage({ type: 'done', id, levels: shown, bytes: loadedBytes });
   } finally {
-    reader.free();
+    pkg.close();
   }
 }
 

@@ -10,6 +10,7 @@
 
 #include <emscripten/emscripten.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -27,6 +28,7 @@
 #include "format/package_reader.h"
 #include "format/parallel.h"
 #include "format/sha256.h"
+#include "format/single_file.h"
 #include "format/tile_codec.h"
 #include "format/two_layer.h"
 #include "wasm-viewer/src/panorama_blob.h"
@@ -129,6 +131,25 @@ EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_panorama_atlas_rgba(Panorama* p) {
   casual3d::Image8 atlas = casual3d::BuildColourAtlas(p->pano, 4);
   p->atlas = std::move(atlas.vector());
   return p->atlas.data();
+}
+
+// One array of one layer (0 front, 1 back) of the panorama, width*height
+// elements (times 3 for rgb and normal), row-major, absent nodes zero (format/
+// two_layer.h LayerData): field 0 present (bytes), 1 rgb (bytes), 2 depth_m
+// (float32), 3 normal (float32), 4 label (bytes), 5 links (bytes). Owned by
+// the panorama; null for an unknown layer or field.
+EMSCRIPTEN_KEEPALIVE const void* c3d_panorama_layer(const Panorama* p, int layer, int field) {
+  if (layer < 0 || layer > 1) return nullptr;
+  const casual3d::LayerData& L = p->pano.layer(layer);
+  switch (field) {
+    case 0: return L.present.data();
+    case 1: return L.rgb.data();
+    case 2: return L.depth_m.data();
+    case 3: return L.normal.data();
+    case 4: return L.label.data();
+    case 5: return L.links.data();
+    default: return nullptr;
+  }
 }
 
 // --- Meshes --------------------------------------------------------------------
@@ -304,6 +325,70 @@ EMSCRIPTEN_KEEPALIVE Panorama* c3d_reader_assemble(Reader* r, int level) {
   p->pano = std::move(pano).value();
   p->validated = true;  // FinishLevel validated it.
   return p;
+}
+
+// --- Single-file containers (.c3d) ----------------------------------------------
+
+// The directory of a single-file container of `total_size` bytes from its first
+// `available` bytes (data), for a reader that fetches the file in ranges. As
+// JSON [{"path", "offset", "size"}] (owned by the library until the next call),
+// checked as ParseSingleFileDirectory checks it. When the directory reaches
+// past `available`, returns null with *needed set to the bytes to fetch before
+// calling again; on an invalid container returns null with the error set and
+// *needed 0.
+EMSCRIPTEN_KEEPALIVE const char* c3d_single_file_directory(const uint8_t* data, size_t available,
+                                                           double total_size, double* needed) {
+  static std::string json;
+  *needed = 0;
+  const uint64_t total = static_cast<uint64_t>(total_size);
+  if (available > total) available = static_cast<size_t>(total);
+  auto le = [data](size_t at, int n) {
+    uint64_t v = 0;
+    for (int i = n - 1; i >= 0; --i) v = (v << 8) | data[at + i];
+    return v;
+  };
+  // Walk the directory's entry lengths to find where it ends. Only a header
+  // that ParseSingleFileDirectory accepts is walked; it refuses any other from
+  // the first 16 bytes alone, and reads no further than the directory's end.
+  if (available < total) {
+    if (available < 16) {
+      *needed = static_cast<double>(std::min<uint64_t>(total, 16));
+      return nullptr;
+    }
+    const uint64_t count = le(12, 4);
+    const bool header_ok = std::memcmp(data, casual3d::kSingleFileMagic, 8) == 0 &&
+                           le(8, 2) == casual3d::kSingleFileVersionMajor && count > 0 &&
+                           count <= casual3d::kMaxSingleFileEntries && count * 19 <= total - 16;
+    if (header_ok) {
+      uint64_t pos = 16;
+      bool complete = true;
+      for (uint64_t i = 0; i < count && complete; ++i) {
+        complete = pos + 2 <= available;
+        if (complete) pos += 2 + le(static_cast<size_t>(pos), 2) + 16;
+        complete = complete && pos <= available;
+      }
+      if (!complete) {
+        // At least twice as much, so that a long directory takes few round trips.
+        *needed = static_cast<double>(
+            std::min<uint64_t>(total, std::max<uint64_t>(pos + 273, 2 * uint64_t{available})));
+        return nullptr;
+      }
+    }
+  }
+  auto entries = casual3d::ParseSingleFileDirectory(data, static_cast<size_t>(total));
+  if (!entries.ok()) {
+    SetError(entries.status());
+    return nullptr;
+  }
+  using casual3d::viewer::JsonString;
+  json = "[";
+  for (size_t i = 0; i < entries->size(); ++i) {
+    const casual3d::SingleFileEntry& e = (*entries)[i];
+    json += (i ? ",{" : "{") + std::string("\"path\":") + JsonString(e.path) +
+            ",\"offset\":" + std::to_string(e.offset) + ",\"size\":" + std::to_string(e.size) + "}";
+  }
+  json += "]";
+  return json.c_str();
 }
 
 }  // extern "C"

@@ -1,0 +1,132 @@
+// casual3d-viewer/format under Node: the API of format.js, reading packages
+// from the file system (a folder, its manifest.json or a .c3d file, read in
+// ranges with positioned reads) as well as URLs, with the wasm format library
+// and a wasm WebP decoder (@jsquash/webp) in place of the browser's.
+//
+//   import { openPackage } from 'casual3d-viewer/format';
+//   const pkg = await openPackage('photo.c3d');
+//   const pano = await pkg.readLevel(0);
+//   console.log(pano.width, pano.layer(0).depth);
+//   pano.free();
+//   pkg.close();
+
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import path from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+
+import { Casual3dPackage } from './format.js';
+import { FormatModule } from './format-module.js';
+import { isSingleFile, memoryRanges, blobRanges, openSingleFile, openUrl } from './package-source.js';
+
+export { Casual3dPackage } from './format.js';
+export { FormatModule, Panorama, PackageReader } from './format-module.js';
+
+const HERE = path.dirname(fileURLToPath(import.meta.url));
+const require = createRequire(import.meta.url);
+
+// Emscripten's ES6 loader reaches for CommonJS' require and __dirname under Node.
+globalThis.require ??= require;
+globalThis.__dirname ??= HERE;
+
+const formats = new Map();
+
+/**
+ * The format library, created once per `threads`: true (default) for the
+ * threaded build (min(cores, 4) threads), false for the single-threaded one.
+ */
+export function createFormat({ threads = true } = {}) {
+  const key = threads === false ? 'st' : 'mt';
+  if (!formats.has(key)) {
+    const wasmBinary = fs.readFileSync(path.join(HERE, key === 'mt' ? 'casual3d-format-mt.wasm' : 'casual3d-format.wasm'));
+    const created = FormatModule.create({ threads: key === 'mt', wasmBinary });
+    created.catch(() => formats.delete(key));
+    formats.set(key, created);
+  }
+  return formats.get(key);
+}
+
+let webpDecode = null;
+
+/** Decodes a WebP tile image to RGBA with @jsquash/webp's wasm libwebp. */
+async function decodeWebp(bytes, name) {
+  if (!webpDecode) {
+    globalThis.ImageData ??= class ImageData {
+      constructor(data, width, height) {
+        this.data = data;
+        this.width = width;
+        this.height = height;
+      }
+    };
+    const dir = path.dirname(require.resolve('@jsquash/webp/package.json'));
+    const { default: decode, init } = await import(pathToFileURL(path.join(dir, 'decode.js')).href);
+    await init(await WebAssembly.compile(fs.readFileSync(path.join(dir, 'codec', 'dec', 'webp_dec.wasm'))));
+    webpDecode = decode;
+  }
+  try {
+    return await webpDecode(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength));
+  } catch {
+    throw new Error(`${name}: not a decodable image (corrupt or truncated file)`);
+  }
+}
+
+/** Byte ranges of a file, read with positioned reads. */
+function fileRanges(file) {
+  return {
+    size: fs.statSync(file).size,
+    read: async (offset, length) => {
+      const handle = await fs.promises.open(file, 'r');
+      try {
+        const bytes = new Uint8Array(length);
+        const { bytesRead } = await handle.read(bytes, 0, length, offset);
+        if (bytesRead !== length) throw new Error(`${file}: ended after ${offset + bytesRead} bytes`);
+        return bytes;
+      } finally {
+        await handle.close();
+      }
+    },
+  };
+}
+
+/** A package folder on disk (`dir` holds manifest.json). */
+async function openFolder(dir) {
+  const manifestBytes = new Uint8Array(await fs.promises.readFile(path.join(dir, 'manifest.json')));
+  // The reader has checked every path it hands out (no "..", not absolute).
+  return { kind: 'folder', manifestBytes, read: async (p) => new Uint8Array(await fs.promises.readFile(path.join(dir, p))) };
+}
+
+/**
+ * Opens a package: a path (or file: URL) of a package folder, its
+ * manifest.json or a .c3d file; an http(s) URL as in browsers (.c3d files in
+ * range requests); a Blob; or the bytes of a .c3d. Options: `format` (default:
+ * createFormat()), `fetch` (for URLs; default: the global fetch).
+ */
+export async function openPackage(input, { format, fetch: fetchFn = globalThis.fetch } = {}) {
+  format ??= await createFormat();
+  let source;
+  if (input instanceof ArrayBuffer || ArrayBuffer.isView(input)) {
+    const bytes = input instanceof ArrayBuffer ? new Uint8Array(input)
+      : new Uint8Array(input.buffer, input.byteOffset, input.byteLength);
+    source = await openSingleFile(format, memoryRanges(bytes));
+  } else if (input instanceof Blob) {
+    source = await openSingleFile(format, blobRanges(input), input.name || 'single file');
+  } else if (/^https?:/i.test(String(input))) {
+    source = await openUrl(format, String(input), { fetch: fetchFn });
+  } else {
+    const file = String(input).startsWith('file:') ? fileURLToPath(String(input)) : String(input);
+    const stat = await fs.promises.stat(file).catch(() => {
+      throw new Error(`${file}: no such file or folder`);
+    });
+    if (stat.isDirectory()) {
+      source = await openFolder(file);
+    } else if (path.basename(file) === 'manifest.json') {
+      source = await openFolder(path.dirname(file));
+    } else {
+      const ranges = fileRanges(file);
+      const head = await ranges.read(0, Math.min(ranges.size, 8));
+      if (!isSingleFile(head)) throw new Error(`${file}: neither a package folder, its manifest.json nor a .c3d file`);
+      source = await openSingleFile(format, ranges, path.basename(file));
+    }
+  }
+  return new Casual3dPackage(format, source, decodeWebp);
+}
