@@ -83,10 +83,7 @@ void AddEncodeCommand(CLI::App& app) {
                   "Bits per octahedral normal coordinate, 4..8 (default 8)");
   cmd->add_option("--threads", options->package.num_threads, "Encoding threads; 0 = all cores");
   cmd->add_flag("!--no-viewer", options->viewer, "Do not add index.html and the viewer");
-  cmd->callback([options] {
-    options->package.generator = "casual3d 0.1.0";
-    RunEncode(*options);
-  });
+  cmd->callback([options] { RunEncode(*options); });
 }
 
 }  // namespace casual3d::cli

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command.h"
+#include "format/version.h"
 #include "reconstruct/util/log.h"
 
 namespace casual3d::cli {
@@ -59,7 +60,7 @@ int main(int argc, char** argv) {
   casual3d::cli::RestartWithHugePages(argv);
   using casual3d::cli::g_options;
   CLI::App app{"casual3d: turns a few dozen hand-held photos into a 3D photo"};
-  app.set_version_flag("--version", std::string("casual3d 0.1.0"));
+  app.set_version_flag("--version", std::string("casual3d ") + casual3d::kVersion);
   app.require_subcommand(1);
   app.add_flag("--verbose,-v", g_options.verbose, "More detail on stderr");
   app.add_flag("--json", g_options.json, "Log as JSON lines on stderr");

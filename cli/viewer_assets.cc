@@ -75,10 +75,10 @@ fs::path FindViewerDir() {
   if (const char* env = std::getenv("CASUAL3D_VIEWER_DIR"); env && *env)
     candidates.emplace_back(env);
   const fs::path exe_dir = ExecutableDir();
-  if (!exe_dir.empty()) candidates.push_back(exe_dir / ".." / "share" / "casual3d" / "viewer");
-#ifdef CASUAL3D_VIEWER_BUILD_DIR
-  candidates.emplace_back(CASUAL3D_VIEWER_BUILD_DIR);
-#endif
+  if (!exe_dir.empty()) {
+    candidates.push_back(exe_dir / CASUAL3D_VIEWER_INSTALLED_RELDIR);
+    candidates.push_back(exe_dir / CASUAL3D_VIEWER_BUILD_RELDIR);
+  }
   std::string searched;
   for (const fs::path& dir : candidates) {
     if (HoldsViewer(dir)) return dir.lexically_normal();

@@ -6,9 +6,11 @@
 //
 // Where the viewer files are found, first match wins:
 //   1. $CASUAL3D_VIEWER_DIR (a folder holding casual3d-viewer.js and friends);
-//   2. <dir of the casual3d binary>/../share/casual3d/viewer (the install layout);
-//   3. the build tree's <build>/wasm-viewer/dist (compiled in by CMake), so a
-//      freshly built, uninstalled binary works too.
+//   2. <folder of the casual3d binary>/../share/casual3d/viewer (the install
+//      layout; relative, so an installed prefix can be moved);
+//   3. <folder of the casual3d binary>/../wasm-viewer/dist (the build tree's
+//      layout), so a freshly built, uninstalled binary works too.
+// Both relative paths come from CMake (cli/CMakeLists.txt).
 
 #include <filesystem>
 #include <string>

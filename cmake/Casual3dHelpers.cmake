@@ -10,7 +10,9 @@ set(CASUAL3D_WARNINGS -Wall -Wextra -Wno-unused-parameter -Wno-sign-compare)
 function(casual3d_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS;PRIVATE_DEPS" ${ARGN})
   add_library(${ARG_NAME} STATIC ${ARG_SRCS})
-  target_include_directories(${ARG_NAME} PUBLIC ${PROJECT_SOURCE_DIR})
+  # Inside the tree, headers are included as "format/x.h"; installed ones carry
+  # their own include directory (cmake/Casual3dSdk.cmake).
+  target_include_directories(${ARG_NAME} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
   target_link_libraries(${ARG_NAME} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   target_compile_options(${ARG_NAME} PRIVATE ${CASUAL3D_WARNINGS})
 endfunction()

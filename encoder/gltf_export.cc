@@ -28,6 +28,7 @@
 #define TINYGLTF_IMPLEMENTATION
 #include "encoder/gltf_tinygltf.h"
 #include "format/colour_atlas.h"
+#include "format/version.h"
 
 namespace casual3d::encoder {
 namespace {
@@ -516,7 +517,7 @@ StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
 
   tinygltf::Model model;
   model.asset.version = "2.0";
-  model.asset.generator = "casual3d";
+  model.asset.generator = std::string("casual3d ") + kVersion;
   model.buffers.resize(1);
 
   tinygltf::Primitive primitive;

@@ -13,6 +13,7 @@
 #include "format/manifest.h"
 #include "format/status.h"
 #include "format/two_layer.h"
+#include "format/version.h"
 
 namespace casual3d::encoder {
 
@@ -36,8 +37,8 @@ struct PackageOptions {
   int normal_bits = 8;
   // Threads encoding tiles; 0 = all cores.
   int num_threads = 0;
-  // Written to the manifest's "generator" member.
-  std::string generator = "casual3d";
+  // Written to the manifest's "generator" member: the writing program.
+  std::string generator = std::string("casual3d ") + kVersion;
 
   Status Check() const;
 };
