@@ -7,8 +7,8 @@
 namespace casual3d {
 namespace {
 
-Status CheckPath(const std::string& path) {
-  if (!IsSafePackagePath(path))
+Status CheckPath(const std::string& path, const ReaderChecks& checks = ReaderChecks()) {
+  if (!IsSafePackagePath(path) && checks.on(ReaderCheck::kPathEscape))
     return InvalidArgument("\"" + path.substr(0, 80) +
                            "\" is not a safe relative path inside the package");
   return Status::Ok();
@@ -31,23 +31,27 @@ StatusOr<std::vector<uint8_t>> MemoryFileSource::Read(const std::string& path,
 }
 
 StatusOr<std::unique_ptr<SingleFileSource>> SingleFileSource::Create(
-    std::vector<uint8_t> container) {
+    std::vector<uint8_t> container, const ReaderChecks& checks) {
   CASUAL3D_ASSIGN_OR_RETURN(std::vector<SingleFileEntry> entries,
-                            ParseSingleFileDirectory(container.data(), container.size()));
+                            ParseSingleFileDirectory(container.data(), container.size(), checks));
   std::unique_ptr<SingleFileSource> source(new SingleFileSource());
   source->bytes_ = std::move(container);
   source->entries_ = std::move(entries);
+  source->checks_ = checks;
   for (size_t i = 0; i < source->entries_.size(); ++i)
-    source->index_[source->entries_[i].path] = i;
+    source->index_.emplace(source->entries_[i].path, i);
   return source;
 }
 
 StatusOr<std::vector<uint8_t>> SingleFileSource::Read(const std::string& path,
                                                       uint64_t max_bytes) const {
-  CASUAL3D_RETURN_IF_ERROR(CheckPath(path));
+  CASUAL3D_RETURN_IF_ERROR(CheckPath(path, checks_));
   auto it = index_.find(path);
   if (it == index_.end()) return NotFound(path + ": no such entry in the single file");
   const SingleFileEntry& e = entries_[it->second];
+  // Kept by the directory only with the entry-outside-file check off.
+  if (e.offset > bytes_.size() || e.size > bytes_.size() - e.offset)
+    return InvalidData(path + ": the entry's data range lies outside the single file");
   if (e.size > max_bytes) return TooLarge(path, e.size, max_bytes);
   const uint8_t* begin = bytes_.data() + e.offset;
   return std::vector<uint8_t>(begin, begin + e.size);
@@ -79,22 +83,23 @@ StatusOr<std::vector<uint8_t>> ReadWholeFile(const std::string& path, uint64_t m
 
 StatusOr<std::vector<uint8_t>> FolderFileSource::Read(const std::string& path,
                                                       uint64_t max_bytes) const {
-  CASUAL3D_RETURN_IF_ERROR(CheckPath(path));
+  CASUAL3D_RETURN_IF_ERROR(CheckPath(path, checks_));
   return ReadWholeFile(root_ + "/" + path, max_bytes);
 }
 
 StatusOr<std::unique_ptr<FileSource>> OpenPackage(const std::string& path,
-                                                  uint64_t max_single_file_bytes) {
+                                                  uint64_t max_single_file_bytes,
+                                                  const ReaderChecks& checks) {
   if (std::FILE* f = std::fopen((path + "/" + kManifestFileName).c_str(), "rb")) {
     std::fclose(f);
-    return std::unique_ptr<FileSource>(new FolderFileSource(path));
+    return std::unique_ptr<FileSource>(new FolderFileSource(path, checks));
   }
   StatusOr<std::vector<uint8_t>> bytes = ReadWholeFile(path, max_single_file_bytes);
   if (!bytes.ok())
     return Status(bytes.status().code(),
                   path + ": not a package folder (no manifest.json) nor a readable .c3d file: " +
                       bytes.status().message());
-  StatusOr<std::unique_ptr<SingleFileSource>> single = SingleFileSource::Create(std::move(*bytes));
+  StatusOr<std::unique_ptr<SingleFileSource>> single = SingleFileSource::Create(std::move(*bytes), checks);
   if (!single.ok())
     return Status(single.status().code(), path + ": not a package folder (no manifest.json) "
                                                  "nor a valid .c3d file: " +

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "format/reader_checks.h"
 #include "format/single_file.h"
 #include "format/status.h"
 
@@ -39,8 +40,10 @@ class MemoryFileSource : public FileSource {
 // The entries of a single-file container (single_file.h) held in memory.
 class SingleFileSource : public FileSource {
  public:
-  // Parses the container's directory; fails as ParseSingleFileDirectory does.
-  static StatusOr<std::unique_ptr<SingleFileSource>> Create(std::vector<uint8_t> container);
+  // Parses the container's directory; fails as ParseSingleFileDirectory does
+  // with `checks`. Of entries sharing a path, the first is read.
+  static StatusOr<std::unique_ptr<SingleFileSource>> Create(
+      std::vector<uint8_t> container, const ReaderChecks& checks = ReaderChecks());
   StatusOr<std::vector<uint8_t>> Read(const std::string& path, uint64_t max_bytes) const override;
   const std::vector<SingleFileEntry>& entries() const { return entries_; }
 
@@ -48,24 +51,30 @@ class SingleFileSource : public FileSource {
   std::vector<uint8_t> bytes_;
   std::vector<SingleFileEntry> entries_;
   std::map<std::string, size_t> index_;
+  ReaderChecks checks_;
 };
 
 // Files of a package folder on disk. Paths are checked with IsSafePackagePath
-// before they touch the file system, so they cannot leave `root`.
+// before they touch the file system, so they cannot leave `root` (unless the
+// path-escape check is off in `checks`: conformance tests only).
 class FolderFileSource : public FileSource {
  public:
-  explicit FolderFileSource(std::string root) : root_(std::move(root)) {}
+  explicit FolderFileSource(std::string root, const ReaderChecks& checks = ReaderChecks())
+      : root_(std::move(root)), checks_(checks) {}
   StatusOr<std::vector<uint8_t>> Read(const std::string& path, uint64_t max_bytes) const override;
 
  private:
   std::string root_;
+  ReaderChecks checks_;
 };
 
 // Opens a package given as a folder (holding manifest.json) or as a
 // single-file container (read whole into memory, at most `max_single_file_bytes`).
-// Errors name `path` and say which form was expected.
+// Errors name `path` and say which form was expected. `checks` as for
+// FolderFileSource and SingleFileSource.
 StatusOr<std::unique_ptr<FileSource>> OpenPackage(const std::string& path,
-                                                  uint64_t max_single_file_bytes = 1ull << 31);
+                                                  uint64_t max_single_file_bytes = 1ull << 31,
+                                                  const ReaderChecks& checks = ReaderChecks());
 
 // Reads a whole file from disk, refusing files above `max_bytes`.
 StatusOr<std::vector<uint8_t>> ReadWholeFile(const std::string& path, uint64_t max_bytes);

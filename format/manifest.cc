@@ -158,8 +158,8 @@ uint64_t Manifest::LevelBytes(int level) const {
   return total;
 }
 
-Status Manifest::Validate() const {
-  if (version_major != kPackageVersionMajor)
+Status Manifest::Validate(const ReaderChecks& checks) const {
+  if (version_major != kPackageVersionMajor && checks.on(ReaderCheck::kUnknownMajor))
     return UnsupportedVersion("version " + std::to_string(version_major) + "." +
                               std::to_string(version_minor) +
                               " is not supported (this reader reads 1.x)");
@@ -181,6 +181,10 @@ Status Manifest::Validate() const {
                          std::to_string(kMinTileSize) + ", " + std::to_string(kMaxTileSize) + "]");
   Status depth_ok = depth.Check();
   if (!depth_ok.ok()) return InvalidData("depth_encoding: " + depth_ok.message());
+  // The log encoding divides by ln(far_m / near_m) (spec/package.md Sec. 4.2).
+  if (!(depth.far_m > depth.near_m) && checks.on(ReaderCheck::kNearEqualsFar))
+    return InvalidData("depth_encoding: near_m = far_m = " + Reader::Format(depth.near_m) +
+                       "; the log encoding needs far_m > near_m");
   Status normal_ok = normal.Check();
   if (!normal_ok.ok()) return InvalidData("normal_encoding: " + normal_ok.message());
   if (levels.empty() || levels.size() > static_cast<size_t>(kMaxLevels))
@@ -189,7 +193,7 @@ Status Manifest::Validate() const {
   for (size_t i = 0; i < files.size(); ++i) {
     const FileEntry& f = files[i];
     const std::string where = "files[" + std::to_string(i) + "]";
-    if (!IsSafePackagePath(f.path))
+    if (!IsSafePackagePath(f.path) && checks.on(ReaderCheck::kPathEscape))
       return InvalidData(where + ".path: \"" + f.path.substr(0, 80) +
                          "\" is not a safe relative path inside the package");
     if (f.path == kManifestFileName)
@@ -227,7 +231,7 @@ Status Manifest::Validate() const {
     for (size_t t = 0; t < L.tiles.size(); ++t) {
       for (int k = 0; k < kNumTileImageKinds; ++k) {
         const std::string& p = L.tiles[t].files[k];
-        if (!IsSafePackagePath(p))
+        if (!IsSafePackagePath(p) && checks.on(ReaderCheck::kPathEscape))
           return InvalidData(where + ".tiles[" + std::to_string(t) + "]." +
                              TileImageKindName(static_cast<TileImageKind>(k)) + ": \"" +
                              p.substr(0, 80) + "\" is not a safe relative path inside the package");
@@ -247,10 +251,11 @@ Status Manifest::Validate() const {
   return Status::Ok();
 }
 
-StatusOr<Manifest> ParseManifest(std::string_view bytes) {
+StatusOr<Manifest> ParseManifest(std::string_view bytes, const ReaderChecks& checks) {
   json::ParseLimits limits;
   limits.max_bytes = kMaxManifestBytes;
-  limits.max_depth = 16;
+  // Without the nesting rule, still a bound on the parser's recursion.
+  limits.max_depth = checks.on(ReaderCheck::kNestingTooDeep) ? kMaxManifestNesting : 64;
   limits.max_values = 1u << 20;  // Bounds memory (about 100 MB) on hostile input.
   StatusOr<Value> parsed = json::Parse(bytes, limits);
   if (!parsed.ok())
@@ -285,7 +290,7 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes) {
     };
     m.version_major = number(0, dot);
     m.version_minor = number(dot + 1, version.size());
-    if (m.version_major != kPackageVersionMajor)
+    if (m.version_major != kPackageVersionMajor && checks.on(ReaderCheck::kUnknownMajor))
       return fail(UnsupportedVersion("version " + version +
                                      " is not supported (this reader reads 1.x)"));
   }
@@ -376,7 +381,7 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes) {
     m.levels.push_back(std::move(L));
   }
 #undef C3D_CHECK
-  Status valid = m.Validate();
+  Status valid = m.Validate(checks);
   if (!valid.ok()) return fail(valid);
   return m;
 }

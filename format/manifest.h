@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "format/equirect.h"
+#include "format/reader_checks.h"
 #include "format/status.h"
 #include "format/tile_codec.h"
 #include "format/view_hints.h"
@@ -90,8 +91,10 @@ struct Manifest {
 
   // Checks everything a reader relies on: version, limits, the level sizes and
   // tile grids, that every tile path is a safe relative path listed in
-  // `files` exactly once, sizes and checksums well formed, depth encoding.
-  Status Validate() const;
+  // `files` exactly once, sizes and checksums well formed, depth encoding
+  // (near_m < far_m). The named rules among these (unknown-major,
+  // path-escape, near-equals-far) are enforced only when on in `checks`.
+  Status Validate(const ReaderChecks& checks = ReaderChecks()) const;
 };
 
 // True if `path` is a safe package-relative path: 1..255 bytes of
@@ -99,9 +102,17 @@ struct Manifest {
 // starting with '/', so that it cannot escape the package folder.
 bool IsSafePackagePath(std::string_view path);
 
+// The nesting limit of manifest.json: arrays and objects enclosing each other,
+// the root object counting 1 (spec/package.md Sec. 3).
+constexpr int kMaxManifestNesting = 16;
+
 // Parses and validates manifest.json. Errors name the field ("levels[1].tiles[3]:
-// ...") or the byte offset of a JSON syntax error.
-StatusOr<Manifest> ParseManifest(std::string_view bytes);
+// ...") or the byte offset of a JSON syntax error. Integer members accept any
+// JSON number with an integral value (64, 64.0 and 6.4e1 alike). The named
+// rules (unknown-major, nesting-too-deep and those of Validate) are enforced
+// when on in `checks`.
+StatusOr<Manifest> ParseManifest(std::string_view bytes,
+                                 const ReaderChecks& checks = ReaderChecks());
 
 // Serializes a manifest as pretty-printed JSON (2-space indent, trailing newline).
 std::string SerializeManifest(const Manifest& manifest);

@@ -9,13 +9,22 @@
 
 namespace casual3d {
 
-PackageReader::PackageReader(Manifest manifest)
+PackageReader::PackageReader(Manifest manifest, const ReaderChecks& checks)
     : manifest_(std::move(manifest)),
-      tile_decoder_(std::make_shared<TileDecoder>(manifest_.quantization())) {}
+      checks_(checks),
+      file_kinds_(manifest_.files.size(), -1),
+      tile_decoder_(std::make_shared<TileDecoder>(manifest_.quantization(), checks)) {
+  for (const LevelEntry& L : manifest_.levels)
+    for (const TileEntry& t : L.tiles)
+      for (int k = 0; k < kNumTileImageKinds; ++k)
+        if (const FileEntry* f = manifest_.FindFile(t.files[k]))
+          file_kinds_[f - manifest_.files.data()] = static_cast<int8_t>(k);
+}
 
-StatusOr<PackageReader> PackageReader::Create(std::string_view manifest_bytes) {
-  CASUAL3D_ASSIGN_OR_RETURN(Manifest manifest, ParseManifest(manifest_bytes));
-  return PackageReader(std::move(manifest));
+StatusOr<PackageReader> PackageReader::Create(std::string_view manifest_bytes,
+                                              const ReaderChecks& checks) {
+  CASUAL3D_ASSIGN_OR_RETURN(Manifest manifest, ParseManifest(manifest_bytes, checks));
+  return PackageReader(std::move(manifest), checks);
 }
 
 std::vector<std::string> PackageReader::FilesForLevel(int level) const {
@@ -30,11 +39,23 @@ Status PackageReader::VerifyFile(const std::string& path, const uint8_t* data,
                                  size_t size) const {
   const FileEntry* f = manifest_.FindFile(path);
   if (f == nullptr) return NotFound(path + ": not listed in the manifest");
-  if (size != f->bytes)
+  if (size != f->bytes && checks_.on(ReaderCheck::kSizeMismatch))
     return InvalidData(path + ": " + std::to_string(size) + " bytes, the manifest says " +
                        std::to_string(f->bytes) + " (truncated or replaced file)");
-  if (Sha256Hex(data, size) != f->sha256)
+  if (checks_.on(ReaderCheck::kChecksumMismatch) && Sha256Hex(data, size) != f->sha256)
     return InvalidData(path + ": SHA-256 does not match the manifest (corrupt file)");
+  const int kind = file_kinds_[f - manifest_.files.data()];
+  if (kind >= 0 && TileImageIsLossless(static_cast<TileImageKind>(kind)) &&
+      checks_.on(ReaderCheck::kLossyDataTile)) {
+    const WebpCoding coding = WebpContainerCoding(data, size);
+    const char* name = TileImageKindName(static_cast<TileImageKind>(kind));
+    if (coding == WebpCoding::kLossy)
+      return InvalidData(path + ": a " + name +
+                         " image must be lossless WebP (VP8L); this one is lossy (VP8)");
+    if (coding == WebpCoding::kNotStill)
+      return InvalidData(path + ": a " + name + " image must be a still lossless WebP image; "
+                                                "this one is animated");
+  }
   return Status::Ok();
 }
 
@@ -95,14 +116,20 @@ StatusOr<TwoLayerPanorama> PackageReader::FinishLevel(int num_threads) {
                              L.tiles[i / kNumTileImageKinds].files[i % kNumTileImageKinds] +
                              " was not added");
   }
-  CASUAL3D_RETURN_IF_ERROR(FinishDecodedPanorama(&pano_, num_threads));
-  // Decoding leaves only valid node values (FinishDecodedPanorama checks the
-  // depths and clears absent nodes; the decoder's normal table holds only
-  // valid normals, tile_codec_test.cc), so the links are what remains to check.
-  Status valid = pano_.ValidateLinks(num_threads);
-  if (!valid.ok())
-    return InvalidData("level " + std::to_string(level_) + ": the decoded panorama is invalid: " +
-                       valid.message());
+  DecodedNodeProblem problem;
+  Status nodes = FinishDecodedPanorama(&pano_, num_threads, checks_, &problem);
+  if (!nodes.ok()) {
+    const int tile = problem.y / manifest_.tile_size * L.columns + problem.x / manifest_.tile_size;
+    return Status(nodes.code(),
+                  L.tiles[tile].files[static_cast<int>(problem.kind)] + ": " + nodes.message());
+  }
+  // FinishDecodedPanorama leaves only valid node values, so the links are
+  // what remains to check.
+  if (checks_.on(ReaderCheck::kLinkNotMutual)) {
+    Status valid = pano_.ValidateLinks(num_threads);
+    if (!valid.ok())
+      return InvalidData("the graph images' links are invalid: " + valid.message());
+  }
   level_ = -1;
   received_.clear();
   return std::move(pano_);
@@ -123,10 +150,13 @@ StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source, const ImageDeco
   CASUAL3D_RETURN_IF_ERROR(options.Check());
   CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> manifest_bytes,
                             source.Read(kManifestFileName, kMaxManifestBytes));
+  ReaderChecks checks = options.checks;
+  if (!options.verify_checksums) checks.Disable(ReaderCheck::kChecksumMismatch);
   CASUAL3D_ASSIGN_OR_RETURN(
       PackageReader reader,
       PackageReader::Create(std::string_view(reinterpret_cast<const char*>(manifest_bytes.data()),
-                                             manifest_bytes.size())));
+                                             manifest_bytes.size()),
+                            checks));
   if (manifest_out != nullptr) *manifest_out = reader.manifest();
   CASUAL3D_RETURN_IF_ERROR(reader.BeginLevel(options.level, options.max_pixels));
   const size_t num_tiles = reader.manifest().levels[options.level].tiles.size();
@@ -150,7 +180,7 @@ StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source, const ImageDeco
       if (!bytes.ok()) {
         s = bytes.status();
       } else {
-        if (options.verify_checksums) s = reader.VerifyFile(path, bytes->data(), bytes->size());
+        s = reader.VerifyFile(path, bytes->data(), bytes->size());
         if (s.ok()) s = reader.AddTileFile(tile, kind, bytes->data(), bytes->size(), decoder);
       }
       if (!s.ok()) {

@@ -39,8 +39,10 @@ class ImageDecoder {
 // Step-by-step reader of one package.
 class PackageReader {
  public:
-  // Parses and validates manifest.json.
-  static StatusOr<PackageReader> Create(std::string_view manifest_bytes);
+  // Parses and validates manifest.json. `checks`: the named rules to enforce
+  // (format/reader_checks.h; all by default) here and in every later step.
+  static StatusOr<PackageReader> Create(std::string_view manifest_bytes,
+                                        const ReaderChecks& checks = ReaderChecks());
 
   const Manifest& manifest() const { return manifest_; }
   int num_levels() const { return static_cast<int>(manifest_.levels.size()); }
@@ -49,7 +51,9 @@ class PackageReader {
   // colour, depth, normal, graph). Empty for a level out of range.
   std::vector<std::string> FilesForLevel(int level) const;
 
-  // Checks `size` and the SHA-256 of a fetched file against the manifest.
+  // Checks a fetched file against the manifest: its size, its SHA-256 and,
+  // for the depth, normal and graph images, that it is lossless WebP
+  // (WebpContainerCoding). Call it for every file before decoding it.
   Status VerifyFile(const std::string& path, const uint8_t* data, size_t size) const;
 
   // Starts assembling `level`: allocates its (empty) panorama. Fails with
@@ -68,16 +72,21 @@ class PackageReader {
   Status AddTileFile(int tile, TileImageKind kind, const uint8_t* data, size_t size,
                      const ImageDecoder& decoder);
 
-  // After every image of every tile was added: clears absent nodes, validates
-  // the panorama (TwoLayerPanorama::Validate) and returns it. The reader can
-  // then begin another level.
+  // After every image of every tile was added: checks present nodes and
+  // clears absent ones (FinishDecodedPanorama; a message names the tile file
+  // of a bad value), validates the links (TwoLayerPanorama::ValidateLinks)
+  // and returns the panorama. The reader can then begin another level.
   // Up to `num_threads` threads share the passes over the nodes.
   StatusOr<TwoLayerPanorama> FinishLevel(int num_threads = 1);
 
  private:
-  explicit PackageReader(Manifest manifest);
+  PackageReader(Manifest manifest, const ReaderChecks& checks);
 
   Manifest manifest_;
+  ReaderChecks checks_;
+  // Per entry of manifest_.files: the TileImageKind of the tile image using
+  // it, or -1 for an entry no tile uses.
+  std::vector<int8_t> file_kinds_;
   std::shared_ptr<TileDecoder> tile_decoder_;
   int level_ = -1;
   TwoLayerPanorama pano_;
@@ -89,6 +98,10 @@ struct ReadOptions {
   int num_threads = 1;            // Threads decoding tiles, 1..256.
   bool verify_checksums = true;   // Check each file's SHA-256 against the manifest.
   int64_t max_pixels = int64_t{1} << 25;  // Refuse larger levels (memory bound).
+  // The named rules to enforce (all by default; verify_checksums false also
+  // switches checksum-mismatch off). Switching them off is for conformance
+  // tests.
+  ReaderChecks checks;
 
   Status Check() const;
 };

@@ -61,14 +61,15 @@ StatusOr<std::vector<uint8_t>> BuildSingleFile(
 }
 
 StatusOr<std::vector<SingleFileEntry>> ParseSingleFileDirectory(const uint8_t* data,
-                                                                size_t size) {
+                                                                size_t size,
+                                                                const ReaderChecks& checks) {
   if (size < 16) return InvalidData("single file: " + std::to_string(size) +
                                     " bytes is shorter than the 16-byte header");
   if (std::memcmp(data, kSingleFileMagic, 8) != 0)
     return InvalidData("single file: bad magic (not a casual3d .c3d file)");
   const uint16_t major = static_cast<uint16_t>(GetLE(data + 8, 2));
   const uint16_t minor = static_cast<uint16_t>(GetLE(data + 10, 2));
-  if (major != kSingleFileVersionMajor)
+  if (major != kSingleFileVersionMajor && checks.on(ReaderCheck::kContainerUnknownMajor))
     return UnsupportedVersion("single file: version " + std::to_string(major) + "." +
                               std::to_string(minor) + " is not supported (this reader reads 1.x)");
   const uint32_t count = static_cast<uint32_t>(GetLE(data + 12, 4));
@@ -96,16 +97,16 @@ StatusOr<std::vector<SingleFileEntry>> ParseSingleFileDirectory(const uint8_t* d
     e.offset = GetLE(data + pos, 8);
     e.size = GetLE(data + pos + 8, 8);
     pos += 16;
-    if (!IsSafePackagePath(e.path))
+    if (!IsSafePackagePath(e.path) && checks.on(ReaderCheck::kPathEscape))
       return InvalidData(where + ": unsafe path \"" + e.path.substr(0, 80) + "\"");
-    if (!seen.insert(e.path).second)
+    if (!seen.insert(e.path).second && checks.on(ReaderCheck::kDuplicateEntry))
       return InvalidData(where + ": duplicate path \"" + e.path + "\"");
-    if (e.offset > size || e.size > size - e.offset)
+    if ((e.offset > size || e.size > size - e.offset) && checks.on(ReaderCheck::kEntryOutsideFile))
       return InvalidData(where + " (\"" + e.path + "\"): data range lies outside the " +
                          std::to_string(size) + "-byte file");
     entries.push_back(std::move(e));
   }
-  if (entries[0].path != kManifestFileName)
+  if (entries[0].path != kManifestFileName && checks.on(ReaderCheck::kManifestNotFirst))
     return InvalidData("single file: the first entry is \"" + entries[0].path +
                        "\", expected manifest.json");
   return entries;

@@ -14,13 +14,17 @@
 //   then the data of the entries, in any order, within the file.
 // The first entry is "manifest.json". Paths follow IsSafePackagePath and are
 // unique. Readers refuse an unknown major version and ignore bytes they do not
-// reference (a later minor version may add entries after the data).
+// reference (a later minor version may add entries after the data). The
+// header's version is the container's own, independent of the manifest's.
+// Entries may share bytes (identical files stored once); entries the manifest
+// does not list are ignored by package readers.
 
 #include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "format/reader_checks.h"
 #include "format/status.h"
 
 namespace casual3d {
@@ -44,7 +48,12 @@ StatusOr<std::vector<uint8_t>> BuildSingleFile(
 
 // Parses the header and directory of a container of `size` bytes (only the
 // first bytes are read; `data` must hold all `size` bytes). Checks magic,
-// version, limits, paths and that each entry lies inside the container.
-StatusOr<std::vector<SingleFileEntry>> ParseSingleFileDirectory(const uint8_t* data, size_t size);
+// version, limits, paths, that paths are unique, that the first entry is the
+// manifest and that each entry lies inside the container; the named rules
+// among these (container-unknown-major, path-escape, duplicate-entry,
+// manifest-not-first, entry-outside-file) only when on in `checks`. An entry
+// kept with entry-outside-file off is refused when read (SingleFileSource).
+StatusOr<std::vector<SingleFileEntry>> ParseSingleFileDirectory(
+    const uint8_t* data, size_t size, const ReaderChecks& checks = ReaderChecks());
 
 }  // namespace casual3d

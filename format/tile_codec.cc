@@ -215,57 +215,62 @@ Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int 
   return image;
 }
 
-TileDecoder::TileDecoder(const TileQuantization& q)
-    : q_(q), table_(q.depth.MaxCode() + 1) {
-  for (int code = 0; code <= q.depth.MaxCode(); ++code)
+TileDecoder::TileDecoder(const TileQuantization& q, const ReaderChecks& checks)
+    : q_(q), checks_(checks), table_(65536) {
+  const int max_code = q.depth.MaxCode();
+  for (int code = 0; code <= max_code; ++code)
     table_[code] = static_cast<float>(DequantizeDepth(static_cast<uint16_t>(code), q.depth));
+  const float above_max = checks.on(ReaderCheck::kDepthCodeAboveMax) ? -1.0f : table_[max_code];
+  std::fill(table_.begin() + max_code + 1, table_.end(), above_max);
   // Every 8-bit code pair through DecodeOctahedral once, so that decoding a
   // tile is a table look-up per pixel with exactly the same floats.
+  const float invalid = checks.on(ReaderCheck::kNormalCodeInvalid)
+                            ? std::numeric_limits<float>::quiet_NaN()
+                            : 0.0f;
   normal_table_.resize(3 * 65536);
-  normal_valid_.resize(65536);
   for (int c0 = 0; c0 < 256; ++c0) {
     for (int c1 = 0; c1 < 256; ++c1) {
       const uint8_t code[2] = {static_cast<uint8_t>(c0), static_cast<uint8_t>(c1)};
-      const size_t k = static_cast<size_t>(c0) << 8 | c1;
-      normal_valid_[k] = DecodeOctahedral(code, q.normal, &normal_table_[3 * k]) ? 1 : 0;
+      float* n = &normal_table_[3 * (static_cast<size_t>(c0) << 8 | c1)];
+      if (!DecodeOctahedral(code, q.normal, n)) n[0] = n[1] = n[2] = invalid;
     }
   }
+}
+
+WebpCoding WebpContainerCoding(const uint8_t* data, size_t size) {
+  auto fourcc = [data](size_t at, const char* tag) { return std::memcmp(data + at, tag, 4) == 0; };
+  auto u32 = [data](size_t at) {
+    return static_cast<uint32_t>(data[at]) | static_cast<uint32_t>(data[at + 1]) << 8 |
+           static_cast<uint32_t>(data[at + 2]) << 16 | static_cast<uint32_t>(data[at + 3]) << 24;
+  };
+  if (size < 20 || !fourcc(0, "RIFF") || !fourcc(8, "WEBP")) return WebpCoding::kNotWebp;
+  // Chunks end where the RIFF size says, or at the end of the bytes.
+  const size_t end = std::min<uint64_t>(size, uint64_t{8} + u32(4));
+  bool extended = false;
+  for (size_t at = 12; at + 8 <= end;) {
+    const uint64_t chunk = u32(at + 4);
+    if (fourcc(at, "VP8L")) return WebpCoding::kLossless;
+    if (fourcc(at, "VP8 ")) return WebpCoding::kLossy;
+    if (fourcc(at, "ANIM") || fourcc(at, "ANMF")) return WebpCoding::kNotStill;
+    // Only a VP8X header may come before the image chunk (ALPH, ICCP and
+    // others follow it).
+    if (!extended && !fourcc(at, "VP8X")) return WebpCoding::kNotWebp;
+    extended = true;
+    at += 8 + chunk + (chunk & 1);  // Chunks are padded to an even size.
+    if (at > end) break;
+  }
+  return WebpCoding::kNotWebp;
 }
 
 namespace {
 
-// The first invalid pixel of a depth or normal image (the same scan order as
-// the decoding loops: rows, columns, then layers), for the error message.
-Status DecodeError(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
-                   int h, const TileDecoder& decoder) {
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      for (int l = 0; l < kNumLayers; ++l) {
-        const uint8_t* px = &image.at(x, l * h + y);
-        if (kind == TileImageKind::kDepth) {
-          const uint16_t code = static_cast<uint16_t>((px[0] << 8) | px[1]);
-          if (decoder.Depth(code) < 0)
-            return InvalidData("depth image: code " + std::to_string(code) + " above the maximum " +
-                               std::to_string(decoder.quantization().depth.MaxCode()) +
-                               " at pixel " + PixelName(x0 + x, y0 + y));
-        } else if (!decoder.NormalValid(px)) {
-          return InvalidData("normal image: invalid octahedral code (" + std::to_string(px[0]) +
-                             ", " + std::to_string(px[1]) + ") at pixel " +
-                             PixelName(x0 + x, y0 + y) + (l == kFront ? " (front)" : " (back)"));
-        }
-      }
-    }
-  }
-  return Status::Ok();
-}
-
 // The per-kind loops of DecodeTileImage for images of `kChannels` channels
-// (DecodeLayerRows over the tile's rows [row_begin, row_end)). Each returns
-// false if some pixel was invalid (the caller then finds the first one for
-// the message); they never read or write out of bounds.
+// (DecodeLayerRows over the tile's rows [row_begin, row_end)). The graph loop
+// returns false if some pixel has reserved flag bits (naming the first); they
+// never read or write out of bounds.
 template <int kChannels>
 bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int h,
-                     TwoLayerPanorama* pano, int* bad_x, int* bad_y) {
+                     bool check_reserved, TwoLayerPanorama* pano, int* bad_x, int* bad_y) {
   LayerData& F = pano->layer(kFront);
   LayerData& B = pano->layer(kBack);
   for (int y = 0; y < h; ++y) {
@@ -321,7 +326,7 @@ bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int 
       front_links[x] = p[0];
       back_links[x] = p[1];
     }
-    if (reserved) {  // The first offending pixel of the row, for the message.
+    if (reserved && check_reserved) {  // The first offending pixel of the row, for the message.
       for (int x = 0; x < w; ++x) {
         if (px[kChannels * x + 2] & kFlagReserved) {
           *bad_x = x0 + x;
@@ -335,10 +340,9 @@ bool DecodeGraphRows(ImageView<const uint8_t> image, int x0, int y0, int w, int 
 }
 
 template <int kChannels>
-bool DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
+void DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
                      int h, int row_begin, int row_end, const TileDecoder& decoder,
                      TwoLayerPanorama* pano) {
-  bool ok = true;
   for (int l = 0; l < kNumLayers; ++l) {
     LayerData& L = pano->layer(l);
     for (int y = row_begin; y < row_end; ++y) {
@@ -365,15 +369,11 @@ bool DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0,
         }
       } else if (kind == TileImageKind::kDepth) {
         float* depth = &L.depth_m[i0];
-        for (int x = 0; x < w; ++x, px += kChannels) {
-          const float d = decoder.Depth(static_cast<uint16_t>((px[0] << 8) | px[1]));
-          ok &= d >= 0;
-          depth[x] = d;
-        }
+        for (int x = 0; x < w; ++x, px += kChannels)
+          depth[x] = decoder.Depth(static_cast<uint16_t>((px[0] << 8) | px[1]));
       } else {
         float* normal = &L.normal[3 * i0];
         for (int x = 0; x < w; ++x, px += kChannels, normal += 3) {
-          ok &= decoder.NormalValid(px);
           const float* n = decoder.Normal(px);
           normal[0] = n[0];
           normal[1] = n[1];
@@ -382,7 +382,6 @@ bool DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0,
       }
     }
   }
-  return ok;
 }
 
 }  // namespace
@@ -395,7 +394,10 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
                            PixelName(x0, y0) + " lies outside the panorama");
   int iw, ih;
   TileImageSize(kind, w, h, &iw, &ih);
-  if (image.width() != iw || image.height() != ih)
+  const bool size_ok = decoder.checks().on(ReaderCheck::kWrongTileSize)
+                           ? image.width() == iw && image.height() == ih
+                           : image.width() >= iw && image.height() >= ih;
+  if (!size_ok)
     return InvalidData(std::string(TileImageKindName(kind)) + " image is " +
                        std::to_string(image.width()) + "x" + std::to_string(image.height()) +
                        ", expected " + std::to_string(iw) + "x" + std::to_string(ih));
@@ -405,8 +407,9 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
   const bool rgba = image.channels() == 4;
   if (kind == TileImageKind::kGraph) {
     int bad_x = 0, bad_y = 0;
-    const bool ok = rgba ? DecodeGraphRows<4>(image, x0, y0, w, h, pano, &bad_x, &bad_y)
-                         : DecodeGraphRows<3>(image, x0, y0, w, h, pano, &bad_x, &bad_y);
+    const bool check = decoder.checks().on(ReaderCheck::kReservedFlagBits);
+    const bool ok = rgba ? DecodeGraphRows<4>(image, x0, y0, w, h, check, pano, &bad_x, &bad_y)
+                         : DecodeGraphRows<3>(image, x0, y0, w, h, check, pano, &bad_x, &bad_y);
     if (!ok)
       return InvalidData("graph image: reserved flag bits set at pixel " + PixelName(bad_x, bad_y));
     return Status::Ok();
@@ -416,21 +419,23 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
   // and normals go through look-up tables.
   const int threads = kind == TileImageKind::kColor ? 1 : ResolveThreads(num_threads);
   const int bands = std::min(h, threads > 1 ? 4 * threads : 1);
-  std::atomic<bool> ok(true);
   ParallelFor(0, bands, threads, [&](int64_t b) {
     int64_t r0, r1;
     ChunkRange(h, bands, b, &r0, &r1);
     const int row_begin = static_cast<int>(r0), row_end = static_cast<int>(r1);
-    const bool band_ok =
-        rgba ? DecodeLayerRows<4>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano)
-             : DecodeLayerRows<3>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano);
-    if (!band_ok) ok.store(false, std::memory_order_relaxed);
+    if (rgba)
+      DecodeLayerRows<4>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano);
+    else
+      DecodeLayerRows<3>(image, kind, x0, y0, w, h, row_begin, row_end, decoder, pano);
   });
-  return ok.load() ? Status::Ok() : DecodeError(image, kind, x0, y0, w, h, decoder);
+  return Status::Ok();
 }
 
-Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads) {
+Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads, const ReaderChecks& checks,
+                             DecodedNodeProblem* problem) {
   const int threads = ResolveThreads(num_threads);
+  // A present node may keep depth 0 (code 0) only with its check off.
+  const bool allow_no_depth = !checks.on(ReaderCheck::kPresentNodeWithoutDepth);
   for (int l = 0; l < kNumLayers; ++l) {
     LayerData& L = pano->layer(l);
     const size_t n = L.present.size();
@@ -438,31 +443,43 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads) {
     // Nodes in chunks on up to `threads` threads; a chunk's runs of absent
     // nodes end at its end, and clearing a node twice changes nothing.
     const int64_t chunks = threads > 1 && n >= (size_t{1} << 16) ? 4 * threads : 1;
-    // Present nodes must have a finite depth (code 0 means none; a depth
-    // range beyond 32-bit floats decodes to infinity): one branch-free pass,
-    // then the first offender for the message.
+    // Present nodes must have a finite depth (code 0 means none, -1 marks a
+    // code above the maximum; a depth range beyond 32-bit floats decodes to
+    // infinity) and a valid normal code (a NaN marks an invalid one): one
+    // branch-free pass, then the first offender for the message. Absent
+    // nodes' values are ignored (spec/package.md Sec. 5).
     constexpr float kMaxDepth = std::numeric_limits<float>::max();
+    auto node_ok = [&](size_t i) {
+      const float d = L.depth_m[i];
+      const bool depth_ok = (d > 0) | ((d == 0) & allow_no_depth);
+      return (present[i] == 0) | (depth_ok & (d <= kMaxDepth) & (L.normal[3 * i] == L.normal[3 * i]));
+    };
     std::atomic<bool> bad(false);
     ParallelFor(0, chunks, threads, [&](int64_t c) {
       int64_t begin, end;
       ChunkRange(static_cast<int64_t>(n), chunks, c, &begin, &end);
-      bool chunk_bad = false;
-      for (size_t i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
-        const float d = L.depth_m[i];
-        chunk_bad |= (present[i] != 0) & !((d > 0) & (d <= kMaxDepth));
-      }
-      if (chunk_bad) bad.store(true, std::memory_order_relaxed);
+      bool chunk_ok = true;
+      for (size_t i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i)
+        chunk_ok &= node_ok(i);
+      if (!chunk_ok) bad.store(true, std::memory_order_relaxed);
     });
     if (bad.load()) {
       for (size_t i = 0; i < n; ++i) {
+        if (node_ok(i)) continue;
         const float d = L.depth_m[i];
-        if (present[i] && !(d > 0 && d <= kMaxDepth))
-          return InvalidData(std::string(l == kFront ? "front" : "back") + " node at pixel " +
-                             PixelName(static_cast<int>(i % pano->width()),
-                                       static_cast<int>(i / pano->width())) +
-                             (d > 0 ? " has a depth beyond the range of 32-bit floats (the "
-                                      "manifest's depth range is too large)"
-                                    : " has no depth (code 0)"));
+        const int x = static_cast<int>(i % pano->width()), y = static_cast<int>(i / pano->width());
+        const bool depth_bad = !(d > 0 && d <= kMaxDepth) && !(d == 0 && allow_no_depth);
+        if (problem != nullptr)
+          *problem = {x, y, l, depth_bad ? TileImageKind::kDepth : TileImageKind::kNormal};
+        const std::string node = std::string(l == kFront ? "front" : "back") +
+                                 " node at pixel " + PixelName(x, y);
+        if (!depth_bad)
+          return InvalidData(node + " has an invalid octahedral normal code (one 0 or above "
+                                    "2^bits - 1)");
+        return InvalidData(node + (d > 0    ? " has a depth beyond the range of 32-bit floats (the "
+                                              "manifest's depth range is too large)"
+                                   : d == 0 ? " has no depth (code 0)"
+                                            : " has a depth code above the maximum 2^bits - 1"));
       }
     }
     // Every field of an absent node becomes zero: runs of absent nodes are

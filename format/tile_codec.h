@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "format/image.h"
+#include "format/reader_checks.h"
 #include "format/status.h"
 #include "format/two_layer.h"
 
@@ -40,6 +41,15 @@ void TileImageSize(TileImageKind kind, int w, int h, int* image_w, int* image_h)
 
 // Whether the image of `kind` is stored lossless (all but colour).
 inline bool TileImageIsLossless(TileImageKind kind) { return kind != TileImageKind::kColor; }
+
+// How a WebP file codes its image, from its RIFF container alone
+// (spec/package.md Sec. 4): kLossless when the image is one VP8L chunk (the
+// file's first chunk, or after a VP8X header without ALPH or animation
+// chunks); kLossy when it is a VP8 chunk (with or without VP8X and ALPH);
+// kNotStill for an animation; kNotWebp when the container is malformed.
+// Reads only within [data, data + size).
+enum class WebpCoding { kLossless, kLossy, kNotStill, kNotWebp };
+WebpCoding WebpContainerCoding(const uint8_t* data, size_t size);
 
 // The "log" depth encoding with b bits (8..16), M = 2^b - 1: code 0 means "no
 // node"; codes 1..M map depths in [near_m, far_m] logarithmically, so the
@@ -99,49 +109,66 @@ struct TileQuantization {
 Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int h,
                        TileImageKind kind, const TileQuantization& q);
 
-// Precomputed DequantizeDepth for all valid codes (up to 256 KB) and
-// DecodeOctahedral for all 65536 code pairs (832 KB), for fast decoding with
-// exactly the values of those functions. Precondition: q.Check() is ok.
+// Precomputed DequantizeDepth for all 65536 codes (256 KB) and
+// DecodeOctahedral for all 65536 code pairs (768 KB), for fast decoding with
+// exactly the values of those functions. Invalid codes decode to markers that
+// FinishDecodedPanorama refuses at present nodes and clears at absent ones
+// (spec/package.md Sec. 5): depth -1 for a code above the maximum, a NaN
+// normal for an invalid octahedral code. With the depth-code-above-max check
+// off such codes decode as the maximum; with normal-code-invalid off as the
+// zero normal. Precondition: q.Check() is ok.
 class TileDecoder {
  public:
-  explicit TileDecoder(const TileQuantization& q);
+  explicit TileDecoder(const TileQuantization& q, const ReaderChecks& checks = ReaderChecks());
   const TileQuantization& quantization() const { return q_; }
-  // Depth of `code`, or -1 for a code above the maximum.
-  float Depth(uint16_t code) const { return code < table_.size() ? table_[code] : -1.0f; }
-  // DecodeOctahedral(code): the normal (zero for an invalid code) and whether
-  // the code is valid.
+  const ReaderChecks& checks() const { return checks_; }
+  // Depth of `code`: 0 for code 0, -1 for a code above the maximum.
+  float Depth(uint16_t code) const { return table_[code]; }
+  // DecodeOctahedral(code), or NaNs for an invalid code.
   const float* Normal(const uint8_t code[2]) const {
     return &normal_table_[3 * (static_cast<size_t>(code[0]) << 8 | code[1])];
-  }
-  bool NormalValid(const uint8_t code[2]) const {
-    return normal_valid_[static_cast<size_t>(code[0]) << 8 | code[1]] != 0;
   }
 
  private:
   TileQuantization q_;
-  std::vector<float> table_;
+  ReaderChecks checks_;
+  std::vector<float> table_;         // 65536 depths.
   std::vector<float> normal_table_;  // 3 floats per code pair (code[0] << 8 | code[1]).
-  std::vector<uint8_t> normal_valid_;
 };
 
 // Writes the content of a decoded image of `kind` into the tile [x0, x0+w) x
-// [y0, y0+h) of `pano`. The image must have the size of TileImageSize and 3 or
-// 4 channels. The graph image sets presence, labels and links; the others set
-// values whether or not a node is present (FinishDecodedPanorama clears the
-// absent ones). Returns kInvalidData, naming the pixel, for a wrong size,
-// reserved bits, or an invalid depth or normal code. Never reads or writes out
-// of bounds. Rows are shared among `num_threads` threads (format/parallel.h;
+// [y0, y0+h) of `pano`. The image must have the size of TileImageSize (with the
+// wrong-tile-size check off: at least that size, of which the top-left part is
+// read) and 3 or 4 channels. The graph image sets presence, labels and links;
+// the others set values whether or not a node is present, invalid codes as the
+// decoder's markers (FinishDecodedPanorama clears absent nodes and refuses
+// markers at present ones). The B channel of depth and normal images and any
+// alpha are ignored. Returns kInvalidData for a wrong size or, naming the
+// pixel, reserved flag bits (checks as in the decoder). Never reads or writes
+// out of bounds. Rows are shared among `num_threads` threads (format/parallel.h;
 // 0: all hardware threads); the result does not depend on it.
 Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x0, int y0, int w,
                        int h, const TileDecoder& decoder, TwoLayerPanorama* pano,
                        int num_threads = 1);
 
-// After all tiles are decoded: zeroes every field of absent nodes and checks
-// that every present node has a finite depth (code != 0, and a depth range
-// within 32-bit floats). Returns the first problem. Afterwards every node value
-// is one that TwoLayerPanorama::Validate() accepts, so only the links remain
-// to check (TwoLayerPanorama::ValidateLinks()).
+// Where FinishDecodedPanorama found its problem: the node and the kind of the
+// tile image whose value is wrong (depth or normal).
+struct DecodedNodeProblem {
+  int x = 0, y = 0, layer = 0;
+  TileImageKind kind = TileImageKind::kDepth;
+};
+
+// After all tiles are decoded: checks every present node (a depth code in
+// 1..M, a depth range within 32-bit floats, a valid normal code) and zeroes
+// every field of absent nodes, whatever their codes. Returns the first problem
+// (by layer, then node) and, if `problem` is not null, where it is. With the
+// present-node-without-depth check off a present node may keep depth 0.
+// Afterwards every node value is one that TwoLayerPanorama::Validate() accepts
+// (but that depth), so only the links remain to check
+// (TwoLayerPanorama::ValidateLinks()).
 // Nodes are shared among `num_threads` threads as in DecodeTileImage.
-Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads = 1);
+Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads = 1,
+                             const ReaderChecks& checks = ReaderChecks(),
+                             DecodedNodeProblem* problem = nullptr);
 
 }  // namespace casual3d

@@ -132,9 +132,10 @@ TEST(TileCodecTest, HostileImagesAreRefused) {
   EXPECT_EQ(s.code(), StatusCode::kInvalidData);
   EXPECT_NE(s.message().find("(3, 2)"), std::string::npos) << s.message();
   Image8 depth(16, 32, 3, 0);
-  depth.at(1, 1, 0) = 0x04;  // Code 1024 > 1023.
-  EXPECT_EQ(DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 16, 16, decoder, &out).code(),
-            StatusCode::kInvalidData);
+  depth.at(1, 1, 0) = 0x04;  // Code 1024 > 1023 at a present node.
+  out.layer(kFront).present[out.index(1, 1)] = 1;
+  ASSERT_TRUE(DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 16, 16, decoder, &out).ok());
+  EXPECT_EQ(FinishDecodedPanorama(&out).code(), StatusCode::kInvalidData);
   Image8 wrong(16, 16, 3, 0);  // Depth images are w x 2h.
   EXPECT_EQ(DecodeTileImage(V(wrong), TileImageKind::kDepth, 0, 0, 16, 16, decoder, &out).code(),
             StatusCode::kInvalidData);
@@ -211,7 +212,11 @@ TEST(TileCodecTest, EveryDecodableValueIsValidForValidate) {
     for (int c0 = 0; c0 <= m; ++c0) {
       for (int c1 = 0; c1 <= m; ++c1) {
         const uint8_t code[2] = {static_cast<uint8_t>(c0), static_cast<uint8_t>(c1)};
-        if (!decoder.NormalValid(code)) continue;
+        float reference[3];
+        if (!DecodeOctahedral(code, q.normal, reference)) {
+          EXPECT_TRUE(std::isnan(decoder.Normal(code)[0])) << c0 << ", " << c1;
+          continue;
+        }
         ++valid;
         const size_t i = pano.index(c0, c1);
         F.present[i] = 1;
@@ -272,28 +277,150 @@ TEST(TileCodecTest, DepthsBeyondFloatRangeAreRefused) {
       << s.ToString();
 }
 
-// Errors name the first invalid pixel in row, column, layer order, whichever
-// layer it is in.
-TEST(TileCodecTest, ErrorsNameTheFirstInvalidPixel) {
+// Invalid depth and normal codes are refused at present nodes, naming the
+// first (front layer first, then row by row) and its image kind, and ignored
+// and cleared at absent nodes (spec/package.md Sec. 5).
+TEST(TileCodecTest, InvalidCodesAreRefusedAtPresentNodesAndClearedAtAbsentOnes) {
   TileQuantization q;
   q.depth.bits = 10;
   q.normal.bits = 6;
   const TileDecoder decoder(q);
+  auto decode = [&](const Image8& depth, const Image8& normal, TwoLayerPanorama* out,
+                    DecodedNodeProblem* problem) {
+    Image8 graph(16, 8, 3, 0);
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 16; ++x) graph.at(x, y, 2) = (x + y) % 2 ? 1 : 3;  // Front, some back.
+    EXPECT_TRUE(DecodeTileImage(V(graph), TileImageKind::kGraph, 0, 0, 16, 8, decoder, out).ok());
+    EXPECT_TRUE(DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 16, 8, decoder, out).ok());
+    EXPECT_TRUE(DecodeTileImage(V(normal), TileImageKind::kNormal, 0, 0, 16, 8, decoder, out).ok());
+    return FinishDecodedPanorama(out, 1, ReaderChecks(), problem);
+  };
+  Image8 depth(16, 16, 3, 0), normal(16, 16, 4, 0);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) depth.at(x, y, 1) = 9;  // Code 9 everywhere.
+  normal.at(1, 8 + 0, 0) = 70;   // Back (1, 0) is absent: 70 > 63 is ignored.
+  depth.at(3, 8 + 0, 0) = 0xff;  // Back (3, 0) is absent: code 65289 is ignored.
+  depth.at(2, 8 + 1, 1) = 0;     // Back (2, 1) is absent: code 0 is fine.
+  depth.at(5, 3, 2) = 77;        // The unused B channel is ignored.
   TwoLayerPanorama out(16, 8);
-  Image8 normal(16, 16, 4, 0);
-  normal.at(5, 3, 0) = 7;       // Front (5, 3): one zero coordinate.
-  normal.at(2, 8 + 3, 1) = 70;  // Back (2, 3): 70 > 63, invalid; comes first.
-  normal.at(1, 8 + 6, 0) = 9;   // Back (1, 6): later row.
-  Status s = DecodeTileImage(V(normal), TileImageKind::kNormal, 0, 0, 16, 8, decoder, &out);
+  DecodedNodeProblem problem;
+  Status s = decode(depth, normal, &out, &problem);
+  ASSERT_TRUE(s.ok()) << s.ToString();
+  EXPECT_EQ(out.layer(kBack).depth_m[out.index(3, 0)], 0.0f);
+  EXPECT_EQ(out.layer(kBack).normal[3 * out.index(1, 0)], 0.0f);
+  EXPECT_EQ(out.layer(kFront).depth_m[out.index(5, 3)], out.layer(kFront).depth_m[out.index(4, 3)]);
+
+  normal.at(5, 3, 0) = 7;         // Front (5, 3): one zero coordinate.
+  normal.at(2, 8 + 2, 1) = 70;    // Back (2, 2), present: after every front node.
+  depth.at(9, 6, 0) = 0x05;       // Front (9, 6): code 1289 > 1023, a later row.
+  s = decode(depth, normal, &out, &problem);
   EXPECT_EQ(s.code(), StatusCode::kInvalidData);
-  EXPECT_NE(s.message().find("(2, 3) (back)"), std::string::npos) << s.message();
-  Image8 depth(16, 16, 3, 0);
-  depth.at(9, 2, 0) = 0x05;      // Front (9, 2): code 1280 > 1023.
-  depth.at(4, 8 + 2, 0) = 0x04;  // Back (4, 2): code 1024, the first.
-  s = DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 16, 8, decoder, &out);
-  EXPECT_EQ(s.code(), StatusCode::kInvalidData);
-  EXPECT_NE(s.message().find("code 1024"), std::string::npos) << s.message();
-  EXPECT_NE(s.message().find("(4, 2)"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("front node at pixel (5, 3) has an invalid octahedral normal code"),
+            std::string::npos)
+      << s.message();
+  EXPECT_EQ(problem.kind, TileImageKind::kNormal);
+  normal.at(5, 3, 0) = 0;
+  s = decode(depth, normal, &out, &problem);
+  EXPECT_NE(s.message().find("front node at pixel (9, 6) has a depth code above the maximum"),
+            std::string::npos)
+      << s.message();
+  EXPECT_EQ(problem.kind, TileImageKind::kDepth);
+  EXPECT_EQ(problem.x, 9);
+  EXPECT_EQ(problem.y, 6);
+  depth.at(9, 6, 0) = 0;
+  s = decode(depth, normal, &out, &problem);
+  EXPECT_NE(s.message().find("back node at pixel (2, 2) has an invalid octahedral"),
+            std::string::npos)
+      << s.message();
+}
+
+// Each named check switched off: the value it would refuse is read as
+// documented in tile_codec.h.
+TEST(TileCodecTest, ChecksSwitchedOff) {
+  TileQuantization q;
+  q.depth.bits = 8;
+  q.normal.bits = 4;
+  Image8 depth(2, 4, 3, 0), normal(2, 4, 3, 0), graph(2, 2, 3, 0), wide(3, 4, 3, 0);
+  for (int x = 0; x < 2; ++x) graph.at(x, 0, 2) = 1;  // Front nodes in row 0.
+  depth.at(0, 0, 0) = 1;      // Code 256 > 255.
+  depth.at(1, 0, 1) = 0;      // Code 0 at a present node.
+  normal.at(0, 0, 0) = 3;     // (3, 0): invalid.
+  graph.at(1, 1, 2) = 0x40;   // Reserved bit at an absent pixel.
+  auto run = [&](const ReaderChecks& checks, TwoLayerPanorama* out) {
+    const TileDecoder decoder(q, checks);
+    Status s = DecodeTileImage(V(graph), TileImageKind::kGraph, 0, 0, 2, 2, decoder, out);
+    if (s.ok()) s = DecodeTileImage(V(wide), TileImageKind::kColor, 0, 0, 2, 2, decoder, out);
+    if (s.ok()) s = DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 2, 2, decoder, out);
+    if (s.ok()) s = DecodeTileImage(V(normal), TileImageKind::kNormal, 0, 0, 2, 2, decoder, out);
+    if (s.ok()) s = FinishDecodedPanorama(out, 1, checks);
+    return s;
+  };
+  TwoLayerPanorama out(2, 2);
+  EXPECT_NE(run(ReaderChecks(), &out).message().find("reserved flag bits"), std::string::npos);
+  ReaderChecks off;
+  off.Disable(ReaderCheck::kReservedFlagBits);
+  EXPECT_NE(run(off, &out).message().find("color image is 3x4, expected 2x4"), std::string::npos)
+      << run(off, &out).message();
+  off.Disable(ReaderCheck::kWrongTileSize);
+  EXPECT_NE(run(off, &out).message().find("(0, 0) has a depth code above"), std::string::npos);
+  off.Disable(ReaderCheck::kDepthCodeAboveMax);
+  EXPECT_NE(run(off, &out).message().find("(0, 0) has an invalid octahedral"), std::string::npos);
+  off.Disable(ReaderCheck::kNormalCodeInvalid);
+  EXPECT_NE(run(off, &out).message().find("(1, 0) has no depth (code 0)"), std::string::npos);
+  off.Disable(ReaderCheck::kPresentNodeWithoutDepth);
+  ASSERT_TRUE(run(off, &out).ok()) << run(off, &out).ToString();
+  EXPECT_EQ(out.layer(kFront).depth_m[0], static_cast<float>(DequantizeDepth(255, q.depth)));
+  EXPECT_EQ(out.layer(kFront).normal[0], 0.0f);
+  EXPECT_EQ(out.layer(kFront).depth_m[1], 0.0f);
+}
+
+// WebpContainerCoding reads the RIFF chunks only: simple lossy and lossless
+// files, the extended form (VP8X, then ALPH and VP8, or VP8L), animations and
+// malformed containers.
+TEST(TileCodecTest, WebpContainerCodingTellsLosslessFromLossy) {
+  auto file = [](std::vector<std::pair<std::string, uint32_t>> chunks) {
+    std::vector<uint8_t> out = {'R', 'I', 'F', 'F', 0, 0, 0, 0, 'W', 'E', 'B', 'P'};
+    for (const auto& [tag, size] : chunks) {
+      out.insert(out.end(), tag.begin(), tag.end());
+      for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(size >> (8 * i)));
+      out.resize(out.size() + size + (size & 1), 0);
+    }
+    const uint32_t riff = static_cast<uint32_t>(out.size() - 8);
+    for (int i = 0; i < 4; ++i) out[4 + i] = static_cast<uint8_t>(riff >> (8 * i));
+    return out;
+  };
+  auto coding = [](const std::vector<uint8_t>& b) { return WebpContainerCoding(b.data(), b.size()); };
+  EXPECT_EQ(coding(file({{"VP8L", 5}})), WebpCoding::kLossless);
+  EXPECT_EQ(coding(file({{"VP8 ", 10}})), WebpCoding::kLossy);
+  EXPECT_EQ(coding(file({{"VP8X", 10}, {"ICCP", 3}, {"VP8L", 5}})), WebpCoding::kLossless);
+  EXPECT_EQ(coding(file({{"VP8X", 10}, {"ALPH", 7}, {"VP8 ", 10}})), WebpCoding::kLossy);
+  EXPECT_EQ(coding(file({{"VP8X", 10}, {"ANIM", 6}, {"ANMF", 30}})), WebpCoding::kNotStill);
+  EXPECT_EQ(coding(file({{"ALPH", 7}, {"VP8L", 5}})), WebpCoding::kNotWebp);  // No VP8X first.
+  EXPECT_EQ(coding(file({{"VP8X", 10}})), WebpCoding::kNotWebp);             // No image.
+  std::vector<uint8_t> truncated = file({{"VP8X", 10}, {"VP8L", 5}});
+  truncated.resize(30);  // Ends inside the VP8X chunk.
+  EXPECT_EQ(coding(truncated), WebpCoding::kNotWebp);
+  EXPECT_EQ(WebpContainerCoding(truncated.data(), 12), WebpCoding::kNotWebp);
+}
+
+// Ties round half up (away from zero; every argument is >= 0), package.md
+// Sec. 4.2 and 4.3: 4-bit normals put u = 0.5 at (0.5 + 1) / 2 * 14 = 10.5,
+// coded 1 + 11; 8-bit depths with far / near = 16 put d = 8 near at 254 *
+// 0.75 = 190.5, coded 1 + 191.
+TEST(TileCodecTest, TiesRoundHalfUp) {
+  NormalQuantization n;
+  n.bits = 4;
+  const float diagonal[3] = {0.70710677f, 0.70710677f, 0.0f};
+  uint8_t code[2];
+  EncodeOctahedral(diagonal, n, code);
+  EXPECT_EQ(code[0], 12);
+  EXPECT_EQ(code[1], 12);
+  DepthQuantization d;
+  d.near_m = 1.0;
+  d.far_m = 16.0;
+  d.bits = 8;
+  ASSERT_EQ(std::log(8.0) / std::log(16.0) * 254, 190.5);  // An exact tie.
+  EXPECT_EQ(QuantizeDepth(8.0, d), 192);
 }
 
 // Rows are decoded in bands on several threads: the panorama and the first
@@ -329,12 +456,13 @@ TEST(TileCodecTest, SameResultForEveryThreadCount) {
     const Status s =
         DecodeTileImage(V(graph), TileImageKind::kGraph, 0, 0, 96, 64, decoder, &out, threads);
     EXPECT_NE(s.message().find("(70, 9)"), std::string::npos) << threads << ": " << s.message();
-    Image8 depth(96, 128, 3, 0);
-    depth.at(30, 60, 0) = 0xff;     // Front (30, 60): code 65280 > 4095.
-    depth.at(3, 64 + 5, 0) = 0xff;  // Back (3, 5): rows come first, so it is named.
-    const Status d =
-        DecodeTileImage(V(depth), TileImageKind::kDepth, 0, 0, 96, 64, decoder, &out, threads);
-    EXPECT_NE(d.message().find("(3, 5)"), std::string::npos) << threads << ": " << d.message();
+    // Two bad present nodes in different chunks: the first is named.
+    TwoLayerPanorama bad = reference;
+    bad.layer(kFront).depth_m[bad.index(30, 60)] = 0.0f;
+    bad.layer(kFront).depth_m[bad.index(3, 5)] = -1.0f;
+    const Status d = FinishDecodedPanorama(&bad, threads);
+    EXPECT_NE(d.message().find("(3, 5) has a depth code above"), std::string::npos)
+        << threads << ": " << d.message();
   }
 }
 

@@ -1,5 +1,6 @@
 // Fuzz target (format/fuzz/CMakeLists.txt): DecodeTileImage of a raw image
-// whose size, kind, quantization and pixels come from the input, then FinishDecodedPanorama and TwoLayerPanorama::Validate.
+// whose size, kind, quantization, checks and pixels come from the input, then FinishDecodedPanorama and
+// TwoLayerPanorama::Validate; and WebpContainerCoding of the input's bytes.
 
 #include <algorithm>
 
@@ -10,8 +11,10 @@ namespace {
 
 // Input layout: byte 0 kind (mod 4), byte 1 tile width 1..32, byte 2 tile
 // height 1..32, byte 3 channels (3 or 4), byte 4 depth bits, byte 5 normal
-// bits, byte 6 image width delta, then pixels (zero-padded).
+// bits, byte 6 image width delta (bits 0-1) and a check to switch off (bits
+// 2-7, none above kNumReaderChecks), then pixels (zero-padded).
 int FuzzTileDecode(const uint8_t* data, size_t size) {
+  (void)WebpContainerCoding(data, size);
   if (size < 7) return 0;
   const TileImageKind kind = static_cast<TileImageKind>(data[0] % kNumTileImageKinds);
   const int w = 1 + data[1] % 32, h = 1 + data[2] % 32;
@@ -27,10 +30,12 @@ int FuzzTileDecode(const uint8_t* data, size_t size) {
   Image8 image(iw, ih, channels, 0);
   std::copy_n(data + 7, std::min(size - 7, image.size()), image.data());
   TwoLayerPanorama pano(48, 40);
-  const TileDecoder decoder(q);
+  ReaderChecks checks;
+  if ((data[6] >> 2) < kNumReaderChecks) checks.Disable(static_cast<ReaderCheck>(data[6] >> 2));
+  const TileDecoder decoder(q, checks);
   const Image8& const_image = image;
   Status s = DecodeTileImage(const_image.view(), kind, 8, 4, w, h, decoder, &pano);
-  if (s.ok() && FinishDecodedPanorama(&pano).ok()) (void)pano.Validate();
+  if (s.ok() && FinishDecodedPanorama(&pano, 1, checks).ok()) (void)pano.Validate();
   return 0;
 }
 
