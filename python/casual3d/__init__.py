@@ -82,13 +82,13 @@ class Layer:
     links: np.ndarray
 
     @classmethod
-    def empty(cls, width: int, height: int, label: int = LABEL_F) -> "Layer":
-        """A layer without nodes; `label` is the label given to nodes added later."""
+    def empty(cls, width: int, height: int) -> "Layer":
+        """A layer of width x height pixels without nodes (all fields as absent)."""
         return cls(
             colour=np.zeros((height, width, 3), np.uint8),
             depth=np.full((height, width), np.nan, np.float32),
             normals=np.full((height, width, 3), np.nan, np.float32),
-            labels=np.full((height, width), label, np.uint8),
+            labels=np.zeros((height, width), np.uint8),
             links=np.zeros((height, width, 4), np.uint8),
         )
 
@@ -125,8 +125,12 @@ class Panorama:
 
     @classmethod
     def empty(cls, width: int, height: int) -> "Panorama":
-        """A panorama of width x height pixels without nodes (back labels B)."""
-        return cls(Layer.empty(width, height), Layer.empty(width, height, LABEL_B))
+        """A panorama of width x height pixels without nodes.
+
+        Nodes are added by setting depth (and colour, normals, labels: back
+        nodes are usually LABEL_B); link_neighbours() then links them.
+        """
+        return cls(Layer.empty(width, height), Layer.empty(width, height))
 
     @property
     def width(self) -> int:

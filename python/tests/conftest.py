@@ -45,9 +45,11 @@ def make_room(width=128, height=64):
     front, back = pano.front, pano.back
     front.depth[:] = np.where(box, np.float32(1.0) + 0.05 * lon.astype(np.float32) ** 2, wall)
     front.normals[:] = np.where(sky[..., None], 0.0, -direction)
-    front.colour[..., 0] = (128 + 100 * np.sin(4 * lon)).astype(np.uint8)
-    front.colour[..., 1] = (128 + 100 * np.cos(3 * lat)).astype(np.uint8)
-    front.colour[..., 2] = np.where(box, 220, 60).astype(np.uint8)
+    # Photo-like colours: a smooth brightness pattern, the box brighter and
+    # tinted blue, the walls tinted warm.
+    brightness = 110 + 60 * np.sin(4 * lon) * np.cos(2 * lat) + np.where(box, 40, 0)
+    tint = np.where(box[..., None], [0.85, 0.95, 1.1], [1.1, 1.0, 0.85])
+    front.colour[:] = np.clip(brightness[..., None] * tint, 0, 255).astype(np.uint8)
     back.depth[:] = np.where(box, wall, np.nan)
     back.normals[:] = np.where(box[..., None], -direction, np.nan)
     back.colour[:] = np.where(box[..., None], front.colour // 2, 0).astype(np.uint8)
