@@ -40,6 +40,9 @@ DepthQuantization DepthRange(const TwoLayerPanorama& pano) {
   DepthQuantization q;
   q.near_m = q.far_m = 1.0;  // An empty panorama.
   pano.NodeDepthRange(&q.near_m, &q.far_m);
+  // One depth (or none): packages need far_m > near_m (spec/package.md Sec.
+  // 4.2); every node then has code 1, which decodes to near_m exactly.
+  if (!(q.far_m > q.near_m)) q.far_m = 2.0 * q.near_m;
   return q;
 }
 

@@ -107,6 +107,51 @@ TEST(ManifestTest, ErrorsNameTheField) {
   }
 }
 
+// spec/package.md Sec. 3: integers are numbers with an integral value;
+// nesting counts arrays and objects enclosing each other with the root object
+// at 1, and 16 is allowed; near_m = far_m is refused; files entries that no
+// tile uses are allowed.
+TEST(ManifestTest, ClarifiedRules) {
+  const std::string text = SerializeManifest(SmallManifest());
+  for (const char* integral : {"32.0", "3.2e1", "320e-1"}) {
+    StatusOr<Manifest> m =
+        ParseManifest(Replace(text, "\"tile_size\": 32", std::string("\"tile_size\": ") + integral));
+    ASSERT_TRUE(m.ok()) << integral << ": " << m.status().ToString();
+    EXPECT_EQ(m->tile_size, 32);
+  }
+  EXPECT_NE(ParseManifest(Replace(text, "\"tile_size\": 32", "\"tile_size\": 32.5"))
+                .status()
+                .message()
+                .find("tile_size: expected an integer"),
+            std::string::npos);
+  // An extension member nested n deep in all: the root object, then n - 1
+  // arrays.
+  auto nested = [&](int n) {
+    const std::string value = std::string(n - 1, '[') + std::string(n - 1, ']');
+    return Replace(text, "\"tile_size\"", "\"x_nest\": " + value + ", \"tile_size\"");
+  };
+  EXPECT_TRUE(ParseManifest(nested(kMaxManifestNesting)).ok());
+  const Status deep = ParseManifest(nested(kMaxManifestNesting + 1)).status();
+  EXPECT_EQ(deep.code(), StatusCode::kLimitExceeded);
+  EXPECT_NE(deep.message().find("nesting deeper than 16"), std::string::npos) << deep.message();
+  EXPECT_TRUE(ParseManifest(nested(kMaxManifestNesting + 1),
+                            ReaderChecks::AllBut(ReaderCheck::kNestingTooDeep))
+                  .ok());
+
+  const std::string flat = Replace(text, "\"far_m\": 40", "\"far_m\": 0.75");
+  const Status equal = ParseManifest(flat).status();
+  EXPECT_EQ(equal.code(), StatusCode::kInvalidData);
+  EXPECT_NE(equal.message().find("depth_encoding: near_m = far_m = 0.75"), std::string::npos)
+      << equal.message();
+  EXPECT_TRUE(ParseManifest(flat, ReaderChecks::AllBut(ReaderCheck::kNearEqualsFar)).ok());
+
+  Manifest extra = SmallManifest();
+  extra.files.push_back({"zz/unused.bin", 5, std::string(64, 'e')});
+  StatusOr<Manifest> with_extra = ParseManifest(SerializeManifest(extra));
+  ASSERT_TRUE(with_extra.ok()) << with_extra.status().ToString();
+  EXPECT_EQ(with_extra->files.size(), 13u);
+}
+
 TEST(ManifestTest, SafePaths) {
   for (const char* good : {"a", "l0/0-0.color.webp", "x/y/z.webp", "..a", "a..b"})
     EXPECT_TRUE(IsSafePackagePath(good)) << good;

@@ -51,5 +51,44 @@ TEST(SingleFileTest, RefusesHostileContainers) {
             StatusCode::kInvalidArgument);
 }
 
+// spec/package.md Sec. 8: entries may share one data range, entries the
+// manifest does not list are kept (package readers ignore them), and any
+// minor version of the container's major 1 is read.
+TEST(SingleFileTest, SharedRangesAndUnlistedEntries) {
+  std::vector<uint8_t> c =
+      *BuildSingleFile({{"manifest.json", Bytes("{}")}, {"a", Bytes("xyz")}, {"b", Bytes("uvw")}});
+  // Point b's data range at a's: 16 + (2 + 13 + 16) + (2 + 1 + 16) + 2 + 1.
+  const size_t a_offset = 16 + 31 + 2 + 1, b_offset = 16 + 31 + 19 + 2 + 1;
+  std::copy_n(c.begin() + a_offset, 8, c.begin() + b_offset);
+  c[10] = 3;  // Container 1.3.
+  StatusOr<std::unique_ptr<SingleFileSource>> s = SingleFileSource::Create(c);
+  ASSERT_TRUE(s.ok()) << s.status().ToString();
+  EXPECT_EQ(*(*s)->Read("b", 10), Bytes("xyz"));
+  EXPECT_EQ(*(*s)->Read("a", 10), Bytes("xyz"));
+}
+
+// Each container check switched off keeps what it would refuse; reads stay
+// inside the container.
+TEST(SingleFileTest, ContainerChecksSwitchedOff) {
+  std::vector<uint8_t> c = *BuildSingleFile(
+      {{"manifest.json", Bytes("{}")}, {"a", Bytes("first")}, {"b", Bytes("other")}});
+  std::vector<uint8_t> dup = c;
+  dup[16 + 31 + 19 + 2] = 'a';  // Second entry "b" -> "a".
+  EXPECT_NE(ParseSingleFileDirectory(dup.data(), dup.size()).status().message().find(
+                "duplicate path \"a\""),
+            std::string::npos);
+  StatusOr<std::unique_ptr<SingleFileSource>> s =
+      SingleFileSource::Create(dup, ReaderChecks::AllBut(ReaderCheck::kDuplicateEntry));
+  ASSERT_TRUE(s.ok()) << s.status().ToString();
+  EXPECT_EQ(*(*s)->Read("a", 10), Bytes("first"));  // The first of the two.
+  std::vector<uint8_t> outside = c;
+  outside[16 + 31 + 2 + 1 + 8] = 0xff;  // Entry a's size.
+  EXPECT_FALSE(ParseSingleFileDirectory(outside.data(), outside.size()).ok());
+  s = SingleFileSource::Create(outside, ReaderChecks::AllBut(ReaderCheck::kEntryOutsideFile));
+  ASSERT_TRUE(s.ok()) << s.status().ToString();
+  EXPECT_EQ((*s)->Read("a", 1000).status().code(), StatusCode::kInvalidData);
+  EXPECT_EQ(*(*s)->Read("b", 10), Bytes("other"));
+}
+
 }  // namespace
 }  // namespace casual3d
