@@ -1,7 +1,8 @@
 // `casual3d view <package> [--port N]`: serves a package folder and the web
 // viewer on 127.0.0.1 with a small static HTTP/1.1 server and prints the address.
 //
-// The server is deliberately minimal and safe: GET and HEAD only, one request
+// The server is deliberately minimal and safe: GET and HEAD only (with single
+// byte ranges, so that the viewer reads a .c3d file level by level), one request
 // per connection, bounded request size, socket timeouts, a cap on concurrent
 // connections, and no path can leave the served folders (".." segments, encoded
 // or not, are refused and symbolic links are resolved before the check).
@@ -154,14 +155,79 @@ void SendSimple(int fd, int code, const char* reason, const std::string& body) {
   SendAll(fd, head.data(), head.size()) && SendAll(fd, body.data(), body.size());
 }
 
-std::string OkHeader(const std::string& type, uintmax_t length) {
-  return "HTTP/1.1 200 OK\r\nContent-Type: " + type +
-         "\r\nContent-Length: " + std::to_string(length) +
-         "\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\n"
+// The head of a response with a body of `length` bytes; `status` is e.g.
+// "200 OK", `extra` more header lines (each ending in \r\n).
+std::string ResponseHeader(const char* status, const std::string& type, uintmax_t length,
+                           const std::string& extra = "") {
+  return std::string("HTTP/1.1 ") + status + "\r\nContent-Type: " + type +
+         "\r\nContent-Length: " + std::to_string(length) + "\r\n" + extra +
+         "Accept-Ranges: bytes\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\n"
          "Access-Control-Allow-Origin: *\r\n"
          // Cross-origin isolation lets the viewer use its threaded wasm build.
          "Cross-Origin-Opener-Policy: same-origin\r\nCross-Origin-Embedder-Policy: require-corp\r\n"
          "Cross-Origin-Resource-Policy: cross-origin\r\nConnection: close\r\n\r\n";
+}
+
+std::string OkHeader(const std::string& type, uintmax_t length) {
+  return ResponseHeader("200 OK", type, length);
+}
+
+// The value of header `name` (lower case) in a request's head, or "".
+std::string HeaderValue(const std::string& request, const std::string& name) {
+  size_t line = request.find("\r\n");
+  while (line != std::string::npos) {
+    const size_t start = line + 2;
+    const size_t end = request.find("\r\n", start);
+    if (end == std::string::npos || end == start) break;
+    const size_t colon = request.find(':', start);
+    if (colon != std::string::npos && colon < end && colon - start == name.size()) {
+      std::string key = request.substr(start, colon - start);
+      for (char& c : key) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (key == name) {
+        size_t a = colon + 1, b = end;
+        while (a < b && (request[a] == ' ' || request[a] == '\t')) ++a;
+        while (b > a && (request[b - 1] == ' ' || request[b - 1] == '\t')) --b;
+        return request.substr(a, b - a);
+      }
+    }
+    line = end;
+  }
+  return "";
+}
+
+// A byte range of a file (RFC 9110 Sec. 14): [first, last], inclusive.
+struct ByteRange {
+  uintmax_t first = 0;
+  uintmax_t last = 0;
+};
+
+// Parses a Range header's value for a file of `size` bytes. nullopt: no range
+// to honour (absent, another unit, several ranges or malformed: the whole file
+// is sent, as the RFC allows); a range with first > last: unsatisfiable (416).
+std::optional<ByteRange> ParseRange(const std::string& value, uintmax_t size) {
+  const std::string unit = "bytes=";
+  if (value.compare(0, unit.size(), unit) != 0) return std::nullopt;
+  const std::string spec = value.substr(unit.size());
+  const size_t dash = spec.find('-');
+  if (dash == std::string::npos || spec.find(',') != std::string::npos) return std::nullopt;
+  const std::string a = spec.substr(0, dash), b = spec.substr(dash + 1);
+  auto number = [](const std::string& t) -> std::optional<uintmax_t> {
+    if (t.empty() || t.size() > 19 || t.find_first_not_of("0123456789") != std::string::npos)
+      return std::nullopt;
+    return std::stoull(t);
+  };
+  const ByteRange unsatisfiable{1, 0};
+  if (a.empty()) {  // "-n": the last n bytes.
+    const std::optional<uintmax_t> n = number(b);
+    if (!n) return std::nullopt;
+    if (*n == 0 || size == 0) return unsatisfiable;
+    return ByteRange{size - std::min(*n, size), size - 1};
+  }
+  const std::optional<uintmax_t> first = number(a);
+  const std::optional<uintmax_t> last = b.empty() ? std::optional<uintmax_t>(UINTMAX_MAX) : number(b);
+  if (!first || !last || *last < *first) return std::nullopt;
+  if (*first >= size) return unsatisfiable;
+  return ByteRange{*first, std::min(*last, size - 1)};
 }
 
 class Server {
@@ -231,11 +297,12 @@ class Server {
       SendSimple(fd, 404, "Not Found", "not found\n");
       return;
     }
-    SendFile(fd, *file, head_only);
+    SendFile(fd, *file, head_only, HeaderValue(request.substr(0, request.find("\r\n\r\n") + 2), "range"));
   }
 
  private:
-  static void SendFile(int fd, const fs::path& path, bool head_only) {
+  // Sends a file, or the byte range `range` (a Range header's value) of it.
+  static void SendFile(int fd, const fs::path& path, bool head_only, const std::string& range) {
     std::ifstream in(path, std::ios::binary);
     std::error_code ec;
     const uintmax_t size = fs::file_size(path, ec);
@@ -243,10 +310,26 @@ class Server {
       SendSimple(fd, 404, "Not Found", "not found\n");
       return;
     }
-    const std::string head = OkHeader(MimeType(path), size);
+    const std::optional<ByteRange> part = range.empty() ? std::nullopt : ParseRange(range, size);
+    std::string head;
+    uintmax_t left = size;
+    if (part && part->first > part->last) {
+      const std::string body = "range not satisfiable\n";
+      head = ResponseHeader("416 Range Not Satisfiable", "text/plain; charset=utf-8", body.size(),
+                            "Content-Range: bytes */" + std::to_string(size) + "\r\n");
+      SendAll(fd, head.data(), head.size()) && !head_only && SendAll(fd, body.data(), body.size());
+      return;
+    } else if (part) {
+      left = part->last - part->first + 1;
+      head = ResponseHeader("206 Partial Content", MimeType(path), left,
+                            "Content-Range: bytes " + std::to_string(part->first) + "-" +
+                                std::to_string(part->last) + "/" + std::to_string(size) + "\r\n");
+      in.seekg(static_cast<std::streamoff>(part->first));
+    } else {
+      head = OkHeader(MimeType(path), size);
+    }
     if (!SendAll(fd, head.data(), head.size()) || head_only) return;
     std::vector<char> chunk(1 << 16);
-    uintmax_t left = size;
     while (left > 0 && in) {
       in.read(chunk.data(), static_cast<std::streamsize>(std::min<uintmax_t>(chunk.size(), left)));
       const std::streamsize n = in.gcount();

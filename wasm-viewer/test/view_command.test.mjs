@@ -1,6 +1,7 @@
 // `casual3d view <package> --port 0`: serves the package and the viewer on
 // 127.0.0.1 with the right MIME types, never outside the served folders, and
-// refuses bad input with one clear line.
+// refuses bad input with one clear line; single byte ranges (206, 416) for
+// reading a .c3d file level by level.
 
 import assert from 'node:assert/strict';
 import { spawn, spawnSync } from 'node:child_process';
@@ -16,10 +17,10 @@ const CASUAL3D = path.join(BINARY_DIR, 'cli', 'casual3d');
 let tmp, pkg, server, base;
 
 /** Raw GET/HEAD (the path is sent exactly as given, no normalisation). */
-function request(rawPath, method = 'GET') {
+function request(rawPath, method = 'GET', headers = {}) {
   const { hostname, port } = new URL(base);
   return new Promise((resolve, reject) => {
-    const req = http.request({ hostname, port, path: rawPath, method }, (res) => {
+    const req = http.request({ hostname, port, path: rawPath, method, headers }, (res) => {
       const chunks = [];
       res.on('data', (c) => chunks.push(c));
       res.on('end', () => resolve({ status: res.statusCode, type: res.headers['content-type'], headers: res.headers, body: Buffer.concat(chunks) }));
@@ -35,6 +36,7 @@ before(async () => {
   fs.mkdirSync(path.join(pkg, 'l0'), { recursive: true });
   fs.writeFileSync(path.join(pkg, 'manifest.json'), '{"format": "casual3d"}\n');
   fs.writeFileSync(path.join(pkg, 'l0', '0-0.color.webp'), Buffer.from('RIFF....WEBPVP8 '));
+  fs.writeFileSync(path.join(pkg, 'photo.c3d'), Buffer.from(Array.from({ length: 1000 }, (_, i) => (i * 7) % 256)));
   fs.writeFileSync(path.join(tmp, 'secret.txt'), 'outside the package');
   fs.symlinkSync(path.join(tmp, 'secret.txt'), path.join(pkg, 'link.txt'));
   server = spawn(CASUAL3D, ['view', pkg, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
@@ -108,4 +110,39 @@ test('refuses bad input with one clear line', () => {
   const badPort = spawnSync(CASUAL3D, ['view', pkg, '--port', '70000'], { encoding: 'utf8' });
   assert.equal(badPort.status, 1);
   assert.match(badPort.stderr, /--port 70000/);
+});
+
+test('serves single byte ranges: 206 with Content-Range, 416 past the end, 200 otherwise', async () => {
+  const whole = fs.readFileSync(path.join(pkg, 'photo.c3d'));
+  const full = await request('/photo.c3d');
+  assert.equal(full.status, 200);
+  assert.equal(full.headers['accept-ranges'], 'bytes');
+  assert.deepEqual(full.body, whole);
+  for (const [range, first, last] of [['bytes=0-9', 0, 9], ['bytes=990-', 990, 999], ['bytes=-4', 996, 999],
+    ['bytes=500-5000', 500, 999], ['bytes=123-123', 123, 123], ['bytes=-5000', 0, 999]]) {
+    const r = await request('/photo.c3d', 'GET', { Range: range });
+    assert.equal(r.status, 206, range);
+    assert.equal(r.headers['content-range'], `bytes ${first}-${last}/1000`, range);
+    assert.equal(Number(r.headers['content-length']), last - first + 1, range);
+    assert.deepEqual(r.body, whole.subarray(first, last + 1), range);
+    assert.equal(r.headers['cross-origin-embedder-policy'], 'require-corp');
+  }
+  for (const range of ['bytes=1000-', 'bytes=5000-6000', 'bytes=-0']) {
+    const r = await request('/photo.c3d', 'GET', { Range: range });
+    assert.equal(r.status, 416, range);
+    assert.equal(r.headers['content-range'], 'bytes */1000', range);
+  }
+  // Several ranges, other units and malformed values: the whole file.
+  for (const range of ['bytes=0-1,5-6', 'items=0-1', 'bytes=9-3', 'bytes=a-b', 'bytes=']) {
+    const r = await request('/photo.c3d', 'GET', { Range: range });
+    assert.equal(r.status, 200, range);
+    assert.deepEqual(r.body, whole, range);
+  }
+  const head = await request('/photo.c3d', 'HEAD', { Range: 'bytes=10-19' });
+  assert.equal(head.status, 206);
+  assert.equal(head.headers['content-range'], 'bytes 10-19/1000');
+  assert.equal(head.body.length, 0);
+  const viewer = await request('/viewer/casual3d-format.wasm', 'GET', { range: 'bytes=0-3' });
+  assert.equal(viewer.status, 206);
+  assert.deepEqual([...viewer.body], [0, 0x61, 0x73, 0x6d]);
 });
