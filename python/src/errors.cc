@@ -3,7 +3,7 @@
 namespace casual3d::python {
 
 std::string NamePath(const std::string& path, const std::string& message) {
-  if (path.empty() || message.compare(0, path.size(), path) == 0) return message;
+  if (path.empty() || message.find(path) != std::string::npos) return message;
   return path + ": " + message;
 }
 

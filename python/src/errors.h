@@ -30,7 +30,7 @@ class IoError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// `message` prefixed with "`path`: " unless it already names `path` first.
+// `message` prefixed with "`path`: " unless it already names `path`.
 std::string NamePath(const std::string& path, const std::string& message);
 
 // Throws the exception of `status` (see above) if it is not OK. `path`, when
