@@ -77,3 +77,33 @@ def test_invalid_vector_refused_as_cli_does(name, cli):
     assert out.stderr.strip() == f"casual3d: error: {error.value}"
     with pytest.raises(casual3d.FormatError, match=str(path)):
         casual3d.read(path)
+
+
+def mesh_sha256(mesh):
+    """spec/package.md Sec. 9: SHA-256 of positions, normals, uvs (float32)
+    and indices (uint32), each little-endian, in that order."""
+    digest = hashlib.sha256()
+    for array, dtype in ((mesh.positions, "<f4"), (mesh.normals, "<f4"), (mesh.uvs, "<f4"),
+                         (mesh.indices, "<u4")):
+        digest.update(np.ascontiguousarray(array, dtype).tobytes())
+    return digest.hexdigest()
+
+
+@pytest.mark.parametrize("name", list(EXPECTED))
+def test_vector_meshes_match_expected(name):
+    package = casual3d.Package(VECTORS / name)
+    for level, want in enumerate(EXPECTED[name]):
+        if "mesh" not in want:
+            pytest.skip(f"expected.json lists no meshes for {name} level {level}")
+        pano = package.read(level)
+        full = casual3d.build_mesh(pano, threads=1)
+        expected = want["mesh"]["full"]
+        assert (full.num_vertices, full.num_triangles) == (expected["vertices"],
+                                                           expected["triangles"])
+        assert mesh_sha256(full) == expected["sha256"]
+        for expected in want["mesh"]["simplified"]:
+            mesh = casual3d.build_mesh(pano, simplify=True, max_triangles=0, threads=1,
+                                       max_relative_error=expected["max_relative_error"])
+            assert (mesh.num_vertices, mesh.num_triangles) == (expected["vertices"],
+                                                               expected["triangles"])
+            assert mesh_sha256(mesh) == expected["sha256"]
