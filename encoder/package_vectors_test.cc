@@ -465,11 +465,11 @@ void Regenerate() {
   for (const InvalidVector& v :
        MakeInvalidVectors(encoded["two-layer-64x32"], encoded["front-only-48x24"])) {
     if (!v.files.empty()) {
+      // path-escape keeps the graph file under its own name, which its
+      // manifest's "l0/../l0/..." path also reaches.
       for (const auto& [p, b] : v.files) {
-        // The escaping path is the graph file's own name with "l0/../" before it.
-        const std::string on_disk = p.rfind("l0/../", 0) == 0 ? p.substr(6) : p;
-        fs::create_directories((dir / "invalid" / v.name / on_disk).parent_path());
-        WriteBytes(dir / "invalid" / v.name / on_disk, b);
+        fs::create_directories((dir / "invalid" / v.name / p).parent_path());
+        WriteBytes(dir / "invalid" / v.name / p, b);
       }
     }
     WriteBytes(dir / "invalid" / (v.name + ".c3d"), v.container);
