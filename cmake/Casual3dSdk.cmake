@@ -110,6 +110,7 @@ install(FILES ${PROJECT_BINARY_DIR}/sdk/casual3dConfig.cmake
 # The prefix is found from the .pc file's own folder (${pcfiledir}).
 set(pc_dir ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 file(RELATIVE_PATH CASUAL3D_PC_PREFIX_FROM_PCFILEDIR /prefix/${pc_dir} /prefix)
+string(REGEX REPLACE "/$" "" CASUAL3D_PC_PREFIX_FROM_PCFILEDIR ${CASUAL3D_PC_PREFIX_FROM_PCFILEDIR})
 configure_file(${PROJECT_SOURCE_DIR}/cmake/casual3d-format.pc.in
   ${PROJECT_BINARY_DIR}/sdk/casual3d-format.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/sdk/casual3d-format.pc DESTINATION ${pc_dir})

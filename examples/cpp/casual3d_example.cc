@@ -112,7 +112,7 @@ bool HitBall(const casual3d::Vec3d& d, Hit* hit) {
   const double c = kBallCentre[0] * kBallCentre[0] + kBallCentre[1] * kBallCentre[1] +
                    kBallCentre[2] * kBallCentre[2] - kBallRadius_m * kBallRadius_m;
   const double disc = b * b - c;
-  if (disc <= 0) return false;
+  if (disc <= 0 || b - std::sqrt(disc) <= 0) return false;  // Missed, or behind the viewer.
   hit->depth_m = b - std::sqrt(disc);
   const double p[3] = {d.x * hit->depth_m, d.y * hit->depth_m, d.z * hit->depth_m};
   for (int i = 0; i < 3; ++i) hit->normal[i] = (p[i] - kBallCentre[i]) / kBallRadius_m;

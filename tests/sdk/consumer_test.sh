@@ -75,6 +75,25 @@ done <"$scratch/expected.txt"
 grep -q "^wrote $scratch/synthetic: read back with the same nodes and links" "$scratch/example.txt" ||
   fail "casual3d_example did not read back the package it wrote"
 
+step "find_package(casual3d COMPONENTS format), and an unknown component"
+mkdir -p "$scratch/components"
+cat >"$scratch/components/CMakeLists.txt" <<'CMAKE'
+cmake_minimum_required(VERSION 3.16)
+project(components LANGUAGES CXX)
+find_package(casual3d CONFIG REQUIRED COMPONENTS format)
+if(NOT TARGET casual3d::format OR NOT casual3d_VERSION STREQUAL EXPECTED_VERSION)
+  message(FATAL_ERROR "casual3d::format ${casual3d_VERSION}: not as expected")
+endif()
+find_package(casual3d CONFIG QUIET COMPONENTS format nosuch)
+if(casual3d_FOUND)
+  message(FATAL_ERROR "find_package(casual3d COMPONENTS nosuch) succeeded")
+endif()
+CMAKE
+sed -i "s/EXPECTED_VERSION/\"$CASUAL3D_VERSION\"/" "$scratch/components/CMakeLists.txt"
+run_quietly "find_package(casual3d) with components" "$CMAKE_COMMAND" -S "$scratch/components" \
+  -B "$scratch/components/build" -DCMAKE_CXX_COMPILER="$CXX" -DCMAKE_PREFIX_PATH="$prefix" \
+  -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
+
 step "the installed casual3d"
 check_installed_program "$prefix"
 out="$("$prefix/bin/casual3d" validate "$scratch/synthetic" 2>&1)" || fail "validate of the example's package: $out"
