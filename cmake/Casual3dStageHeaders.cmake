@@ -35,7 +35,7 @@ foreach(header ${HEADERS})
     string(REGEX REPLACE "^#include \"([^\"]+)\".*" "\\1" name "${line}")
     if(NOT name IN_LIST HEADERS)
       message(FATAL_ERROR "${header} is public but includes ${name}, which is not: "
-                          "make ${name} public (CASUAL3D_PUBLIC_HEADERS in cmake/Casual3dSdk.cmake) "
+                          "list ${name} among the public headers in cmake/Casual3dSdk.cmake "
                           "or move the include into a .cc file")
     endif()
   endforeach()
