@@ -11,9 +11,12 @@ void ThrowIfError(const Status& status, const std::string& path) {
   if (status.ok()) return;
   const std::string message = NamePath(path, status.message());
   switch (status.code()) {
-    case StatusCode::kInvalidArgument: throw std::invalid_argument(message);
-    case StatusCode::kIoError: throw IoError(message);
-    default: throw FormatError(message);
+    case StatusCode::kInvalidArgument:
+      throw std::invalid_argument(message);
+    case StatusCode::kIoError:
+      throw IoError(message);
+    default:
+      throw FormatError(message);
   }
 }
 

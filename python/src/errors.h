@@ -9,10 +9,10 @@
 //   anything else     -> casual3d.FormatError (a ValueError: malformed,
 //                        unsupported or missing data, limits, internal errors)
 
+#include <pybind11/pybind11.h>
+
 #include <stdexcept>
 #include <string>
-
-#include <pybind11/pybind11.h>
 
 #include "format/status.h"
 

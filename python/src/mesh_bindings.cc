@@ -1,10 +1,10 @@
 // Meshes: the full mesh of spec/mesh.md or the simplified one, as numpy
 // arrays, and the colour atlas their uvs address.
 
+#include <pybind11/pybind11.h>
+
 #include <algorithm>
 #include <optional>
-
-#include <pybind11/pybind11.h>
 
 #include "format/colour_atlas.h"
 #include "format/mesh_builder.h"

@@ -133,12 +133,13 @@ TwoLayerPanorama PanoramaFromPython(py::handle pano) {
     LayerFromPython(pano.attr(kLayerNames[l]), kLayerNames[l], out.width(), out.height(),
                     &out.layer(l));
   }
-  const auto centre = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
-      pano.attr("centre"));
-  const auto rotation = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
-      pano.attr("rotation"));
+  const auto centre =
+      py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(pano.attr("centre"));
+  const auto rotation =
+      py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(pano.attr("rotation"));
   if (!centre || centre.size() != 3) throw std::invalid_argument("centre: expected 3 numbers");
-  if (!rotation || rotation.size() != 9) throw std::invalid_argument("rotation: expected 3x3 numbers");
+  if (!rotation || rotation.size() != 9)
+    throw std::invalid_argument("rotation: expected 3x3 numbers");
   std::memcpy(out.frame().centre, centre.data(), 3 * sizeof(double));
   std::memcpy(out.frame().rotation, rotation.data(), 9 * sizeof(double));
   py::object hints = pano.attr("view_hints");

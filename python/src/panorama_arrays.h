@@ -11,10 +11,10 @@
 //                               1 the neighbour's front node, 2 its back node
 // A node exists exactly where its depth is not NaN.
 
-#include <vector>
-
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+
+#include <vector>
 
 #include "format/two_layer.h"
 

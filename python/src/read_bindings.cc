@@ -1,13 +1,13 @@
 // Reading: packages (folder or .c3d) level by level, master files, and the
 // complete check of `casual3d validate`.
 
+#include <pybind11/pybind11.h>
+
 #include <algorithm>
 #include <memory>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <pybind11/pybind11.h>
 
 #include "encoder/master_file.h"
 #include "encoder/webp_codec.h"
@@ -111,8 +111,7 @@ py::list Validate(const std::string& path, int threads) {
       pano = ReadPackage(**source, encoder::WebpImageDecoder(), options, &manifest);
     }
     if (!pano.ok()) {
-      throw FormatError(path + ": level " + std::to_string(level) + ": " +
-                        pano.status().message());
+      throw FormatError(path + ": level " + std::to_string(level) + ": " + pano.status().message());
     }
     count = static_cast<int>(manifest.levels.size());
     py::dict summary;

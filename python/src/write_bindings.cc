@@ -1,9 +1,9 @@
 // Writing: a package folder or .c3d file (encoder/package_writer.h), a
 // master file (encoder/master_file.h) and a binary glTF (encoder/gltf_export.h).
 
-#include <string>
-
 #include <pybind11/pybind11.h>
+
+#include <string>
 
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
@@ -30,7 +30,7 @@ py::dict WritePackage(py::handle pano_object, const std::string& path, bool sing
     if (status.ok()) status = pano.Validate();
     if (status.ok()) {
       StatusOr<encoder::PackageFiles> files = encoder::EncodePackage(pano, options, &stats);
-      status = !files.ok()      ? files.status()
+      status = !files.ok()   ? files.status()
                : single_file ? encoder::WritePackageSingleFile(*files, path)
                              : encoder::WritePackageFolder(*files, path);
     }

@@ -5,6 +5,8 @@ FNV-1a over the same arrays, format/testing/mesh_checksum.h), on the same
 `casual3d export`."""
 
 import re
+import threading
+import time
 
 import numpy as np
 
@@ -84,3 +86,33 @@ def test_triangle_counts_match_casual3d_export(cli, tmp_path):
             assert out.returncode == 0, out.stderr
             counts = re.search(r"(\d+) vertices, (\d+) triangles", out.stdout)
             assert int(counts.group(2)) == mesh.num_triangles, (vector, flags)
+
+
+def test_long_calls_release_the_gil():
+    """While a mesh is built on another thread, this thread keeps running:
+    its longest pause is far shorter than the call (the GIL is released)."""
+    blocks = make_blocks_panorama()
+    tile = lambda a: np.tile(a, (2, 2) + (1,) * (a.ndim - 2))  # 1024 x 512 pixels.
+    big = casual3d.Panorama(*(casual3d.Layer(**{k: tile(a) for k, a in vars(layer).items()})
+                              for layer in blocks.layers))
+    casual3d.link_neighbours(big)
+    done = threading.Event()
+
+    def work():
+        casual3d.build_mesh(big, simplify=True, threads=1)
+        done.set()
+
+    start = time.perf_counter()
+    worker = threading.Thread(target=work)
+    worker.start()
+    last, longest_pause = start, 0.0
+    while not done.is_set():
+        now = time.perf_counter()
+        longest_pause = max(longest_pause, now - last)
+        last = now
+    worker.join()
+    duration = time.perf_counter() - start
+    assert duration > 0.2
+    # Held through the call, the GIL would stop this loop for nearly all of
+    # it; the margin is for a busy machine's scheduling.
+    assert longest_pause < 0.5 * duration, (longest_pause, duration)
