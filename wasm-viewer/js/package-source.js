@@ -5,8 +5,9 @@
 // of manifest.json and read(path) for the files it names; the package reader
 // checks each file's size and SHA-256, so a source only moves bytes.
 //
-// A .c3d over HTTP costs one request for its header and directory (usually
-// the first 64 KiB, which also hold the manifest), then one range per file,
+// A .c3d over HTTP costs one request for its header and directory (the first
+// 16 KiB, more for a long directory), one for the manifest unless those bytes
+// hold it, then one range per file (the files those bytes hold excepted),
 // so that the coarsest level shows after a few requests. A server that
 // ignores Range (200 instead of 206) sends the whole file, which is then read
 // from memory.
@@ -32,7 +33,7 @@ export async function forEachLimited(items, limit, task) {
   if (failure) throw failure;
 }
 
-const PREFIX_BYTES = 64 * 1024;
+const PREFIX_BYTES = 16 * 1024;
 const SINGLE_FILE_MAGIC = [0x89, 0x43, 0x33, 0x44, 0x0d, 0x0a, 0x1a, 0x0a];
 
 /** Whether `bytes` begin with the .c3d magic. */

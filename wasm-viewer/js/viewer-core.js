@@ -327,6 +327,8 @@ export class Casual3dViewer extends EventTarget {
           this._emitError(`level ${msg.level} cannot be shown: ${err.message || err}`, !this._levelShown);
           break;
         }
+        // In VR the session draws the frames: the level is on screen now.
+        if (!this._levelShown && this._xrSession) this._worker.postMessage({ type: 'shown', id: msg.id });
         this._levelShown = true;
         this.stats.level = msg.level;
         this.stats.levels = msg.levels;
@@ -495,6 +497,7 @@ export class Casual3dViewer extends EventTarget {
         timeToFirstFrameMs: this.stats.timeToFirstFrameMs,
         bytesBeforeFirstFrame: this.stats.bytesBeforeFirstFrame,
       });
+      this._worker?.postMessage({ type: 'shown', id: this._loadId });
     }
     const waiters = this._frameWaiters;
     this._frameWaiters = [];

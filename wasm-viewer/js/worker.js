@@ -13,8 +13,12 @@
 // from that level, with the content narrowed to where that level has nodes;
 // and the soft background image (environment.js) built from that level.
 //
+// Finer levels are fetched once the page has drawn the first one (it says so
+// with 'shown'), so that nothing competes with the first frame.
+//
 // Messages in:  {type: 'load', id, url, yawDeg, maxLevelWidth, maxTriangles}
 //               {type: 'view', yawDeg}
+//               {type: 'shown', id}   (the first level of load `id` is on screen)
 // Messages out: {type: 'progress', id, progress: {loadedBytes, totalBytes, level, levels}}
 //               {type: 'level', id, level, levels, width, height, mesh, atlas, timing,
 //                view?: {hints, warning, environment}}   (first level only)
@@ -32,6 +36,19 @@ const FETCH_CONCURRENCY = 6;
 let formatPromise = null;
 let currentId = 0;
 let viewYawDeg = 0;
+let shownId = -1;
+let shownWaiter = null;
+
+/** Resolves once load `id`'s first level is on screen, or a newer load began. */
+function firstLevelShown(id) {
+  if (shownId === id) return Promise.resolve();
+  return new Promise((resolve) => { shownWaiter = resolve; });
+}
+
+function wakeShownWaiter() {
+  shownWaiter?.();
+  shownWaiter = null;
+}
 
 class Superseded extends Error {}
 
@@ -41,8 +58,16 @@ self.onmessage = (e) => {
     viewYawDeg = msg.yawDeg;
     return;
   }
+  if (msg.type === 'shown') {
+    if (msg.id === currentId) {
+      shownId = msg.id;
+      wakeShownWaiter();
+    }
+    return;
+  }
   if (msg.type !== 'load') return;
   currentId = msg.id;
+  wakeShownWaiter();  // The previous load, waiting, sees that it is superseded.
   viewYawDeg = msg.yawDeg ?? 0;
   load(msg).catch((err) => {
     if (err instanceof Superseded) return;
@@ -102,6 +127,10 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
     progress(chosen[0].level, true);
 
     for (const { level, info } of chosen) {
+      if (shown === 1) {
+        await firstLevelShown(id);
+        check();
+      }
       const timing = { level, fetchDecodeMs: 0, meshMs: 0, threads: format.numThreads };
       const t0 = performance.now();
       try {

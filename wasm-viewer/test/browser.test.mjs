@@ -8,7 +8,10 @@
 //  - effects are geometry-aware: an object behind the near sphere is hidden, one
 //    in front of it shows; water covers the floor but not the sphere's top;
 //  - a package with a corrupted tile shows the error message, keeps the coarser
-//    level on screen and the page stays responsive.
+//    level on screen and the page stays responsive;
+//  - the same package as one .c3d file, by URL: read in HTTP range requests,
+//    the first frame before any range of the finest level was asked for, the
+//    same images; and from a server that ignores ranges (one whole download).
 // Screenshots go to $CASUAL3D_BINARY_DIR/wasm-viewer/browser-test/.
 // Exits 77 (ctest: skipped) when Chromium is not installed.
 
@@ -99,7 +102,13 @@ before(async () => {
   fs.writeFileSync(path.join(bad, damaged), bytes);
   metrics.damagedFile = damaged;
 
-  server = await startServer({ '/viewer/': DIST_DIR, '/pkg/': good, '/bad/': bad }, {
+  // The same package as one file.
+  const single = path.join(tmp, 'single');
+  fs.mkdirSync(single);
+  runTool('viewer_test_tool', ['single-file', good, path.join(single, 'room.c3d')]);
+
+  server = await startServer({ '/viewer/': DIST_DIR, '/pkg/': good, '/bad/': bad, '/single/': single }, {
+    '/room.html': viewerPage('/single/room.c3d', { width: W, height: H, maxLevelWidth: 1024 }),
     '/index.html': viewerPage('/pkg/manifest.json', { width: W, height: H, maxLevelWidth: 1024 }),
     '/bad.html': viewerPage('/bad/manifest.json', { width: W, height: H, maxLevelWidth: 1024 }),
     '/missing.html': viewerPage('/nothing-here/manifest.json', { width: W, height: H }),
@@ -246,6 +255,116 @@ test('effects: inserted object and water are occluded by nearer geometry', async
   await page.screenshot({ path: path.join(OUT, 'effect_all.png') });
   assert.ok(changed(plain, lit) > W * H * 0.2, 'lighting changes the image');
   await setup(none);
+});
+
+/** {path, offset, size} of each entry of a .c3d file (spec/package.md Sec. 8). */
+function singleFileEntries(file) {
+  const b = fs.readFileSync(file);
+  const entries = [];
+  for (let i = 0, at = 16; i < b.readUInt32LE(12); ++i) {
+    const len = b.readUInt16LE(at);
+    entries.push({ path: b.toString('utf8', at + 2, at + 2 + len), offset: Number(b.readBigUInt64LE(at + 2 + len)),
+      size: Number(b.readBigUInt64LE(at + 10 + len)) });
+    at += 18 + len;
+  }
+  return entries;
+}
+
+/** Opens `url` in a new page; resolves to {page, events, firstEpochMs} once the package has loaded. */
+async function loadInNewPage(url) {
+  const p = await browser.newPage({ viewport: { width: W, height: H }, deviceScaleFactor: 1 });
+  p.on('pageerror', (e) => console.log(`page error: ${e.message}`));
+  await p.goto(url);
+  await p.waitForFunction(() => (window.__events ?? []).some((e) => e.type === 'load' || e.type === 'error'),
+    null, { timeout: 120000, polling: 100 });
+  const { events, origin } = await p.evaluate(() => ({ events: window.__events, origin: performance.timeOrigin + window.__t0 }));
+  const first = events.find((e) => e.type === 'firstframe');
+  return { page: p, events, firstEpochMs: first ? origin + first.t : NaN };
+}
+
+/** PSNR of the viewer in `p` from camera 0 against the native reference image. */
+async function psnrOfCamera0(p) {
+  const reference = path.join(OUT, 'reference_single_0.ppm');
+  if (!fs.existsSync(reference)) {
+    const c = CAMERAS[0];
+    runTool('viewer_test_tool', ['render', path.join(tmp, 'room'), '0', String(W), String(H),
+      path.join(OUT, 'reference_single'), [c.yawDeg, c.pitchDeg, c.fovDeg, ...c.position].join(',')]);
+  }
+  await p.evaluate((c) => document.getElementById('v').setCamera(c), CAMERAS[0]);
+  const previous = page;
+  page = p;  // readFrame reads the current page.
+  try {
+    return psnr(await readFrame(), readPpm(reference).data, W, H);
+  } finally {
+    page = previous;
+  }
+}
+
+test('a .c3d by URL: range requests, the first frame before the finest level is asked for', async () => {
+  const file = path.join(tmp, 'single', 'room.c3d');
+  const entries = singleFileEntries(file);
+  const start = server.log.length;
+  const { page: p, events, firstEpochMs } = await loadInNewPage(`${server.url}/room.html`);
+  try {
+    const errors = events.filter((e) => e.type === 'error');
+    assert.equal(errors.length, 0, `unexpected errors: ${JSON.stringify(errors)}`);
+    assert.deepEqual(events.filter((e) => e.type === 'level').map((e) => e.detail.level), [2, 1, 0]);
+    const requests = server.log.slice(start).filter((r) => r.path === '/single/room.c3d');
+    assert.ok(requests.every((r) => r.status === 206 && r.range), 'every request of the .c3d is a range');
+    // The first request reads the header and directory (16 KiB, which may hold
+    // the first files' bytes too); every other one reads one file.
+    assert.equal(requests[0].range[0], 0);
+    assert.ok(requests[0].bytes <= 16 * 1024);
+    const fileOf = new Map(entries.map((e) => [e.offset, e.path]));
+    const reads = requests.slice(1).map((r) => ({ ...r, file: fileOf.get(r.range[0]) }));
+    assert.ok(reads.every((r) => r.file && r.bytes === entries.find((e) => e.path === r.file).size),
+      'each range is one file of the container');
+    const finest = reads.filter((r) => r.file.startsWith('l0/'));
+    assert.ok(finest.length > 0, 'the finest level was read');
+    const firstFinest = Math.min(...finest.map((r) => r.epochMs));
+    metrics.singleFile = {
+      requests: requests.length, bytes: requests.reduce((s, r) => s + r.bytes, 0), fileBytes: fs.statSync(file).size,
+      firstFrameBeforeFinestMs: Math.round(firstFinest - firstEpochMs),
+      timeToFirstFrameMs: Math.round(events.find((e) => e.type === 'firstframe').detail.timeToFirstFrameMs),
+    };
+    assert.ok(firstEpochMs < firstFinest,
+      `the first frame (${firstEpochMs}) came before the first request of the finest level (${firstFinest})`);
+    // Coarse levels first: no range of the finest level before the coarsest was complete.
+    const coarsest = reads.filter((r) => r.file.startsWith('l2/'));
+    assert.ok(coarsest.length > 0 && Math.max(...coarsest.map((r) => r.epochMs)) < firstFinest);
+    // Each file at most once (one straddling the first 16 KiB is read whole).
+    assert.equal(new Set(reads.map((r) => r.file)).size, reads.length);
+    assert.ok(metrics.singleFile.bytes <= metrics.singleFile.fileBytes + 16 * 1024);
+    const db = await psnrOfCamera0(p);
+    metrics.singleFile.psnrDb = Number(db.toFixed(2));
+    assert.ok(db >= 30, `PSNR ${db.toFixed(2)} dB < 30 dB`);
+    await p.screenshot({ path: path.join(OUT, 'single_file.png') });
+  } finally {
+    await p.close();
+  }
+});
+
+test('a .c3d from a server that ignores ranges: one whole download', async () => {
+  const plain = await startServer({ '/viewer/': DIST_DIR, '/single/': path.join(tmp, 'single') }, {
+    '/room.html': viewerPage('/single/room.c3d', { width: W, height: H, maxLevelWidth: 1024 }),
+    '/favicon.ico': '',
+  }, { isolated: true, ranges: false });
+  try {
+    const { page: p, events } = await loadInNewPage(`${plain.url}/room.html`);
+    try {
+      assert.deepEqual(events.filter((e) => e.type === 'error'), []);
+      assert.deepEqual(events.filter((e) => e.type === 'level').map((e) => e.detail.level), [2, 1, 0]);
+      const requests = plain.log.filter((r) => r.path === '/single/room.c3d');
+      assert.deepEqual(requests.map((r) => [r.status, r.bytes]), [[200, fs.statSync(path.join(tmp, 'single', 'room.c3d')).size]]);
+      const db = await psnrOfCamera0(p);
+      metrics.singleFileNoRanges = { psnrDb: Number(db.toFixed(2)) };
+      assert.ok(db >= 30, `PSNR ${db.toFixed(2)} dB < 30 dB`);
+    } finally {
+      await p.close();
+    }
+  } finally {
+    await plain.close();
+  }
 });
 
 test('a corrupted tile shows an error, keeps the coarser level and the page responsive', async () => {

@@ -1,6 +1,7 @@
 // A tiny static HTTP server for the viewer's browser tests and benchmarks:
 // serves `routes` (URL prefix -> folder) on 127.0.0.1 with the MIME types the
-// viewer needs (application/wasm included) and counts the bytes it sends.
+// viewer needs (application/wasm included), single byte ranges (206) unless
+// told to ignore them, and logs each request with the bytes it sends.
 
 import fs from 'node:fs';
 import http from 'node:http';
@@ -8,29 +9,50 @@ import path from 'node:path';
 
 const MIME = {
   '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8', '.json': 'application/json',
-  '.wasm': 'application/wasm', '.webp': 'image/webp', '.png': 'image/png', '.ts': 'text/plain',
+  '.mjs': 'text/javascript; charset=utf-8', '.css': 'text/css', '.wasm': 'application/wasm', '.webp': 'image/webp',
+  '.png': 'image/png', '.ts': 'text/plain',
 };
 
 /**
  * @param {Record<string, string>} routes e.g. {'/viewer/': distDir, '/pkg/': packageDir}
  * @param {Record<string, string>} pages exact paths served from memory (e.g. '/index.html')
- * @param {{isolated?: boolean}} options isolated: send the cross-origin isolation headers
- *   (COOP same-origin, COEP require-corp) that let the viewer use its threaded wasm build
- * @returns {Promise<{url: string, close: () => Promise<void>, log: {path: string, bytes: number, t: number}[]}>}
+ * @param {{isolated?: boolean, ranges?: boolean}} options isolated: send the cross-origin
+ *   isolation headers (COOP same-origin, COEP require-corp) that let the viewer use its
+ *   threaded wasm build; ranges (default true): answer a single-range Range header with 206,
+ *   else send the whole file (200) as a server without range support does
+ * @returns {Promise<{url: string, close: () => Promise<void>,
+ *   log: {path: string, status: number, range: [number, number] | null, bytes: number, t: number, epochMs: number}[]}>}
+ *   t: performance.now() of this process; epochMs: the same instant in milliseconds since
+ *   1970, comparable with a page's performance.timeOrigin + performance.now()
  */
-export async function startServer(routes, pages = {}, { isolated = false } = {}) {
+export async function startServer(routes, pages = {}, { isolated = false, ranges = true } = {}) {
   const log = [];
   const server = http.createServer((req, res) => {
     const urlPath = decodeURIComponent(new URL(req.url, 'http://x').pathname);
-    const send = (code, type, body) => {
-      const headers = { 'Content-Type': type, 'Content-Length': body.length, 'Cache-Control': 'no-store' };
+    const arrived = performance.now();
+    const send = (code, type, body, extra = {}, range = null) => {
+      const headers = { 'Content-Type': type, 'Content-Length': body.length, 'Cache-Control': 'no-store', ...extra };
       if (isolated) {
         headers['Cross-Origin-Opener-Policy'] = 'same-origin';
         headers['Cross-Origin-Embedder-Policy'] = 'require-corp';
       }
       res.writeHead(code, headers);
       res.end(body);
-      log.push({ path: urlPath, bytes: body.length, t: performance.now() });
+      log.push({ path: urlPath, status: code, range, bytes: body.length, t: arrived, epochMs: performance.timeOrigin + arrived });
+    };
+    const sendFile = (file) => {
+      const body = fs.readFileSync(file);
+      const type = MIME[path.extname(file)] ?? 'application/octet-stream';
+      const m = ranges ? /^bytes=(\d*)-(\d*)$/.exec(req.headers.range ?? '') : null;
+      if (!m || (m[1] === '' && m[2] === '')) return send(200, type, body);
+      const size = body.length;
+      const first = m[1] === '' ? Math.max(0, size - Number(m[2])) : Number(m[1]);
+      const last = m[1] === '' || m[2] === '' ? size - 1 : Math.min(Number(m[2]), size - 1);
+      if (first >= size || last < first) {
+        return send(416, 'text/plain', Buffer.from('range not satisfiable'), { 'Content-Range': `bytes */${size}` });
+      }
+      return send(206, type, body.subarray(first, last + 1), { 'Content-Range': `bytes ${first}-${last}/${size}` },
+        [first, last]);
     };
     if (pages[urlPath] !== undefined) return send(200, MIME['.html'], Buffer.from(pages[urlPath]));
     for (const [prefix, dir] of Object.entries(routes)) {
@@ -39,7 +61,7 @@ export async function startServer(routes, pages = {}, { isolated = false } = {})
       if (rel.split('/').some((s) => s === '..')) return send(400, 'text/plain', Buffer.from('bad path'));
       const file = path.join(dir, rel);
       if (!fs.existsSync(file) || !fs.statSync(file).isFile()) break;
-      return send(200, MIME[path.extname(file)] ?? 'application/octet-stream', fs.readFileSync(file));
+      return sendFile(file);
     }
     send(404, 'text/plain', Buffer.from('not found'));
   });

@@ -11,6 +11,9 @@
 //     renders it with the native software renderer (reconstruct/render/) from
 //     each WebGL-style camera (degrees, metres): <out_prefix>_<i>.ppm (binary
 //     RGB, for comparisons) and <out_prefix>_<i>.png (for looking at).
+//   viewer_test_tool single-file <package_dir> <out.c3d>
+//     Writes the package folder's files (manifest.json first, then the files
+//     in the manifest's order) as a single-file container (spec/package.md 8).
 //   viewer_test_tool mesh <package_dir> <level> <out_base>
 //     Reads the package natively and writes <out_base>.pano and <out_base>.mesh
 //     (src/panorama_blob.h): the decoded panorama and its native mesh.
@@ -206,13 +209,33 @@ int Render(int argc, char** argv) {
 
 }  // namespace
 
+int SingleFile(int argc, char** argv) {
+  if (argc != 4) return Fail("usage: viewer_test_tool single-file <package_dir> <out.c3d>");
+  casual3d::FolderFileSource source(argv[2]);
+  auto manifest_bytes = source.Read(casual3d::kManifestFileName, 16u << 20);
+  if (!manifest_bytes.ok()) return Fail(manifest_bytes.status().ToString());
+  auto reader = casual3d::PackageReader::Create(
+      std::string_view(reinterpret_cast<const char*>(manifest_bytes->data()), manifest_bytes->size()));
+  if (!reader.ok()) return Fail(reader.status().ToString());
+  casual3d::encoder::PackageFiles files;
+  files.emplace_back(casual3d::kManifestFileName, std::move(manifest_bytes).value());
+  for (const casual3d::FileEntry& f : reader->manifest().files) {
+    auto bytes = source.Read(f.path, f.bytes);
+    if (!bytes.ok()) return Fail(bytes.status().ToString());
+    files.emplace_back(f.path, std::move(bytes).value());
+  }
+  const casual3d::Status s = casual3d::encoder::WritePackageSingleFile(files, argv[3]);
+  return s.ok() ? 0 : Fail(s.ToString());
+}
+
 int main(int argc, char** argv) {
   try {
     if (argc >= 2 && std::string(argv[1]) == "package") return Package(argc, argv);
     if (argc >= 2 && std::string(argv[1]) == "render") return Render(argc, argv);
     if (argc >= 2 && std::string(argv[1]) == "mesh") return DumpMesh(argc, argv);
+    if (argc >= 2 && std::string(argv[1]) == "single-file") return SingleFile(argc, argv);
   } catch (const std::exception& e) {
     return Fail(e.what());
   }
-  return Fail("usage: viewer_test_tool <package|render|mesh> ...");
+  return Fail("usage: viewer_test_tool <package|render|mesh|single-file> ...");
 }
