@@ -82,6 +82,42 @@ void FillDepths(const Grid& cells, int gw, int gh, std::vector<float>* depth) {
   }
 }
 
+// The cells of `cells` plus its holes that `closed` (its closing) covers
+// whole: 4-connected components of non-content cells (columns wrap, rows do
+// not) all of whose cells are in `closed`. A notch of the outline belongs to
+// the component outside the content, which reaches beyond the closing, so it
+// stays out.
+Grid AddNarrowHoles(const Grid& cells, const Grid& closed, int gw, int gh) {
+  Grid out = cells;
+  std::vector<int> seen(cells.size(), 0), component, stack;
+  for (size_t start = 0; start < cells.size(); ++start) {
+    if (cells[start] || seen[start]) continue;
+    component.clear();
+    stack.assign(1, static_cast<int>(start));
+    seen[start] = 1;
+    bool enclosed = true;
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      component.push_back(i);
+      enclosed = enclosed && closed[i];
+      const int x = i % gw, y = i / gw;
+      const int nx[4] = {WrapColumn(x + 1, gw), WrapColumn(x - 1, gw), x, x};
+      const int ny[4] = {y, y, y - 1, y + 1};
+      for (int k = 0; k < 4; ++k) {
+        if (ny[k] < 0 || ny[k] >= gh) continue;
+        const int j = ny[k] * gw + nx[k];
+        if (cells[j] || seen[j]) continue;
+        seen[j] = 1;
+        stack.push_back(j);
+      }
+    }
+    if (enclosed)
+      for (const int i : component) out[i] = 1;
+  }
+  return out;
+}
+
 bool WithinExtent(const ViewHints& hints, double lon_deg, double lat_deg) {
   if (lat_deg < hints.content_pitch_min_deg || lat_deg > hints.content_pitch_max_deg) return false;
   const double span = hints.content_yaw_max_deg - hints.content_yaw_min_deg;
@@ -124,7 +160,8 @@ CapturedField::CapturedField(const TwoLayerPanorama& pano, const ViewHints& hint
     }
   const double cell_deg = 360.0 * cell / w;
   const int r = static_cast<int>(std::ceil(closing_deg / cell_deg - 1e-9));
-  if (r > 0) cells_ = Morph(Morph(cells_, gw, gh, r, true), gw, gh, r, false);
+  if (r > 0)
+    cells_ = AddNarrowHoles(cells_, Morph(Morph(cells_, gw, gh, r, true), gw, gh, r, false), gw, gh);
 
   // The proxy surface.
   std::vector<float> depth = CellDepths(pano, cell, gw, gh);

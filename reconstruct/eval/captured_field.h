@@ -7,11 +7,13 @@
 // max(1, round(width / 512)) pixels; a cell holds content when more than half
 // of its pixels have a front node and its centre direction lies within the
 // content's angular extent of the view hints (ViewHints::content_yaw_*_deg,
-// content_pitch_*_deg; longitudes modulo 360). The mask is then closed
-// (dilated, then eroded; square window, columns wrapping around the seam,
-// rows clamped) with a radius of ceil(closing_deg / cell angle) cells, so
-// that holes in the front layer narrower than about 2 closing_deg count as
-// captured while the outline stays where it is.
+// content_pitch_*_deg; longitudes modulo 360). Its holes narrower than
+// about 2 closing_deg then count as captured: the 4-connected components of
+// non-content cells (columns wrapping around the seam, rows not) that lie
+// wholly inside the mask's closing (dilated, then eroded; square window,
+// rows clamped) with a radius of ceil(closing_deg / cell angle) cells. The
+// outline stays where it is, notches included: a notch of a ragged outline
+// is part of what no photo saw, not a hole in what they saw.
 //
 // Proxy: the mask's cells as one closed surface, a node at each content
 // cell's centre direction at the median front depth of its pixels (cells

@@ -147,6 +147,33 @@ TEST(DeriveViewHintsTest, ContentAcrossTheSeamGivesAWrappedExtent) {
   EXPECT_EQ(full.fov_deg, 120);
 }
 
+TEST(CapturedFieldTest, NarrowHolesCountNotchesOfTheOutlineDoNot) {
+  // Content over columns 171..340 and rows 86..169 of a 512 x 256 panorama
+  // (one pixel a cell); a 3 x 3 hole inside it and a notch 3 rows high,
+  // 6 columns deep, cut into its right edge. Closing radius 2 degrees = 3 cells.
+  TwoLayerPanorama pano(512, 256);
+  LayerData& f = pano.layer(kFront);
+  for (int y = 86; y < 170; ++y)
+    for (int x = 171; x < 341; ++x) {
+      const bool hole = x >= 250 && x < 253 && y >= 120 && y < 123;
+      const bool notch = x >= 335 && y >= 130 && y < 133;
+      if (hole || notch) continue;
+      f.present[pano.index(x, y)] = 1;
+      f.depth_m[pano.index(x, y)] = 2.0f;
+    }
+  ViewHints h = Ahead(0.1);
+  h.content_yaw_min_deg = -60;
+  h.content_yaw_max_deg = 60;
+  h.content_pitch_min_deg = -30;
+  h.content_pitch_max_deg = 30;
+  const CapturedField field(pano, h, 2.0);
+  const auto pixel = [&](double x, double y) { return EquirectPixelToDirection(x, y, 512, 256); };
+  EXPECT_TRUE(field.Contains(pixel(251.5, 121.5)));   // The hole: captured.
+  EXPECT_FALSE(field.Contains(pixel(338.5, 131.5)));  // The notch: not.
+  EXPECT_TRUE(field.Contains(pixel(330.5, 131.5)));   // Content beside it.
+  EXPECT_FALSE(field.Contains(pixel(345.5, 131.5)));  // Beyond the outline.
+}
+
 TEST(ViewerViewsTest, HoleInsideTheContentTearsTheCentreView) {
   const int w = 256, h = 128;
   TwoLayerPanorama pano = testing::MakeSpherePanorama(w, h, 2.0f);

@@ -36,7 +36,8 @@ class Sealer {
  public:
   Sealer(TwoLayerPanorama* pano, const SealOptions& options)
       : p_(*pano), min_ratio_(static_cast<float>(options.min_link_ratio)),
-        tau_(static_cast<float>(options.tau_dratio)) {}
+        tau_(static_cast<float>(options.tau_dratio)),
+        continuous_ratio_(static_cast<float>(options.continuous_ratio)) {}
 
   bool AllFront(int x, int y) const { return AllPresent(p_, kFront, x, y); }
   bool AllBack(int x, int y) const { return AllPresent(p_, kBack, x, y); }
@@ -46,9 +47,22 @@ class Sealer {
   bool BackOpen(int x, int y) const {
     return AllBack(x, y) && QuadCoverage(p_, x, y, true, 1u << kFront) != 0xFu;
   }
+  // A quad of one continuous front surface (four front corners whose depths
+  // lie within the ratio `continuous_ratio` of each other) that the front
+  // layer's own triangles leave open: closed seen from the centre by back
+  // nodes behind it, it opens as soon as the eye moves.
+  bool FrontOnlyOpen(int x, int y) const {
+    if (!AllFront(x, y)) return false;
+    if (!Continuous(x, y)) return false;
+    return QuadCoverage(p_, x, y, true, 1u << kBack) != 0xFu;
+  }
   // Whether closed back quads count in the score (the back-layer round);
   // closed front quarters always weigh more.
   void set_score_back(bool on) { score_back_ = on; }
+  // Whether the front layer's own closed quarters of continuous quads count
+  // (the front-surface round); below every quarter closed seen from the
+  // centre, above every back quarter.
+  void set_score_front_only(bool on) { score_front_only_ = on; }
 
   // Tries the edits of quad (x, y); true if some were kept. `behind`: also
   // links across any depth step between two nodes that both lie clearly
@@ -103,6 +117,12 @@ class Sealer {
     return gain > 0 && (gain > best_gain || (gain == best_gain && pref > best_pref));
   }
   bool Present(int l, int x, int y) const { return p_.layer(l).present[p_.index(x, y)] != 0; }
+  bool Continuous(int x, int y) const {
+    const int xb = x + 1 == p_.width() ? 0 : x + 1;
+    const float d[4] = {Depth(kFront, x, y), Depth(kFront, xb, y), Depth(kFront, x, y + 1),
+                        Depth(kFront, xb, y + 1)};
+    return *std::min_element(d, d + 4) > continuous_ratio_ * *std::max_element(d, d + 4);
+  }
   float Depth(int l, int x, int y) const { return p_.layer(l).depth_m[p_.index(x, y)]; }
   bool Linked(int l, int x, int y, Direction d, int to) const {
     return GetLink(p_.layer(l).links[p_.index(x, y)], d) == LinkTo(to);
@@ -297,10 +317,15 @@ class Sealer {
     if (qy < 0 || qy > p_.height() - 2) return 0;
     qx = WrapColumn(qx, p_.width());
     int s = 0;
-    // A front quarter outweighs every back quarter of the 5x5 window (at
-    // most 100), so that no edit trades closure seen from the centre for
-    // closure behind it.
-    if (AllFront(qx, qy)) s += 128 * __builtin_popcount(QuadCoverage(p_, qx, qy));
+    // A quarter closed seen from the centre outweighs every other quarter
+    // of the 5x5 window (at most 25 * 4 * (16 + 1) = 1700), so that no edit
+    // trades closure seen from the centre for closure elsewhere; a front
+    // surface's own quarter outweighs every back quarter (at most 100).
+    if (AllFront(qx, qy)) {
+      s += 4096 * __builtin_popcount(QuadCoverage(p_, qx, qy));
+      if (score_front_only_ && Continuous(qx, qy))
+        s += 128 * __builtin_popcount(QuadCoverage(p_, qx, qy, true, 1u << kBack));
+    }
     if (score_back_ && AllBack(qx, qy))
       s += __builtin_popcount(QuadCoverage(p_, qx, qy, true, 1u << kFront));
     return s;
@@ -318,6 +343,8 @@ class Sealer {
   float min_ratio_, tau_;
   std::vector<SavedPixel> log_;
   bool score_back_ = false;
+  bool score_front_only_ = false;
+  float continuous_ratio_ = 0.9f;
 };
 
 }  // namespace
@@ -327,6 +354,7 @@ std::string SealOptions::Check() const {
   if (!(tau_dratio > min_link_ratio && tau_dratio < 1))
     return "tau_dratio: must be in (min_link_ratio, 1)";
   if (max_passes < 1 || max_passes > 32) return "max_passes: must be in [1, 32]";
+  if (!(continuous_ratio > 0 && continuous_ratio < 1)) return "continuous_ratio: must be in (0, 1)";
   return "";
 }
 
@@ -380,6 +408,12 @@ SealStats SealTears(TwoLayerPanorama* pano, const SealOptions& options) {
   stats.open_quads_before =
       SealPasses(&sealer, W, H, options.max_passes, false, front_open, &stats).first;
   SealPasses(&sealer, W, H, options.max_passes, true, front_open, &stats);
+  // Then continuous front surfaces whose own triangles leave a quad open
+  // (closed from the centre only by what lies behind them).
+  sealer.set_score_front_only(true);
+  const auto front_only_open = [&](int x, int y) { return sealer.FrontOnlyOpen(x, y); };
+  std::tie(stats.front_surface_open_quads_before, stats.front_surface_open_quads_after) =
+      SealPasses(&sealer, W, H, options.max_passes, true, front_only_open, &stats);
   // Then tears of the back layer (noisy depth behind an edge), within one
   // surface, without opening anything seen from the centre.
   sealer.set_score_back(true);

@@ -22,6 +22,10 @@
 // if both lie clearly behind the quad's nearest front node (depth above
 // nearest / tau_dratio): a thin sheet hidden behind the foreground from the
 // centre, instead of a hole seen from everywhere.
+// A third round closes continuous front surfaces (four front corners within
+// continuous_ratio in depth) whose own triangles leave a quad open: from the
+// centre the back node behind such a quad hides the gap, but a viewer who
+// moves sees through it. Its score keeps everything closed from the centre.
 // A last round does the same for the back layer: quads whose four corners
 // have back nodes that its own triangles leave open (noisy depth behind an
 // edge) get links within one surface, scored so that nothing seen from the
@@ -47,6 +51,10 @@ struct SealOptions {
   // (min_link_ratio, 1). Fusion's tau_dratio.
   double tau_dratio = 0.95;
   int max_passes = 4;  // [1, 32].
+  // Four front nodes whose depths lie within this ratio (min / max) of each
+  // other are one continuous surface, whose quad the front layer's own
+  // triangles should close; (0, 1). The warp's min_edge_depth_ratio.
+  double continuous_ratio = 0.9;
 
   std::string Check() const;
 };
@@ -57,6 +65,10 @@ struct SealStats {
   // Quads with four back corners that the back layer leaves open.
   int64_t back_open_quads_before = 0;
   int64_t back_open_quads_after = 0;
+  // Quads of continuous front surfaces that the front layer's own triangles
+  // leave open (closed from the centre by back nodes only).
+  int64_t front_surface_open_quads_before = 0;
+  int64_t front_surface_open_quads_after = 0;
   int64_t links_made = 0;
   int64_t back_nodes_added = 0;
 };

@@ -48,6 +48,34 @@ TEST(SealTears, NoisyContinuousSurfaceIsClosed) {
   EXPECT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
 }
 
+TEST(SealTears, SmallStepOfOneSurfaceIsClosedByTheFrontLayerItself) {
+  // A wall with a 8% step (ratio 0.926, above continuous_ratio 0.9, below
+  // tau_dratio 0.95): fusion cuts the front links across it and grows the
+  // farther side behind the nearer one, which closes the quads seen from the
+  // centre but leaves a slit that opens as soon as the eye moves. The
+  // front-surface round links the two sides in the front layer.
+  const int W = 64, H = 32;
+  Input in = Flat(W, H);
+  for (int y = 4; y < 28; ++y)
+    for (int x = 0; x < W; ++x) in.front_depth.at(x, y) = x < 30 ? 2.0f : 2.16f;
+  TwoLayerPanorama pano = FuseInputs(in);
+  const auto front_only_open = [&] {
+    int open = 0;
+    for (int y = 4; y + 1 < 28; ++y)
+      for (int x = 0; x < W; ++x)
+        open += QuadCoverage(pano, x, y, true, 1u << kBack) != 0xFu;
+    return open;
+  };
+  ASSERT_EQ(CountOpenQuads(pano), 0);  // Closed from the centre by the grown back layer.
+  ASSERT_GT(front_only_open(), 0);     // But not by the front surface itself.
+  const SealStats stats = SealTears(&pano);
+  EXPECT_GT(stats.front_surface_open_quads_before, 0);
+  EXPECT_EQ(stats.front_surface_open_quads_after, 0);
+  EXPECT_EQ(front_only_open(), 0);
+  EXPECT_EQ(CountOpenQuads(pano), 0);
+  EXPECT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
+}
+
 TEST(SealTears, DepthEdgeWithoutBackLayerGetsTheFarSurfaceBehind) {
   // A near square (1 m) on a wall (3 m), fused without back-layer growth:
   // the quads across its border are open. Sealing extends the wall behind

@@ -319,7 +319,9 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
                   std::to_string(report.seal.open_quads_before - report.seal.open_quads_after) +
                   " of " + std::to_string(report.seal.open_quads_before) + " open quads (" +
                   std::to_string(report.seal.links_made) + " links, " +
-                  std::to_string(report.seal.back_nodes_added) + " back nodes); back layer: " +
+                  std::to_string(report.seal.back_nodes_added) + " back nodes); front surfaces: " +
+                  std::to_string(report.seal.front_surface_open_quads_before) + " -> " +
+                  std::to_string(report.seal.front_surface_open_quads_after) + " open quads; back layer: " +
                   std::to_string(report.seal.back_open_quads_before) + " -> " +
                   std::to_string(report.seal.back_open_quads_after) + " open quads");
   }
@@ -402,6 +404,8 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
                {"open_quads_after", report.seal.open_quads_after},
                {"back_open_quads_before", report.seal.back_open_quads_before},
                {"back_open_quads_after", report.seal.back_open_quads_after},
+               {"front_surface_open_quads_before", report.seal.front_surface_open_quads_before},
+               {"front_surface_open_quads_after", report.seal.front_surface_open_quads_after},
                {"links_made", report.seal.links_made},
                {"back_nodes_added", report.seal.back_nodes_added}};
   j["normals"] = {{"nodes", report.normals.nodes}, {"sky_nodes", report.normals.sky_nodes}};
