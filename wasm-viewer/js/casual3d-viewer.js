@@ -100,7 +100,11 @@ export class Casual3dViewerElement extends HTMLElement {
     }
     this._bindToolbar();
     this._applyAttributes();
-    if (this.src) this._load();
+    // After the running script: a page that registered the element in the same
+    // script may still call setAssetBase() or set src.
+    queueMicrotask(() => {
+      if (this._viewer && this.src && !this._loading) this._load();
+    });
   }
 
   disconnectedCallback() {

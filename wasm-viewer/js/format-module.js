@@ -156,9 +156,10 @@ export class FormatModule {
   }
 
   /**
-   * Builds the mesh of a panorama. maxTriangles 0: the full mesh of spec/mesh.md;
-   * > 0: simplified to that budget with the largest relative depth error
-   * maxRelativeError (0: the library's default). Returns plain typed arrays:
+   * Builds the mesh of a panorama. maxTriangles 0: the full mesh of spec/mesh.md
+   * (or, with maxRelativeError > 0, simplified as far as that relative depth
+   * error allows); > 0: simplified to that budget with the largest relative
+   * depth error maxRelativeError (0: the library's default). Returns plain typed arrays:
    * {positions, normals, uvs, colors, indices, maxRelativeError}.
    */
   buildMesh(pano, { maxTriangles = 0, maxRelativeError = 0 } = {}) {

@@ -39,7 +39,10 @@ export function createFormat({ threads = true } = {}) {
   const key = threads === false ? 'st' : 'mt';
   if (!formats.has(key)) {
     const wasmBinary = fs.readFileSync(path.join(HERE, key === 'mt' ? 'casual3d-format-mt.wasm' : 'casual3d-format.wasm'));
-    const created = FormatModule.create({ threads: key === 'mt', wasmBinary });
+    // The threaded build's pthread worker is CommonJS: its .cjs copy.
+    const locateFile = (file, prefix) =>
+      (file.endsWith('.worker.js') ? path.join(HERE, file.replace(/\.js$/, '.cjs')) : prefix + file);
+    const created = FormatModule.create({ threads: key === 'mt', wasmBinary, locateFile });
     created.catch(() => formats.delete(key));
     formats.set(key, created);
   }

@@ -31,7 +31,10 @@ export interface Mesh {
 export interface MeshOptions {
   /** 0 (default): the full mesh of spec/mesh.md; > 0: simplified to this many triangles. */
   maxTriangles?: number;
-  /** Largest relative depth error of the simplified mesh (0: the library's default). */
+  /**
+   * Largest relative depth error of the simplified mesh (0: the library's
+   * default); > 0 with maxTriangles 0: simplified as far as it allows.
+   */
   maxRelativeError?: number;
 }
 

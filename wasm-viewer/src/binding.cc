@@ -156,12 +156,14 @@ EMSCRIPTEN_KEEPALIVE const void* c3d_panorama_layer(const Panorama* p, int layer
 
 // Builds the mesh of spec/mesh.md. max_triangles > 0 simplifies it to that budget
 // with BuildSimplifiedMesh (max_error_rel: the largest relative depth error
-// allowed, 0: the library's default); 0 keeps the full mesh. Null on error.
+// allowed, 0: the library's default); max_triangles 0 with max_error_rel > 0
+// simplifies as far as that error allows (mesh.md Sec. 5, no budget); both 0
+// keep the full mesh. Null on error.
 EMSCRIPTEN_KEEPALIVE MeshResult* c3d_build_mesh(const Panorama* p, double max_triangles,
                                                 double max_error_rel) {
   casual3d::MeshBuildOptions options;
   options.validate_input = !p->validated;
-  if (max_triangles > 0) {
+  if (max_triangles > 0 || max_error_rel > 0) {
     casual3d::MeshSimplifyOptions simplify;
     simplify.validate_input = !p->validated;
     simplify.max_triangles = static_cast<int64_t>(max_triangles);

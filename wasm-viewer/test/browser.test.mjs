@@ -21,6 +21,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { after, before, test } from 'node:test';
 
+import { psnr, readCanvas, readPpm } from './native-comparison.mjs';
 import { BINARY_DIR, DIST_DIR, copyPackageWithView, runTool } from './node-support.mjs';
 import { chromiumArgs, chromiumOrSkip, startServer, viewerPage } from './static-server.mjs';
 
@@ -36,44 +37,8 @@ const CAMERAS = [
 
 let tmp, server, browser, page, metrics = {};
 
-function readPpm(file) {
-  const buf = fs.readFileSync(file);
-  const header = buf.subarray(0, 64).toString('latin1').match(/^P6\s+(\d+)\s+(\d+)\s+255\s/);
-  assert.ok(header, `${file}: not a binary PPM`);
-  return { width: Number(header[1]), height: Number(header[2]), data: buf.subarray(header[0].length) };
-}
-
-/** PSNR (dB) of WebGL RGBA (bottom row first) against RGB (top row first). */
-function psnr(glRgba, rgb, width, height) {
-  let se = 0;
-  for (let y = 0; y < height; ++y) {
-    const gy = height - 1 - y;
-    for (let x = 0; x < width; ++x) {
-      for (let c = 0; c < 3; ++c) {
-        const d = glRgba[(gy * width + x) * 4 + c] - rgb[(y * width + x) * 3 + c];
-        se += d * d;
-      }
-    }
-  }
-  const mse = se / (width * height * 3);
-  return mse === 0 ? Infinity : 10 * Math.log10((255 * 255) / mse);
-}
-
 /** The canvas' pixels (RGBA, bottom row first) after the next frame. */
-async function readFrame() {
-  const b64 = await page.evaluate(async () => {
-    const v = document.getElementById('v').viewer;
-    await v.nextFrame();
-    const gl = v.renderer.gl;
-    const px = new Uint8Array(gl.drawingBufferWidth * gl.drawingBufferHeight * 4);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    gl.readPixels(0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight, gl.RGBA, gl.UNSIGNED_BYTE, px);
-    let s = '';
-    for (let i = 0; i < px.length; i += 0x8000) s += String.fromCharCode.apply(null, px.subarray(i, i + 0x8000));
-    return btoa(s);
-  });
-  return new Uint8Array(Buffer.from(b64, 'base64'));
-}
+const readFrame = () => readCanvas(page);
 
 function waitForEvent(type, timeoutMs = 120000) {
   return page.waitForFunction((t) => window.__events.some((e) => e.type === t), type, { timeout: timeoutMs, polling: 100 });
@@ -291,13 +256,7 @@ async function psnrOfCamera0(p) {
       path.join(OUT, 'reference_single'), [c.yawDeg, c.pitchDeg, c.fovDeg, ...c.position].join(',')]);
   }
   await p.evaluate((c) => document.getElementById('v').setCamera(c), CAMERAS[0]);
-  const previous = page;
-  page = p;  // readFrame reads the current page.
-  try {
-    return psnr(await readFrame(), readPpm(reference).data, W, H);
-  } finally {
-    page = previous;
-  }
+  return psnr(await readCanvas(p), readPpm(reference).data, W, H);
 }
 
 test('a .c3d by URL: range requests, the first frame before the finest level is asked for', async () => {
