@@ -179,3 +179,10 @@ declare global {
     'casual3d-viewer': Casual3dViewerElement;
   }
 }
+
+/**
+ * The folder (URL, relative to the page) the viewer's worker and wasm files
+ * are served from, for pages that bundle this module; null: beside this module.
+ * Call it before the element loads (it loads after the script registering it).
+ */
+export function setAssetBase(url: string | URL | null): void;

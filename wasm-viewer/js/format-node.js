@@ -17,7 +17,7 @@ import { fileURLToPath, pathToFileURL } from 'node:url';
 
 import { Casual3dPackage } from './format.js';
 import { FormatModule } from './format-module.js';
-import { isSingleFile, memoryRanges, blobRanges, openSingleFile, openUrl } from './package-source.js';
+import { isSingleFile, openInMemory, openSingleFile, openUrl } from './package-source.js';
 
 export { Casual3dPackage } from './format.js';
 export { FormatModule, Panorama, PackageReader } from './format-module.js';
@@ -98,6 +98,20 @@ async function openFolder(dir) {
   return { kind: 'folder', manifestBytes, read: async (p) => new Uint8Array(await fs.promises.readFile(path.join(dir, p))) };
 }
 
+/** The source of a package folder, its manifest.json or a .c3d file on disk (a path or file: URL). */
+async function openPath(format, input) {
+  const file = String(input).startsWith('file:') ? fileURLToPath(String(input)) : String(input);
+  const stat = await fs.promises.stat(file).catch(() => {
+    throw new Error(`${file}: no such file or folder`);
+  });
+  if (stat.isDirectory()) return openFolder(file);
+  if (path.basename(file) === 'manifest.json') return openFolder(path.dirname(file));
+  const ranges = fileRanges(file);
+  const head = await ranges.read(0, Math.min(ranges.size, 8));
+  if (!isSingleFile(head)) throw new Error(`${file}: neither a package folder, its manifest.json nor a .c3d file`);
+  return openSingleFile(format, ranges, path.basename(file));
+}
+
 /**
  * Opens a package: a path (or file: URL) of a package folder, its
  * manifest.json or a .c3d file; an http(s) URL as in browsers (.c3d files in
@@ -106,30 +120,7 @@ async function openFolder(dir) {
  */
 export async function openPackage(input, { format, fetch: fetchFn = globalThis.fetch } = {}) {
   format ??= await createFormat();
-  let source;
-  if (input instanceof ArrayBuffer || ArrayBuffer.isView(input)) {
-    const bytes = input instanceof ArrayBuffer ? new Uint8Array(input)
-      : new Uint8Array(input.buffer, input.byteOffset, input.byteLength);
-    source = await openSingleFile(format, memoryRanges(bytes));
-  } else if (input instanceof Blob) {
-    source = await openSingleFile(format, blobRanges(input), input.name || 'single file');
-  } else if (/^https?:/i.test(String(input))) {
-    source = await openUrl(format, String(input), { fetch: fetchFn });
-  } else {
-    const file = String(input).startsWith('file:') ? fileURLToPath(String(input)) : String(input);
-    const stat = await fs.promises.stat(file).catch(() => {
-      throw new Error(`${file}: no such file or folder`);
-    });
-    if (stat.isDirectory()) {
-      source = await openFolder(file);
-    } else if (path.basename(file) === 'manifest.json') {
-      source = await openFolder(path.dirname(file));
-    } else {
-      const ranges = fileRanges(file);
-      const head = await ranges.read(0, Math.min(ranges.size, 8));
-      if (!isSingleFile(head)) throw new Error(`${file}: neither a package folder, its manifest.json nor a .c3d file`);
-      source = await openSingleFile(format, ranges, path.basename(file));
-    }
-  }
+  const source = (await openInMemory(format, input)) ??
+    (/^https?:/i.test(String(input)) ? await openUrl(format, String(input), { fetch: fetchFn }) : await openPath(format, input));
   return new Casual3dPackage(format, source, decodeWebp);
 }

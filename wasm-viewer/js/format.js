@@ -14,7 +14,7 @@
 
 import { FormatModule } from './format-module.js';
 import { assetUrl } from './assets.js';
-import { blobRanges, forEachLimited, memoryRanges, openSingleFile, openUrl } from './package-source.js';
+import { forEachLimited, openInMemory, openUrl } from './package-source.js';
 import { decodeImage } from './tile-decoder.js';
 
 export { FormatModule, Panorama, PackageReader } from './format-module.js';
@@ -126,14 +126,8 @@ export function createFormat({ threads = 'auto' } = {}) {
  */
 export async function openPackage(input, { format, fetch: fetchFn = globalThis.fetch } = {}) {
   format ??= await createFormat();
-  let source;
-  if (input instanceof ArrayBuffer || ArrayBuffer.isView(input)) {
-    const bytes = input instanceof ArrayBuffer ? new Uint8Array(input)
-      : new Uint8Array(input.buffer, input.byteOffset, input.byteLength);
-    source = await openSingleFile(format, memoryRanges(bytes));
-  } else if (typeof Blob !== 'undefined' && input instanceof Blob) {
-    source = await openSingleFile(format, blobRanges(input), input.name || 'single file');
-  } else {
+  let source = await openInMemory(format, input);
+  if (!source) {
     const base = typeof document !== 'undefined' ? document.baseURI : globalThis.location?.href;
     source = await openUrl(format, new URL(String(input), base).href, { fetch: fetchFn });
   }

@@ -182,3 +182,19 @@ export async function openUrl(format, url, { fetch: fetchFn = fetch } = {}) {
   const name = decodeURIComponent(new URL(url).pathname.split('/').pop() || 'single file');
   return openSingleFile(format, await httpRanges(url, { fetch: fetchFn, name }), name);
 }
+
+/**
+ * The source of a .c3d held in memory (ArrayBuffer or typed array) or in a
+ * Blob; null for any other input.
+ */
+export async function openInMemory(format, input) {
+  if (input instanceof ArrayBuffer || ArrayBuffer.isView(input)) {
+    const bytes = input instanceof ArrayBuffer ? new Uint8Array(input)
+      : new Uint8Array(input.buffer, input.byteOffset, input.byteLength);
+    return openSingleFile(format, memoryRanges(bytes));
+  }
+  if (typeof Blob !== 'undefined' && input instanceof Blob) {
+    return openSingleFile(format, blobRanges(input), input.name || 'single file');
+  }
+  return null;
+}

@@ -21,6 +21,7 @@ import path from 'node:path';
 import { after, before, test } from 'node:test';
 import zlib from 'node:zlib';
 
+import { readCanvas as readViewerCanvas } from './native-comparison.mjs';
 import { directionFromYawPitch, lookAlong, multiply, perspective } from '../js/camera.js';
 import { BINARY_DIR, DIST_DIR, copyPackageWithView, runTool } from './node-support.mjs';
 import { chromiumArgs, chromiumOrSkip, startServer, viewerPage } from './static-server.mjs';
@@ -229,18 +230,7 @@ async function captureEyes(name, headPosition, frames = 3) {
 
 /** The page canvas' RGB pixels (top row first) after the next frame. */
 async function readCanvas() {
-  const b64 = await page.evaluate(async () => {
-    const v = document.getElementById('v').viewer;
-    await v.nextFrame();
-    const gl = v.renderer.gl;
-    const px = new Uint8Array(gl.drawingBufferWidth * gl.drawingBufferHeight * 4);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    gl.readPixels(0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight, gl.RGBA, gl.UNSIGNED_BYTE, px);
-    let s = '';
-    for (let i = 0; i < px.length; i += 0x8000) s += String.fromCharCode.apply(null, px.subarray(i, i + 0x8000));
-    return btoa(s);
-  });
-  const rgba = new Uint8Array(Buffer.from(b64, 'base64'));
+  const rgba = await readViewerCanvas(page);
   const data = new Uint8Array(W * H * 3);
   for (let y = 0; y < H; ++y) {
     for (let x = 0; x < W; ++x) for (let c = 0; c < 3; ++c) data[(y * W + x) * 3 + c] = rgba[((H - 1 - y) * W + x) * 4 + c];
