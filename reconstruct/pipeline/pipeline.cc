@@ -86,7 +86,7 @@ std::string DenseOptionsText(const depth::DenseOptions& o) {
 std::string PanoramaOptionsText(const PanoramaStageOptions& o) {
   std::ostringstream s;
   // The stage's version (spec/stage-panorama.md): its output changed.
-  s << "version=panorama-5 pano_width=" << o.pano_width << " max_auto_width=" << o.max_auto_width << " solve=" << o.stitch.solve_width
+  s << "version=panorama-6 pano_width=" << o.pano_width << " max_auto_width=" << o.max_auto_width << " solve=" << o.stitch.solve_width
     << " back_layer=" << o.back_layer << " fill_front_gaps=" << o.fill_front_gaps
     << " tau_stretch=" << o.warp.tau_stretch_deg
     << " lambda_gc=" << o.stitch.lambda_gc << " tau_dratio=" << o.fuse.tau_dratio

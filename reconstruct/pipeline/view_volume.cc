@@ -53,6 +53,9 @@ std::string ViewVolumeOptions::Check() const {
   return "";
 }
 
+// Largest share of the content box (solid angle) left without content.
+constexpr double kMaxEmptyFraction = 0.005;
+
 bool ContentExtent(const Image8& fov_mask, ViewHints* hints) {
   const int W = fov_mask.width(), H = fov_mask.height();
   std::vector<uint8_t> column(W, 0);
@@ -75,7 +78,73 @@ bool ContentExtent(const Image8& fov_mask, ViewHints* hints) {
     return false;
   hints->content_pitch_max_deg = 90.0 - 180.0 * top / H;
   hints->content_pitch_min_deg = 90.0 - 180.0 * (bottom + 1) / H;
+  PeelContentBox(fov_mask, kMaxEmptyFraction, hints);
   return true;
+}
+
+void PeelContentBox(const Image8& fov_mask, double max_empty_fraction, ViewHints* hints) {
+  const int W = fov_mask.width(), H = fov_mask.height();
+  // Cells of about 1/1024 of the circle; each holds its share of content
+  // and its solid angle (cos of the latitude).
+  const int cell = std::max(1, W / 1024);
+  const int gw = (W + cell - 1) / cell, gh = (H + cell - 1) / cell;
+  std::vector<double> full(size_t(gw) * gh, 0.0), empty(full.size(), 0.0);
+  for (int y = 0; y < H; ++y) {
+    const double weight = std::cos((0.5 - (y + 0.5) / H) * kPi);
+    const uint8_t* row = &fov_mask.at(0, y);
+    for (int x = 0; x < W; ++x) {
+      const size_t c = size_t(y / cell) * gw + x / cell;
+      full[c] += weight;
+      if (!row[x]) empty[c] += weight;
+    }
+  }
+  // Summed-area tables over two copies side by side, so that a box across
+  // the seam is one rectangle.
+  const int tw = 2 * gw + 1;
+  std::vector<double> sum_full(size_t(tw) * (gh + 1), 0.0), sum_empty(sum_full.size(), 0.0);
+  for (int y = 0; y < gh; ++y)
+    for (int x = 0; x < 2 * gw; ++x) {
+      const size_t c = size_t(y) * gw + x % gw;
+      const size_t t = size_t(y + 1) * tw + x + 1;
+      sum_full[t] = full[c] + sum_full[t - 1] + sum_full[t - tw] - sum_full[t - tw - 1];
+      sum_empty[t] = empty[c] + sum_empty[t - 1] + sum_empty[t - tw] - sum_empty[t - tw - 1];
+    }
+  const auto box = [&](const std::vector<double>& t, int x0, int x1, int y0, int y1) {
+    // Columns x0..x1 (x0 in [0, gw), x1 < x0 + gw), rows y0..y1, inclusive.
+    return t[size_t(y1 + 1) * tw + x1 + 1] - t[size_t(y0) * tw + x1 + 1] -
+           t[size_t(y1 + 1) * tw + x0] + t[size_t(y0) * tw + x0];
+  };
+  const double yaw_span = hints->content_yaw_max_deg - hints->content_yaw_min_deg;
+  if (yaw_span >= 360.0) return;  // Content all around: no side to peel.
+  // Cell columns of the extent, unwrapped (content across the seam starts
+  // below 0), then moved into [0, gw) by `shift` whole turns.
+  const int u0 = static_cast<int>(std::floor((hints->content_yaw_min_deg / 360.0 + 0.5) * gw));
+  const int u1 = static_cast<int>(std::ceil((hints->content_yaw_max_deg / 360.0 + 0.5) * gw)) - 1;
+  const int shift = u0 >= 0 ? -(u0 / gw) * gw : ((-u0 + gw - 1) / gw) * gw;
+  int x0 = u0 + shift, x1 = std::min(u1, u0 + gw - 1) + shift;
+  int y0 = std::clamp(static_cast<int>(std::floor((0.5 - hints->content_pitch_max_deg / 180.0) * gh)), 0, gh - 1);
+  int y1 = std::clamp(static_cast<int>(std::ceil((0.5 - hints->content_pitch_min_deg / 180.0) * gh)) - 1, y0, gh - 1);
+  while (x1 > x0 + 1 && y1 > y0 + 1) {
+    const double f = box(sum_full, x0, x1, y0, y1);
+    if (!(f > 0) || box(sum_empty, x0, x1, y0, y1) <= max_empty_fraction * f) break;
+    // The edge line with the largest empty share goes.
+    const auto share = [&](int a0, int a1, int b0, int b1) {
+      const double lf = box(sum_full, a0, a1, b0, b1);
+      return lf > 0 ? box(sum_empty, a0, a1, b0, b1) / lf : 0.0;
+    };
+    const double left = share(x0, x0, y0, y1), right = share(x1, x1, y0, y1);
+    const double top = share(x0, x1, y0, y0), bottom = share(x0, x1, y1, y1);
+    const double worst = std::max({left, right, top, bottom});
+    if (worst == left) ++x0;
+    else if (worst == right) --x1;
+    else if (worst == top) ++y0;
+    else --y1;
+  }
+  // Back to degrees, on the original extent's branch.
+  hints->content_yaw_min_deg = (double(x0 - shift) / gw - 0.5) * 360.0;
+  hints->content_yaw_max_deg = (double(x1 + 1 - shift) / gw - 0.5) * 360.0;
+  hints->content_pitch_max_deg = (0.5 - double(y0) / gh) * 180.0;
+  hints->content_pitch_min_deg = (0.5 - double(y1 + 1) / gh) * 180.0;
 }
 
 ViewHints ComputeViewHints(const TwoLayerPanorama& pano, const Image8& fov_mask,

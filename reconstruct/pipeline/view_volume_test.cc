@@ -37,6 +37,34 @@ TEST(ContentExtent, AcrossTheSeamIsOneInterval) {
   EXPECT_TRUE(h.Validate().ok());
 }
 
+TEST(ContentExtent, EmptyCornerIsPeeledOff) {
+  // Columns 96..160 (longitudes -45 .. 45), rows 32..96 (latitudes 45 ..
+  // -45), without its top-left corner (columns 96..112, rows 32..48): sky
+  // above trees that no photo saw. The box loses the corner's rows or
+  // columns, until at most 0.5% of it is empty.
+  Image8 mask = MaskOfColumns(256, 128, 96, 160, 32, 96);
+  for (int y = 32; y < 48; ++y)
+    for (int x = 96; x < 112; ++x) mask.at(x, y) = 0;
+  ViewHints h;
+  ASSERT_TRUE(ContentExtent(mask, &h));
+  const bool lost_top = h.content_pitch_max_deg <= 90.0 - 180.0 * 48 / 128 + 1e-9;
+  const bool lost_left = h.content_yaw_min_deg >= -180.0 + 360.0 * 112 / 256 - 1e-9;
+  EXPECT_TRUE(lost_top || lost_left) << h.content_yaw_min_deg << " " << h.content_pitch_max_deg;
+  // Only that: the other sides stay.
+  EXPECT_DOUBLE_EQ(h.content_yaw_max_deg, 45.0);
+  EXPECT_DOUBLE_EQ(h.content_pitch_min_deg, -45.0);
+  // The same across the seam: columns 240..303 wrap, the corner 240..255.
+  Image8 seam = MaskOfColumns(256, 128, 240, 304, 32, 96);
+  for (int y = 32; y < 48; ++y)
+    for (int x = 240; x < 256; ++x) seam.at(x, y) = 0;
+  ViewHints s;
+  ASSERT_TRUE(ContentExtent(seam, &s));
+  EXPECT_NEAR(s.content_yaw_max_deg - (-180.0 + 360.0 * 48 / 256), 0.0, 1e-9);
+  EXPECT_LT(s.content_yaw_max_deg - s.content_yaw_min_deg, 90.0 + 1e-9);
+  EXPECT_TRUE(s.content_yaw_min_deg < -180.0 || s.content_pitch_max_deg < 45.0 - 1e-9);
+  EXPECT_TRUE(s.Validate().ok());
+}
+
 TEST(ContentExtent, FullCircleAndEmpty) {
   ViewHints h;
   ASSERT_TRUE(ContentExtent(MaskOfColumns(64, 32, 0, 64, 10, 20), &h));
