@@ -44,7 +44,7 @@ test('npm pack: the element, both wasm builds, types, README; no tests, tools or
   const pkgJson = JSON.parse(fs.readFileSync(path.join(SOURCE_DIR, 'wasm-viewer', 'package.json'), 'utf8'));
   assert.equal(path.basename(tarball), `casual3d-viewer-${pkgJson.version}.tgz`);
   const files = execFileSync('tar', ['-tzf', tarball], { encoding: 'utf8' }).trim().split('\n').sort();
-  for (const f of ['package.json', 'README.md', 'dist/casual3d-viewer.js', 'dist/casual3d-viewer.d.ts', 'dist/format.js',
+  for (const f of ['package.json', 'README.md', 'LICENSE', 'dist/casual3d-viewer.js', 'dist/casual3d-viewer.d.ts', 'dist/format.js',
     'dist/format-node.js', 'dist/format.d.ts', 'dist/worker.js', 'dist/casual3d-format.js', 'dist/casual3d-format.wasm',
     'dist/casual3d-format-mt.js', 'dist/casual3d-format-mt.wasm', 'dist/casual3d-format-mt.worker.js']) {
     assert.ok(files.includes(`package/${f}`), `${f} is in the tarball`);

@@ -35,6 +35,7 @@ export function pack(dist, out) {
   delete manifest.devDependencies;
   fs.writeFileSync(path.join(stage, 'package.json'), `${JSON.stringify(manifest, null, 2)}\n`);
   fs.copyFileSync(path.join(SOURCE, 'README.md'), path.join(stage, 'README.md'));
+  fs.copyFileSync(path.join(SOURCE, '..', 'LICENSE'), path.join(stage, 'LICENSE'));
   for (const f of fs.readdirSync(dist).sort()) {
     if (PACKAGE_FILE.test(f) && fs.statSync(path.join(dist, f)).isFile()) {
       fs.copyFileSync(path.join(dist, f), path.join(stage, 'dist', f));
