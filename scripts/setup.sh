@@ -18,6 +18,8 @@ packages=(
   libwebp-dev libopenexr-dev libdraco-dev libtinygltf-dev libmeshoptimizer-dev nlohmann-json3-dev
   # reconstruct/
   colmap libsqlite3-dev libopencv-dev libeigen3-dev libmaxflow-dev libjpeg-dev libpng-dev libexif-dev
+  # reconstruct/: HEIC photos (libheif; heif-enc for tests) and video (ffmpeg for tests)
+  libheif-dev libheif-examples ffmpeg
   # cli/, tests and benchmarks
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   # python/: the module (import casual3d) and its tests

@@ -6,8 +6,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <vector>
+
+#include <cstdio>
+#include <jpeglib.h>
 #include <opencv2/imgproc.hpp>
 
 #include "reconstruct/io/cv_bridge.h"
@@ -151,6 +157,101 @@ TEST_F(ImageIoTest, MaxSideIsEnforced) {
   ReadImageOptions options;
   options.max_side = 32;
   EXPECT_THROW(ReadImage(Path("big.png"), options), IoError);
+}
+
+TEST_F(ImageIoTest, TruncatedJpegIsRefusedAndCompleteOnesPass) {
+  const Image8 ramp = Ramp(64, 48);
+  const std::string jpeg = EncodeJpeg(std::as_const(ramp).view(), {90});
+  EXPECT_TRUE(JpegIsComplete(jpeg));
+  int w = 0, h = 0;
+  ASSERT_TRUE(JpegSize(jpeg, &w, &h));
+  EXPECT_EQ(w, 64);
+  EXPECT_EQ(h, 48);
+  // libjpeg alone decodes a cut file with grey where the data is missing.
+  WriteFileAtomic(Path("cut.jpg"), jpeg.substr(0, jpeg.size() * 2 / 3));
+  EXPECT_FALSE(JpegIsComplete(ReadFile(Path("cut.jpg"))));
+  try {
+    ReadImage(Path("cut.jpg"));
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find(Path("cut.jpg") + ": truncated JPEG"), std::string::npos)
+        << e.what();
+  }
+  // Bytes after the end-of-image marker (phone trailers) are fine.
+  EXPECT_TRUE(JpegIsComplete(jpeg + "trailer"));
+  EXPECT_FALSE(JpegIsComplete("not a jpeg"));
+}
+
+TEST_F(ImageIoTest, LargeJpegIsDecodedDownscaled) {
+  const Image8 img = Ramp(800, 600);
+  WriteFileAtomic(Path("big.jpg"), WithExifOrientation(EncodeJpeg(std::as_const(img).view(), {90}), 6));
+  ReadImageOptions options;
+  options.apply_exif_orientation = true;
+  options.min_decoded_pixels = 100 * 75;  // 800x600 / 8 per side still has that many.
+  DecodedImageInfo info;
+  const Image8 small = ReadImage(Path("big.jpg"), options, &info);
+  EXPECT_EQ(info.reduction, 8);
+  EXPECT_EQ(small.width(), 75);  // Turned upright by the orientation.
+  EXPECT_EQ(small.height(), 100);
+  EXPECT_EQ(info.full_width, 600);
+  EXPECT_EQ(info.full_height, 800);
+  options.min_decoded_pixels = 300 * 220;  // Only halving keeps that many.
+  EXPECT_EQ(ReadImage(Path("big.jpg"), options, &info).width(), 300);
+  EXPECT_EQ(info.reduction, 2);
+}
+
+TEST_F(ImageIoTest, SixteenBitPngAndTiffAreRead) {
+  cv::Mat deep(30, 40, CV_16UC3);
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 40; ++x) deep.at<cv::Vec3w>(y, x) = cv::Vec3w(0, y * 2000, x * 1600);
+  ASSERT_TRUE(cv::imwrite(Path("deep.png"), deep));
+  ASSERT_TRUE(cv::imwrite(Path("deep.tif"), deep));
+  for (const char* name : {"deep.png", "deep.tif"}) {
+    DecodedImageInfo info;
+    const Image8 back = ReadImage(Path(name), {}, &info);
+    ASSERT_EQ(back.width(), 40) << name;
+    // Scaled from 16 to 8 bits: 39 * 1600 / 257 = 242.8 in red (OpenCV's BGR blue).
+    EXPECT_NEAR(back.at(39, 0, 0), 243, 1) << name;
+    EXPECT_NEAR(back.at(0, 29, 1), 29 * 2000 / 257.0, 1) << name;
+    EXPECT_EQ(info.format, std::string(name).find("png") != std::string::npos ? "png" : "tiff");
+  }
+}
+
+TEST_F(ImageIoTest, CmykJpegIsConvertedToRgb) {
+  // A CMYK JPEG as Adobe applications write it (inverted CMYK, Adobe APP14).
+  const int w = 32, h = 16;
+  std::vector<uint8_t> cmyk(w * h * 4);
+  for (int i = 0; i < w * h; ++i) {
+    // Pure red: no cyan, full magenta and yellow, no black; stored inverted.
+    cmyk[i * 4 + 0] = 255, cmyk[i * 4 + 1] = 0, cmyk[i * 4 + 2] = 0, cmyk[i * 4 + 3] = 255;
+  }
+  jpeg_compress_struct cinfo;
+  jpeg_error_mgr jerr;
+  cinfo.err = jpeg_std_error(&jerr);
+  jpeg_create_compress(&cinfo);
+  unsigned char* out = nullptr;
+  unsigned long out_size = 0;
+  jpeg_mem_dest(&cinfo, &out, &out_size);
+  cinfo.image_width = w;
+  cinfo.image_height = h;
+  cinfo.input_components = 4;
+  cinfo.in_color_space = JCS_CMYK;
+  jpeg_set_defaults(&cinfo);
+  jpeg_set_quality(&cinfo, 95, TRUE);
+  jpeg_start_compress(&cinfo, TRUE);
+  for (int y = 0; y < h; ++y) {
+    JSAMPROW row = cmyk.data() + y * w * 4;
+    jpeg_write_scanlines(&cinfo, &row, 1);
+  }
+  jpeg_finish_compress(&cinfo);
+  const std::string bytes(reinterpret_cast<char*>(out), out_size);
+  jpeg_destroy_compress(&cinfo);
+  std::free(out);
+  const Image8 back = DecodeImage(bytes, "cmyk.jpg");
+  ASSERT_EQ(back.channels(), 3);
+  EXPECT_GT(back.at(5, 5, 0), 200);
+  EXPECT_LT(back.at(5, 5, 1), 60);
+  EXPECT_LT(back.at(5, 5, 2), 60);
 }
 
 TEST(CvBridgeTest, MatAndViewShareMemory) {
