@@ -28,9 +28,11 @@ void AddReconstructCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "reconstruct",
-      "Turn a folder of photos (or a COLMAP workspace) into a web-ready 3D photo: sparse, dense, "
+      "Turn a folder of photos, a video (or a COLMAP workspace) into a web-ready 3D photo: sparse, dense, "
       "panorama (warp, stitch, fuse, normals) and encode stages, resumable");
-  cmd->add_option("input", args->input, "Folder of photos (JPEG, PNG) or a COLMAP workspace")
+  cmd->add_option("input", args->input,
+                  "Folder of photos (JPEG, PNG, TIFF, HEIC), a video clip (or a folder holding "
+                  "one), or a COLMAP workspace")
       ->required();
   cmd->add_option("-o,--output", args->output,
                   "Output folder: web/ (deployable package with index.html), photo.c3d, "
@@ -52,6 +54,7 @@ void AddReconstructCommand(CLI::App& app) {
                   "Photos are downscaled to about this size before matching and depth")
       ->capture_default_str();
   AddSiftOptions(cmd, &args->options.sparse);
+  AddPhotoInputOptions(cmd, &args->options.sparse);
   cmd->add_flag("--no-gap-fill", "Leave the front layer's gaps inside the photos' field of view empty")
       ->each([args](const std::string&) { args->options.panorama.fill_front_gaps = false; });
   cmd->add_flag("--no-near-envelope", args->no_near_envelope,

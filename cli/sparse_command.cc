@@ -67,6 +67,16 @@ void AddSiftOptions(CLI::App* cmd, sfm::SparseStageOptions* options) {
                          "Match descriptors with COLMAP's own CPU matcher (same criteria, slower)");
 }
 
+void AddPhotoInputOptions(CLI::App* cmd, sfm::SparseStageOptions* options) {
+  cmd->add_flag_callback("--strict-photos", [options] { options->import.skip_unreadable = false; },
+                         "Stop at an unreadable, truncated or corrupt photo instead of skipping it");
+  cmd->add_flag("--mixed-cameras", options->import.allow_mixed_devices,
+                "Accept photos from different cameras (one calibration per camera)");
+  cmd->add_option("--max-frames", options->video.max_frames,
+                  "Video input: at most this many frames become photos [3, 2000]")
+      ->capture_default_str();
+}
+
 void AddSparseCommand(CLI::App& app) {
   auto options = std::make_shared<SparseCommandOptions>();
   sfm::SparseStageOptions& s = options->stage;
@@ -74,7 +84,9 @@ void AddSparseCommand(CLI::App& app) {
       "sparse",
       "Calibrate the cameras of a folder of photos (or an existing COLMAP workspace) with COLMAP "
       "and write undistorted photos, the sparse model, the 3D photo's frame and depth ranges");
-  cmd->add_option("input", options->input, "Folder of photos (JPEG, PNG) or COLMAP workspace")
+  cmd->add_option("input", options->input,
+                  "Folder of photos (JPEG, PNG, TIFF, HEIC), a video clip (or a folder holding "
+                  "one), or a COLMAP workspace")
       ->required();
   cmd->add_option("-o,--output", options->output, "Output folder (must not exist)")->required();
   cmd->add_option("--input-type", options->input_type, "auto, photos or workspace")
@@ -85,10 +97,7 @@ void AddSparseCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--focal-px", s.import.focal_px,
                   "Focal length prior in pixels at the photos' original size (default: EXIF)");
-  cmd->add_flag("--skip-unreadable", s.import.skip_unreadable,
-                "Skip unreadable or corrupt photos instead of stopping");
-  cmd->add_flag("--mixed-cameras", s.import.allow_mixed_devices,
-                "Accept photos from different cameras (one calibration per camera)");
+  AddPhotoInputOptions(cmd, &s);
   cmd->add_option("--camera-model", s.camera_model,
                   "COLMAP camera model: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV")
       ->check(CLI::IsMember({"SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV"}))

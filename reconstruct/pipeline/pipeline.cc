@@ -23,7 +23,8 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 // Bump when a stage's output format or algorithm changes, so old caches are stale.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-2", "dense-4", "panorama-3",
+// sparse-3: the import skips bad and duplicate files, reads HEIF, TIFF and video.
+constexpr const char* kStageVersions[kNumStages] = {"sparse-3", "dense-4", "panorama-3",
                                                     "encode-1"};
 
 std::string HashHex(const std::string& text) {
@@ -35,6 +36,10 @@ std::string HashHex(const std::string& text) {
 std::string InputFingerprint(const std::string& input) {
   std::vector<std::string> rows;
   std::error_code ec;
+  if (fs::is_regular_file(input, ec)) {  // A video clip.
+    return std::to_string(fs::file_size(input, ec)) + " " +
+           std::to_string(fs::last_write_time(input, ec).time_since_epoch().count()) + "\n";
+  }
   for (auto it = fs::recursive_directory_iterator(input, ec); !ec && it != fs::end(it);
        it.increment(ec)) {
     if (!it->is_regular_file(ec)) continue;
@@ -56,6 +61,9 @@ std::string SparseOptionsText(const sfm::SparseStageOptions& o) {
     << " working_megapixels=" << o.import.working_megapixels
     << " skip_unreadable=" << o.import.skip_unreadable
     << " allow_mixed_devices=" << o.import.allow_mixed_devices << " focal_px=" << o.import.focal_px
+    << " video_max_frames=" << o.video.max_frames << " video_min_step=" << o.video.min_step_fraction
+    << " video_blur_ratio=" << o.video.blur_ratio << " video_blur_window=" << o.video.blur_window
+    << " video_analysis=" << o.video.analysis_long_side
     << " camera_model=" << o.camera_model << " shared_camera=" << o.shared_camera
     << " matcher=" << static_cast<int>(o.matcher) << " max_features=" << o.max_features
     << " sift_first_octave=" << o.sift_first_octave << " native_matching=" << o.native_matching
@@ -176,8 +184,8 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
   const auto start = Clock::now();
 
   std::error_code ec;
-  if (!fs::is_directory(input, ec)) {
-    throw std::runtime_error(input + ": not a folder of photos or a COLMAP workspace");
+  if (!fs::is_directory(input, ec) && !sfm::IsVideoFileName(input)) {
+    throw std::runtime_error(input + ": not a folder of photos, a video or a COLMAP workspace");
   }
   const fs::path root(out);
   const fs::path work = root / "work";
@@ -276,10 +284,23 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
         fs::remove(key_paths[s], ec);
         const sfm::SparseStageResult r = sfm::RunSparseStage(input, dirs[s].string(), sparse);
         io::WriteFileAtomic(key_paths[s].string(), keys[s]);
-        stage_json["sparse"] = {{"photos", r.num_photos},
+        nlohmann::json skipped = nlohmann::json::array();
+        for (const sfm::SkippedPhoto& p : r.skipped)
+          skipped.push_back({{"file", p.file}, {"reason", p.reason}});
+        stage_json["sparse"] = {{"input_type", r.input_type},
+                                {"photos", r.num_photos},
                                 {"registered", r.num_registered},
+                                {"unregistered", r.unregistered},
+                                {"skipped", skipped},
                                 {"points", r.num_points},
                                 {"mean_reprojection_error_px", r.mean_reprojection_error_px}};
+        if (r.input_type == "video") {
+          stage_json["sparse"]["video"] = {{"frames", r.video.frames_decoded},
+                                           {"picked", r.video.picked.size()},
+                                           {"blurred", r.video.blurred},
+                                           {"rotation_deg", r.video.rotation_deg},
+                                           {"frame_selection_seconds", r.video.seconds}};
+        }
         break;
       }
       case Stage::kDense: {
@@ -385,6 +406,9 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
       stage_json[name] = previous["results"][name];
   }
   j["results"] = stage_json;
+  // Files of the input the import left out (bad or duplicate), at the top level.
+  if (stage_json.contains("sparse") && stage_json["sparse"].contains("skipped"))
+    j["skipped"] = stage_json["sparse"]["skipped"];
   if (options.holdout_every > 0 && fs::exists(dirs[0] / "sparse", ec)) {
     input_workspace();
     j["holdout_every"] = options.holdout_every;

@@ -1,10 +1,15 @@
 #include "reconstruct/sfm/exif.h"
 
 #include <libexif/exif-data.h>
+#include <libexif/exif-loader.h>
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <utility>
+
+#include "reconstruct/io/file_util.h"
+#include "reconstruct/io/heif_io.h"
 
 namespace casual3d::sfm {
 namespace {
@@ -55,11 +60,8 @@ double NumberValue(ExifData* data, ExifTag tag) {
   }
 }
 
-}  // namespace
-
-ExifInfo ReadExif(const std::string& path) {
+ExifInfo FromExifData(std::unique_ptr<ExifData, ExifDataDeleter> data) {
   ExifInfo info;
-  std::unique_ptr<ExifData, ExifDataDeleter> data(exif_data_new_from_file(path.c_str()));
   if (!data) return info;
   info.present = true;
   const double orientation = NumberValue(data.get(), EXIF_TAG_ORIENTATION);
@@ -79,6 +81,37 @@ ExifInfo ReadExif(const std::string& path) {
   if (!std::isfinite(info.focal_mm) || info.focal_mm < 0) info.focal_mm = 0;
   if (!std::isfinite(info.focal_35mm) || info.focal_35mm < 0) info.focal_35mm = 0;
   return info;
+}
+
+}  // namespace
+
+ExifInfo ReadExif(const std::string& path) {
+  std::string bytes;
+  try {
+    bytes = io::ReadFile(path);
+  } catch (const std::exception&) {
+    return {};
+  }
+  return ExifFromFileBytes(bytes);
+}
+
+ExifInfo ExifFromFileBytes(const std::string& bytes) {
+  std::string exif = bytes;
+  if (io::LooksLikeHeif(bytes)) {
+    const std::string tiff = io::HeifExifTiff(bytes);
+    if (tiff.empty()) return {};
+    exif = std::string("Exif\0\0", 6) + tiff;  // The header libexif looks for.
+  }
+  if (exif.empty()) return {};
+  // The loader (as exif_data_new_from_file uses) yields no data when the bytes
+  // hold no EXIF block, unlike exif_data_new_from_data.
+  ExifLoader* loader = exif_loader_new();
+  if (loader == nullptr) return {};
+  exif_loader_write(loader, reinterpret_cast<unsigned char*>(exif.data()),
+                    static_cast<unsigned int>(exif.size()));
+  std::unique_ptr<ExifData, ExifDataDeleter> data(exif_loader_get_data(loader));
+  exif_loader_unref(loader);
+  return FromExifData(std::move(data));
 }
 
 double FocalPixelsFromExif(const ExifInfo& exif, int width, int height, int original_long_side) {

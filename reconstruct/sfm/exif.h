@@ -2,7 +2,8 @@
 
 // The EXIF fields the sparse stage needs from a photo: orientation, focal
 // length (mm and 35 mm equivalent), focal-plane resolution, make and model.
-// Read with libexif; files without EXIF (PNG, stripped JPEG) give empty fields.
+// Read with libexif from JPEG files and from the Exif block of HEIF files;
+// files without EXIF (PNG, TIFF, stripped JPEG) give empty fields.
 
 #include <string>
 
@@ -24,6 +25,9 @@ struct ExifInfo {
 // Reads the EXIF block of `path`. A file without EXIF, or with a malformed
 // EXIF block, yields present = false; never throws for bad bytes.
 ExifInfo ReadExif(const std::string& path);
+
+// The same from the bytes of a whole file (JPEG or HEIF).
+ExifInfo ExifFromFileBytes(const std::string& bytes);
 
 // The focal length in pixels for an image of `width` x `height` pixels (after
 // the orientation has been applied and after any resizing, so pass the working

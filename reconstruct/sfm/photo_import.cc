@@ -16,7 +16,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "format/sha256.h"
 #include "reconstruct/io/cv_bridge.h"
+#include "reconstruct/io/file_util.h"
 #include "reconstruct/io/image_io.h"
 
 namespace casual3d::sfm {
@@ -68,7 +70,9 @@ Status PhotoImportOptions::Check() const {
 bool IsPhotoFileName(const std::string& name) {
   const std::string l = Lower(name);
   return !name.empty() && name[0] != '.' &&
-         (EndsWith(l, ".jpg") || EndsWith(l, ".jpeg") || EndsWith(l, ".png"));
+         (EndsWith(l, ".jpg") || EndsWith(l, ".jpeg") || EndsWith(l, ".png") ||
+          EndsWith(l, ".tif") || EndsWith(l, ".tiff") || EndsWith(l, ".heic") ||
+          EndsWith(l, ".heif"));
 }
 
 PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output_dir,
@@ -94,38 +98,69 @@ PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output
   std::sort(names.begin(), names.end());
   if (static_cast<int>(names.size()) < options.min_photos) {
     throw std::runtime_error(input_dir + ": found " + std::to_string(names.size()) +
-                             " photos (.jpg, .jpeg, .png); a 3D photo needs at least " +
+                             " photos (.jpg, .jpeg, .png, .tif, .tiff, .heic, .heif); a 3D photo needs at least " +
                              std::to_string(options.min_photos) +
                              " overlapping photos (the paper's captures have 20 to 200)");
   }
 
   PhotoImport result;
-  std::vector<std::string> unreadable;
+  std::map<std::string, std::string> first_with_hash;  // SHA-256 of the bytes -> file name.
   int done = 0;
   for (const std::string& name : names) {
     const std::string path = input_dir + "/" + name;
+    const auto skip = [&](const std::string& reason) {
+      result.skipped.push_back({name, reason});
+      if (on_photo) on_photo(++done, static_cast<int>(names.size()));
+    };
+    std::string bytes;
+    try {
+      bytes = io::ReadFile(path);
+    } catch (const std::exception& e) {
+      skip(std::string(e.what()).substr(path.size() + 2));  // The reason after "path: ".
+      continue;
+    }
+    const std::string hash =
+        Sha256Hex(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+    if (!bytes.empty()) {
+      const auto [it, fresh] = first_with_hash.emplace(hash, name);
+      if (!fresh) {
+        skip("same bytes as " + it->second);
+        continue;
+      }
+    }
     ImportedPhoto photo;
-    photo.name = name;
-    photo.exif = ReadExif(path);
+    photo.source = name;
+    photo.exif = ExifFromFileBytes(bytes);
     Image8 image;
+    io::DecodedImageInfo info;
     try {
       io::ReadImageOptions read_options;
       read_options.apply_exif_orientation = true;
-      image = io::ReadImage(path, read_options);
+      // Large JPEGs come out of libjpeg at 1/2..1/8 size, never below the working size.
+      read_options.min_decoded_pixels = static_cast<int64_t>(options.working_megapixels * 1e6);
+      image = io::DecodeImage(bytes, name, read_options, &info);
     } catch (const std::exception& e) {
-      unreadable.push_back(e.what());
-      if (on_photo) on_photo(++done, static_cast<int>(names.size()));
+      skip(std::string(e.what()).substr(name.size() + 2));
       continue;
     }
-    photo.original_width = image.width();
-    photo.original_height = image.height();
+    bytes.clear();
+    bytes.shrink_to_fit();
+    photo.original_width = info.full_width;
+    photo.original_height = info.full_height;
     const double pixels = static_cast<double>(image.width()) * image.height();
-    const double scale = std::min(1.0, std::sqrt(options.working_megapixels * 1e6 / pixels));
-    const std::string out_path = output_dir + "/" + name;
-    const bool png = EndsWith(Lower(name), ".png");
-    if (scale < 1.0) {
-      photo.width = std::max(1, static_cast<int>(std::lround(image.width() * scale)));
-      photo.height = std::max(1, static_cast<int>(std::lround(image.height() * scale)));
+    const double full_pixels = static_cast<double>(info.full_width) * info.full_height;
+    const double scale = std::min(1.0, std::sqrt(options.working_megapixels * 1e6 / full_pixels));
+    const std::string lower = Lower(name);
+    const bool png = EndsWith(lower, ".png");
+    const bool keep_name = png || EndsWith(lower, ".jpg") || EndsWith(lower, ".jpeg");
+    photo.name = keep_name ? name : name + ".jpg";
+    const std::string out_path = output_dir + "/" + photo.name;
+    const int target_width = std::max(1, static_cast<int>(std::lround(info.full_width * scale)));
+    const int target_height = std::max(1, static_cast<int>(std::lround(info.full_height * scale)));
+    if (target_width < image.width() && target_height < image.height() &&
+        target_width * static_cast<double>(target_height) < pixels) {
+      photo.width = target_width;
+      photo.height = target_height;
       Image8 small(photo.width, photo.height, image.channels());
       cv::Mat dst = io::ToMat(small);
       cv::resize(io::ToMat(image), dst, dst.size(), 0, 0, cv::INTER_AREA);
@@ -154,25 +189,29 @@ PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output
     if (on_photo) on_photo(++done, static_cast<int>(names.size()));
   }
 
-  if (!unreadable.empty()) {
-    if (!options.skip_unreadable) {
-      throw std::runtime_error(JoinList(unreadable, 5) +
-                               "; remove or replace the file, or pass --skip-unreadable");
-    }
-    result.skipped = unreadable;
+  std::vector<std::string> unreadable;
+  for (const SkippedPhoto& s : result.skipped) {
+    if (s.reason.rfind("same bytes as ", 0) != 0) unreadable.push_back(s.file + ": " + s.reason);
+  }
+  if (!unreadable.empty() && !options.skip_unreadable) {
+    throw std::runtime_error(input_dir + ": " + JoinList(unreadable, 5) +
+                             "; remove or replace the file, or drop --strict-photos");
   }
   if (static_cast<int>(result.photos.size()) < options.min_photos) {
-    throw std::runtime_error(input_dir + ": only " + std::to_string(result.photos.size()) +
-                             " readable photos; at least " + std::to_string(options.min_photos) +
-                             " are needed");
+    std::vector<std::string> why;
+    for (const SkippedPhoto& s : result.skipped) why.push_back(s.file + ": " + s.reason);
+    throw std::runtime_error(input_dir + ": " + std::to_string(result.photos.size()) +
+                             " usable photos of " + std::to_string(names.size()) + "; at least " +
+                             std::to_string(options.min_photos) + " are needed (left out: " +
+                             JoinList(why, 4) + ")");
   }
 
-  // Devices: make, model and sensor (long x short side).
+  // Devices by EXIF make and model. Sizes alone do not make another device: a
+  // phone writes photos of several sizes, and every size is its own camera group.
+  // Photos without EXIF (PNG, TIFF, edited copies) may come from any of them.
   std::map<std::string, std::vector<std::string>> devices;
   for (const auto& p : result.photos) {
-    const int a = std::max(p.original_width, p.original_height);
-    const int b = std::min(p.original_width, p.original_height);
-    devices[p.device + " " + std::to_string(a) + "x" + std::to_string(b)].push_back(p.name);
+    if (p.exif.present && p.device != "unknown camera") devices[p.device].push_back(p.source);
   }
   if (devices.size() > 1 && !options.allow_mixed_devices) {
     std::vector<std::string> list;

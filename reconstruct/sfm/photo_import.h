@@ -1,11 +1,17 @@
 #pragma once
 
-// Photo import for the sparse stage: lists a folder of photos (JPEG, PNG),
-// reads their EXIF (orientation, focal length, make and model), decodes them
-// upright, downsamples them to the working resolution (Sec. 4.1: the paper's
+// Photo import for the sparse stage: lists a folder of photos (JPEG, PNG, TIFF,
+// HEIF/HEIC), reads their EXIF (orientation, focal length, make and model),
+// decodes them upright (large JPEGs at a reduced size straight from the
+// decoder), downsamples them to the working resolution (Sec. 4.1: the paper's
 // depth maps are about 900x1350) and writes them for COLMAP, together with the
 // focal-length prior at the working size and the grouping into cameras (one
-// shared calibration per device, orientation and focal length).
+// shared calibration per device, upright size and focal length: portrait and
+// landscape photos, or photos of different sizes from one phone, get one each).
+//
+// Bad files among good ones: unreadable, truncated and undecodable files, and
+// files with the same bytes as an earlier one (by name order), are skipped and
+// listed; the import goes on while at least min_photos usable photos remain.
 
 #include <functional>
 #include <string>
@@ -20,11 +26,11 @@ struct PhotoImportOptions {
   // Working resolution in megapixels; larger photos are downsampled (area
   // filter) to about this many pixels, smaller ones are kept as they are.
   double working_megapixels = 1.2;  // Range [0.05, 100]. Sec. 4.1: ~900x1350.
-  // Unreadable or corrupt photos: skip them with a warning (true) or stop with
-  // an error naming them (false).
-  bool skip_unreadable = false;
-  // Photos from different devices (EXIF make, model or sensor size differ): use
-  // one calibration per device (true) or stop with an error listing them.
+  // Unreadable, truncated or corrupt photos: skip them with a warning (true) or
+  // stop with an error naming them (false). Duplicates are always skipped.
+  bool skip_unreadable = true;
+  // Photos from different devices (EXIF make or model differ): use one
+  // calibration per device (true) or stop with an error listing them.
   bool allow_mixed_devices = false;
   // Focal length prior in pixels at the photos' original size; overrides EXIF
   // (needed for photos without EXIF). 0: from EXIF, or none.
@@ -36,7 +42,10 @@ struct PhotoImportOptions {
 };
 
 struct ImportedPhoto {
-  std::string name;         // File name in the input and output folders.
+  std::string source;       // File name in the input folder.
+  // File name in the output folder: `source` for JPEG and PNG, else
+  // `source` + ".jpg" (the photo is written as JPEG).
+  std::string name;
   int original_width = 0;   // Upright (after EXIF orientation), pixels.
   int original_height = 0;
   int width = 0;            // Written (working) size, pixels.
@@ -56,19 +65,27 @@ struct CameraGroup {
   std::vector<int> photos;  // Indices into PhotoImport::photos.
 };
 
-struct PhotoImport {
-  std::vector<ImportedPhoto> photos;  // Sorted by name.
-  std::vector<CameraGroup> groups;
-  std::vector<std::string> skipped;   // "name: reason", when skip_unreadable.
+// A file of the input folder that was left out.
+struct SkippedPhoto {
+  std::string file;    // File name in the input folder.
+  std::string reason;  // "truncated JPEG ...", "same bytes as IMG_3.jpg", ...
 };
 
-// True for the file names the stage treats as photos (.jpg, .jpeg, .png, any case).
+struct PhotoImport {
+  std::vector<ImportedPhoto> photos;  // Sorted by source name.
+  std::vector<CameraGroup> groups;
+  std::vector<SkippedPhoto> skipped;  // In name order.
+};
+
+// True for the file names the stage treats as photos (.jpg, .jpeg, .png, .tif,
+// .tiff, .heic, .heif, any case; not hidden files).
 bool IsPhotoFileName(const std::string& name);
 
 // Imports every photo of `input_dir` (not recursive) into `output_dir` (must
 // exist). `on_photo(done, total)` is called after each photo (may be empty).
 // Throws std::runtime_error with one clear line for: a missing input folder,
-// fewer than min_photos photos, unreadable photos (naming them) unless skipped,
+// fewer than min_photos usable photos (saying how many there are and why the
+// others were left out), unreadable photos (naming them) when not skipped,
 // mixed devices unless allowed, or a failed write.
 PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output_dir,
                          const PhotoImportOptions& options,

@@ -268,6 +268,12 @@ Json OptionsJson(const SparseStageOptions& o) {
           {"allow_mixed_devices", o.import.allow_mixed_devices},
           {"focal_px", o.import.focal_px},
           {"jpeg_quality", o.import.jpeg_quality},
+          {"video",
+           {{"max_frames", o.video.max_frames},
+            {"min_step_fraction", o.video.min_step_fraction},
+            {"blur_ratio", o.video.blur_ratio},
+            {"blur_window", o.video.blur_window},
+            {"analysis_long_side", o.video.analysis_long_side}}},
           {"camera_model", o.camera_model},
           {"shared_camera", o.shared_camera},
           {"matcher", matcher},
@@ -294,6 +300,7 @@ Json OptionsJson(const SparseStageOptions& o) {
 
 Status SparseStageOptions::Check() const {
   CASUAL3D_RETURN_IF_ERROR(import.Check());
+  CASUAL3D_RETURN_IF_ERROR(video.Check());
   CASUAL3D_RETURN_IF_ERROR(depth_ranges.Check());
   CASUAL3D_RETURN_IF_ERROR(frame.Check());
   if (std::find(std::begin(kCameraModels), std::end(kCameraModels), camera_model) ==
@@ -340,9 +347,11 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
   // Inputs first: cheap checks before any work.
   const fs::path input_path(input);
   std::error_code ec;
-  if (!fs::is_directory(input_path, ec)) {
-    throw std::runtime_error(input + ": not a folder; give a folder of photos or a COLMAP "
-                             "workspace (images/ and sparse/)");
+  const std::string video =
+      options.input_type == SparseInputType::kWorkspace ? "" : VideoOf(input);
+  if (!fs::is_directory(input_path, ec) && video.empty()) {
+    throw std::runtime_error(input + ": not a folder or a video; give a folder of photos, a video "
+                             "clip (.mp4, .mov) or a COLMAP workspace (images/ and sparse/)");
   }
   const fs::path output_path = fs::absolute(fs::path(output)).lexically_normal();
   if (fs::exists(output_path, ec) && !options.overwrite) {
@@ -352,7 +361,8 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
   bool workspace = false;
   switch (options.input_type) {
     case SparseInputType::kAuto:
-      workspace = !workspace_models.empty() && fs::is_directory(input_path / "images", ec);
+      workspace = video.empty() && !workspace_models.empty() &&
+                  fs::is_directory(input_path / "images", ec);
       break;
     case SparseInputType::kWorkspace:
       if (workspace_models.empty() || !fs::is_directory(input_path / "images", ec)) {
@@ -376,7 +386,7 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
   AppendLog(log_path, "casual3d sparse: input " + input + ", output " + output);
 
   SparseStageResult result;
-  result.input_type = workspace ? "workspace" : "photos";
+  result.input_type = workspace ? "workspace" : video.empty() ? "photos" : "video";
   fs::path image_dir;
   fs::path model_dir;
   geometry::SparseModel raw_model;
@@ -397,19 +407,39 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
     }
     AppendLog(log_path, "workspace model " + model_dir.string());
   } else {
-    // 1. Import the photos at the working resolution.
+    // 1. Import the photos at the working resolution (a video's picked frames first).
+    std::string photo_dir = input;
+    if (!video.empty()) {
+      const fs::path frames = work / "video_frames";
+      fs::create_directories(frames);
+      result.video = ExtractVideoFrames(video, frames.string(), options.video);
+      const VideoFrames& v = result.video;
+      char line[256];
+      std::snprintf(line, sizeof(line),
+                    "frame selection: %d frames of %dx%d at %.3g fps (rotation %d degrees), "
+                    "%d blurred, motion %.2f frame diagonals; picked %zu in %.1f s",
+                    v.frames_decoded, v.width, v.height, v.fps, v.rotation_deg, v.blurred,
+                    v.motion_diagonals, v.picked.size(), v.seconds);
+      AppendLog(log_path, line);
+      util::LogInfo(line);
+      result.timings_s.emplace_back("frame_selection", v.seconds);
+      photo_dir = frames.string();
+    }
     const auto t0 = std::chrono::steady_clock::now();
     PhotoImport photos;
     {
       util::Progress progress("import photos", 1000);
-      photos = ImportPhotos(input, (work / "images").string(), options.import,
+      photos = ImportPhotos(photo_dir, (work / "images").string(), options.import,
                             [&](int done, int total) {
                               if (InterruptRequested()) throw std::runtime_error("interrupted");
                               progress.Set(static_cast<int64_t>(done) * 1000 / std::max(total, 1));
                             });
     }
     result.skipped = photos.skipped;
-    for (const auto& s : photos.skipped) util::LogWarning("skipped " + s);
+    for (const auto& s : photos.skipped) {
+      util::LogWarning("skipped " + s.file + ": " + s.reason);
+      AppendLog(log_path, "skipped " + s.file + ": " + s.reason);
+    }
     for (const auto& p : photos.photos) all_names.push_back(p.name);
     result.timings_s.emplace_back("import", SecondsSince(t0));
     image_dir = work / "images";
@@ -549,8 +579,18 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
   }
   result.timings_s.emplace_back("total", SecondsSince(stage_start));
 
+  Json stage_video;
+  Json skipped = Json::array();
+  for (const SkippedPhoto& s : result.skipped) skipped.push_back({{"file", s.file}, {"reason", s.reason}});
   Json timings = Json::object();
   for (const auto& [step, s] : result.timings_s) timings[step] = s;
+  if (!video.empty()) {
+    const VideoFrames& v = result.video;
+    stage_video = {{"file", v.video}, {"frames", v.frames_decoded}, {"fps", v.fps},
+                   {"width", v.width}, {"height", v.height}, {"rotation_deg", v.rotation_deg},
+                   {"blurred", v.blurred}, {"motion_diagonals", v.motion_diagonals},
+                   {"picked", v.picked}, {"seconds", v.seconds}};
+  }
   Json stage = {{"format", "casual3d-stage-sparse"},
                 {"version", "1.0"},
                 {"input", fs::absolute(input_path).lexically_normal().string()},
@@ -561,10 +601,11 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
                 {"num_photos", result.num_photos},
                 {"num_registered", result.num_registered},
                 {"unregistered", result.unregistered},
-                {"skipped", result.skipped},
+                {"skipped", skipped},
                 {"num_points", result.num_points},
                 {"mean_reprojection_error_px", result.mean_reprojection_error_px},
                 {"timings_s", timings}};
+  if (!stage_video.is_null()) stage["video"] = stage_video;
   io::WriteFileAtomic((tmp / "stage.json").string(), stage.dump(2) + "\n");
   AppendLog(log_path, "done: " + std::to_string(result.num_registered) + "/" +
                           std::to_string(result.num_photos) + " registered, " +

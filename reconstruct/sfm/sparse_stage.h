@@ -2,8 +2,10 @@
 
 // The sparse stage (Sec. 4.1 of the paper): photos in, calibrated cameras out.
 //
-// Input: a folder of photos (JPEG, PNG, with EXIF), or an existing COLMAP
-// workspace (DIR/images plus a sparse model in DIR/sparse or DIR/sparse/N).
+// Input: a folder of photos (JPEG, PNG, TIFF, HEIF, with EXIF), a video clip
+// (or a folder holding one video: video_import.h picks its frames), or an
+// existing COLMAP workspace (DIR/images plus a sparse model in DIR/sparse or
+// DIR/sparse/N).
 // For photos it imports them at the working resolution (photo_import.h), runs
 // Debian's COLMAP on the CPU (feature_extractor; descriptor matching by
 // descriptor_matcher.h, then COLMAP's exhaustive or sequential matcher for
@@ -27,12 +29,13 @@
 #include "format/status.h"
 #include "reconstruct/sfm/photo_import.h"
 #include "reconstruct/sfm/scene_setup.h"
+#include "reconstruct/sfm/video_import.h"
 
 namespace casual3d::sfm {
 
 enum class SparseInputType {
   kAuto,       // A workspace if DIR/images and a model below DIR/sparse exist, else photos.
-  kPhotos,     // A folder of photos.
+  kPhotos,     // A folder of photos, or a video.
   kWorkspace,  // A COLMAP workspace.
 };
 
@@ -45,6 +48,7 @@ enum class MatcherType {
 struct SparseStageOptions {
   SparseInputType input_type = SparseInputType::kAuto;
   PhotoImportOptions import;
+  VideoFrameOptions video;  // For a video input.
   // COLMAP camera model of the photos: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL,
   // RADIAL or OPENCV. SIMPLE_RADIAL is COLMAP's default for phone photos.
   std::string camera_model = "SIMPLE_RADIAL";
@@ -89,11 +93,12 @@ struct SparseStageOptions {
 };
 
 struct SparseStageResult {
-  std::string input_type;  // "photos" or "workspace".
+  std::string input_type;  // "photos", "video" or "workspace".
   int num_photos = 0;      // Photos given (workspace: images in its model).
   int num_registered = 0;
   std::vector<std::string> unregistered;  // Names.
-  std::vector<std::string> skipped;       // Unreadable photos skipped.
+  std::vector<SkippedPhoto> skipped;      // Files left out by the import.
+  VideoFrames video;                      // For a video input.
   int num_points = 0;
   double mean_reprojection_error_px = 0.0;
   std::string matcher;  // "exhaustive", "sequential" or "" (workspace).

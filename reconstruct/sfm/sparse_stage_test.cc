@@ -80,7 +80,8 @@ TEST_F(SparseStageTest, TooFewPhotos) {
 TEST_F(SparseStageTest, CorruptPhotoIsNamed) {
   WritePhotos(4);
   std::ofstream(root_ / "photos" / "broken.jpg") << "not a jpeg";
-  ExpectFailure({"broken.jpg", "--skip-unreadable"});
+  options_.import.skip_unreadable = false;
+  ExpectFailure({"broken.jpg", "--strict-photos"});
 }
 
 TEST_F(SparseStageTest, MissingColmapSaysHowToInstall) {
@@ -115,13 +116,11 @@ TEST_F(SparseStageTest, SkipUnreadableGoesOnWithoutTheBrokenPhoto) {
   ExpectFailure({"registered none of the 3 photos"});  // Only the 3 good ones went on.
 }
 
-TEST_F(SparseStageTest, PhotosOfDifferentCameras) {
+TEST_F(SparseStageTest, PhotosOfDifferentSizesWithoutExifGoOn) {
   WritePhotos(3);  // p0..p2 at 320x240.
   cv::Mat other(480, 640, CV_8UC3, cv::Scalar(10, 200, 30));
   cv::imwrite((root_ / "photos" / "z.jpg").string(), other);
-  ExpectFailure({"2 different cameras", "640x480", "z.jpg", "--mixed-cameras"});
-  options_.import.allow_mixed_devices = true;
-  ExpectFailure({"registered none of the 4 photos"});
+  ExpectFailure({"registered none of the 4 photos"});  // Each size its own calibration.
 }
 
 TEST_F(SparseStageTest, ExistingOutputIsKept) {
