@@ -1,5 +1,5 @@
 // `casual3d encode <master.exr> -o <package> [--quality Q] [--tile-size N]
-// [--levels N] [--single-file out.c3d]`: turns a master file into a web package
+// [--levels N] [--depth-bits B] [--normal-bits B] [--single-file out.c3d]`: turns a master file into a web package
 // (spec/package.md), optionally also as one .c3d file.
 
 #include <chrono>
@@ -20,7 +20,9 @@ struct EncodeCommandOptions {
   std::string output;        // Output package folder.
   std::string single_file;   // Optional .c3d output.
   bool viewer = true;        // Add index.html and the viewer to the folder.
-  encoder::PackageOptions package;
+  // Web delivery settings; --depth-bits 12 --normal-bits 8 keep each node's
+  // value as closely as PackageOptions' defaults.
+  encoder::PackageOptions package = encoder::DeliveryPackageOptions();
 };
 
 void RunEncode(const EncodeCommandOptions& o) {
@@ -78,9 +80,11 @@ void AddEncodeCommand(CLI::App& app) {
   cmd->add_option("--levels", options->package.levels,
                   "Levels of detail, 1..8; 0 = automatic (default)");
   cmd->add_option("--depth-bits", options->package.depth_bits,
-                  "Bits of the log-depth code, 8..16 (default 12)");
+                  "Bits of the log-depth code, 8..16 (default 10: relative error at most "
+                  "0.34% for far/near 1000; 12 for 0.084%)");
   cmd->add_option("--normal-bits", options->package.normal_bits,
-                  "Bits per octahedral normal coordinate, 4..8 (default 8)");
+                  "Bits per octahedral normal coordinate, 4..8 (default 5: angular error at "
+                  "most 8.1 degrees; 8 for 1 degree)");
   cmd->add_option("--threads", options->package.num_threads, "Encoding threads; 0 = all cores");
   cmd->add_flag("!--no-viewer", options->viewer, "Do not add index.html and the viewer");
   cmd->callback([options] { RunEncode(*options); });

@@ -94,6 +94,15 @@ Status PackageOptions::Check() const {
   return Status::Ok();
 }
 
+PackageOptions DeliveryPackageOptions() {
+  PackageOptions options;
+  options.normal_bits = 5;
+  options.depth_bits = 10;
+  options.lossless_method = 4;
+  options.lossless_effort = 75.0f;
+  return options;
+}
+
 StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const PackageOptions& options,
                                      PackageStats* stats) {
   CASUAL3D_RETURN_IF_ERROR(options.Check());

@@ -43,6 +43,18 @@ struct PackageOptions {
   Status Check() const;
 };
 
+// The settings for web delivery of reconstructed 3D photos, used by
+// `casual3d encode` and `casual3d reconstruct` (docs/PERFORMANCE.md, "Package
+// size"; docs/DECISIONS.md, "Delivery budget"): PackageOptions' defaults but
+// 5-bit normals (angular error at most 8.1 degrees, about 2.6 on average
+// against 8 bits on reconstructions, whose normals are noisier than that),
+// 10-bit depth (relative error at most exp(ln(far_m / near_m) / 2046) - 1:
+// 0.34% for far/near = 1000) and lossless WebP method 4, effort 75. Lossless
+// codes of reconstructed normals and depth are mostly noise, so every bit
+// they drop saves about as much as it can; readers are unchanged, as every
+// encoding declares its bits in the manifest.
+PackageOptions DeliveryPackageOptions();
+
 // Sizes and timing of an encoded package.
 struct PackageStats {
   uint64_t total_bytes = 0;               // All files including manifest.json.

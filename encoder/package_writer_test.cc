@@ -62,9 +62,11 @@ double ColorPsnr(const TwoLayerPanorama& a, const TwoLayerPanorama& b) {
   return 10 * std::log10(255.0 * 255.0 / (se / n));
 }
 
-// Graph exact, depth within the encoding's bound, normals within 1 degree.
+// Graph exact, depth within the encoding's bound, normals within
+// `max_angle_deg` (1 degree for 8-bit codes).
 void ExpectDecodedMatches(const TwoLayerPanorama& expected, const TwoLayerPanorama& decoded,
-                          const DepthQuantization& q, double min_psnr) {
+                          const DepthQuantization& q, double min_psnr,
+                          double max_angle_deg = 1.0) {
   ASSERT_EQ(decoded.width(), expected.width());
   ASSERT_EQ(decoded.height(), expected.height());
   const double bound = q.MaxRelativeError() * 1.01 + 1e-7;
@@ -91,7 +93,7 @@ void ExpectDecodedMatches(const TwoLayerPanorama& expected, const TwoLayerPanora
     }
   }
   EXPECT_LE(worst_depth, bound);
-  EXPECT_LT(worst_angle, 1.0);
+  EXPECT_LT(worst_angle, max_angle_deg);
   EXPECT_GT(ColorPsnr(expected, decoded), min_psnr);
   for (int i = 0; i < 9; ++i) EXPECT_EQ(decoded.frame().rotation[i], expected.frame().rotation[i]);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(decoded.frame().centre[i], expected.frame().centre[i]);
@@ -128,6 +130,66 @@ TEST_F(PackageWriterTest, FolderRoundTripAtEveryLevel) {
   int entries = 0;
   for (const auto& e : fs::directory_iterator(dir_)) entries += 1 + 0 * e.is_directory();
   EXPECT_EQ(entries, 1);
+}
+
+// The largest angle between a unit normal and its decoded `bits`-bit
+// octahedral code, over a dense spiral of normals.
+double WorstOctahedralErrorDeg(int bits) {
+  NormalQuantization q;
+  q.bits = bits;
+  double worst = 0;
+  constexpr int kSamples = 2000000;
+  for (int k = 0; k < kSamples; ++k) {
+    const double z = 1 - (2 * k + 1.0) / kSamples, r = std::sqrt(1 - z * z);
+    const double phi = k * M_PI * (3 - std::sqrt(5.0));
+    const float n[3] = {float(r * std::cos(phi)), float(r * std::sin(phi)), float(z)};
+    uint8_t code[2];
+    float d[3];
+    EncodeOctahedral(n, q, code);
+    EXPECT_TRUE(DecodeOctahedral(code, q, d));
+    const double dot = double(n[0]) * d[0] + double(n[1]) * d[1] + double(n[2]) * d[2];
+    worst = std::max(worst, std::acos(std::fmin(1.0, dot)) * 180 / M_PI);
+  }
+  return worst;
+}
+
+TEST(DeliveryPackageOptionsTest, NormalBoundOfFiveBitCodes) {
+  // DeliveryPackageOptions() declares 5-bit normals within 8.1 degrees.
+  const double worst5 = WorstOctahedralErrorDeg(5);
+  std::printf("largest angular error: 5 bits %.2f deg, 8 bits %.2f deg\n", worst5,
+              WorstOctahedralErrorDeg(8));
+  EXPECT_LT(worst5, 8.1);
+  EXPECT_GT(worst5, 7.5);  // Not far from the bound: the bound is tight.
+}
+
+TEST_F(PackageWriterTest, DeliveryOptionsKeepTheirBoundsAndShrinkThePackage) {
+  PackageStats exact_stats, delivery_stats;
+  Encode(&exact_stats);
+  const PackageOptions exact = options_;
+  options_ = DeliveryPackageOptions();
+  options_.tile_size = exact.tile_size;
+  options_.levels = exact.levels;
+  options_.num_threads = exact.num_threads;
+  ASSERT_TRUE(options_.Check().ok());
+  const PackageFiles files = Encode(&delivery_stats);
+  EXPECT_LT(delivery_stats.total_bytes, exact_stats.total_bytes * 3 / 4);
+  MemoryFileSource source;
+  for (const auto& [path, bytes] : files) source.Add(path, bytes);
+  TwoLayerPanorama expected = pano_;
+  for (int level = 0; level < 3; ++level) {
+    ReadOptions read;
+    read.level = level;
+    Manifest manifest;
+    StatusOr<TwoLayerPanorama> decoded = ReadPackage(source, decoder_, read, &manifest);
+    ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+    EXPECT_EQ(manifest.normal.bits, 5);
+    EXPECT_EQ(manifest.depth.bits, 10);
+    // Depth within exp(ln(50) / 2046) - 1 = 0.19% (the bound of 10-bit codes).
+    EXPECT_NEAR(manifest.depth.MaxRelativeError(), std::exp(std::log(50.0) / 2046) - 1, 1e-5);
+    const double min_psnr[3] = {37.5, 35.5, 33.5};
+    ExpectDecodedMatches(expected, *decoded, manifest.depth, min_psnr[level], 8.1);
+    if (level < 2) expected = *HalvePanorama(expected);
+  }
 }
 
 TEST_F(PackageWriterTest, SingleFileGivesTheSamePanorama) {

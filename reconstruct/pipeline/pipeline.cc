@@ -25,7 +25,7 @@ using Clock = std::chrono::steady_clock;
 // Bump when a stage's output format or algorithm changes, so old caches are stale.
 // sparse-3: the import skips bad and duplicate files, reads HEIF, TIFF and video.
 constexpr const char* kStageVersions[kNumStages] = {"sparse-3", "dense-4", "panorama-3",
-                                                    "encode-1"};
+                                                    "encode-2"};
 
 std::string HashHex(const std::string& text) {
   return Sha256Hex(reinterpret_cast<const uint8_t*>(text.data()), text.size());
@@ -338,7 +338,7 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
                                               : encoder::ReadMasterFile(master.string());
         fresh_panorama.reset();
         if (!pano.ok()) throw std::runtime_error(pano.status().ToString());
-        encoder::PackageOptions package;
+        encoder::PackageOptions package = encoder::DeliveryPackageOptions();
         package.color_quality = options.color_quality;
         package.tile_size = options.tile_size;
         package.num_threads = options.num_threads;

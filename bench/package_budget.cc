@@ -1,0 +1,217 @@
+// Delivery budget of a web package (docs/PERFORMANCE.md, "Package size"):
+// encodes a master file with the reference settings (PackageOptions' defaults:
+// 12-bit depth, 8-bit normals) and with candidate settings (by default
+// DeliveryPackageOptions()), decodes both through the package reader
+// and prints the bytes by level and tile image kind, and what the candidate
+// changes: normals' angle to the reference package's (mean, 99th percentile,
+// largest) and to the master's (largest: the declared bound), depth's relative
+// error to the master (99th percentile, largest). Optionally writes a
+// side-by-side Lambert shading of the front layer's normals (reference |
+// candidate), the effect the viewer's lights have.
+//
+//   build/bench/package_budget MASTER.exr [--normal-bits B] [--depth-bits B]
+//       [--lossless-effort F] [--lossless-method M] [--reference-only]
+//       [--shading out.png]
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "encoder/master_file.h"
+#include "encoder/package_writer.h"
+#include "encoder/webp_codec.h"
+#include "format/file_source.h"
+#include "format/package_reader.h"
+#include "reconstruct/io/image_io.h"
+
+namespace casual3d {
+namespace {
+
+struct Encoded {
+  encoder::PackageFiles files;
+  encoder::PackageStats stats;
+  double seconds = 0;
+  std::vector<TwoLayerPanorama> levels;  // Decoded, finest first.
+};
+
+Encoded EncodeAndDecode(const TwoLayerPanorama& master, const encoder::PackageOptions& options) {
+  Encoded e;
+  const auto start = std::chrono::steady_clock::now();
+  StatusOr<encoder::PackageFiles> files = encoder::EncodePackage(master, options, &e.stats);
+  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!files.ok()) {
+    std::fprintf(stderr, "package_budget: %s\n", files.status().ToString().c_str());
+    std::exit(1);
+  }
+  e.files = std::move(*files);
+  MemoryFileSource source;
+  for (const auto& [path, bytes] : e.files) source.Add(path, bytes);
+  encoder::WebpImageDecoder decoder;
+  ReadOptions read;
+  read.num_threads = std::max(1u, std::thread::hardware_concurrency());
+  for (size_t l = 0; l < e.stats.level_bytes.size(); ++l) {
+    read.level = static_cast<int>(l);
+    StatusOr<TwoLayerPanorama> pano = ReadPackage(source, decoder, read);
+    if (!pano.ok()) {
+      std::fprintf(stderr, "package_budget: level %zu: %s\n", l, pano.status().ToString().c_str());
+      std::exit(1);
+    }
+    e.levels.push_back(std::move(*pano));
+  }
+  return e;
+}
+
+// Bytes of the tile files of `level` whose name ends in ".<kind>.webp".
+uint64_t KindBytes(const encoder::PackageFiles& files, int level, const char* kind) {
+  const std::string prefix = "l" + std::to_string(level) + "/";
+  const std::string suffix = std::string(".") + kind + ".webp";
+  uint64_t sum = 0;
+  for (const auto& [path, bytes] : files)
+    if (path.compare(0, prefix.size(), prefix) == 0 && path.size() > suffix.size() &&
+        path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0)
+      sum += bytes.size();
+  return sum;
+}
+
+void PrintSizes(const char* name, const Encoded& e) {
+  std::printf("%s: %.0f KB in all (manifest %.1f KB), encoded in %.1f s\n", name,
+              e.stats.total_bytes / 1024.0, e.stats.manifest_bytes / 1024.0, e.seconds);
+  std::printf("  level | color KB | depth KB | normal KB | graph KB | level KB\n");
+  for (size_t l = 0; l < e.stats.level_bytes.size(); ++l) {
+    std::printf("  %5zu", l);
+    for (const char* kind : {"color", "depth", "normal", "graph"})
+      std::printf(" | %8.0f", KindBytes(e.files, static_cast<int>(l), kind) / 1024.0);
+    std::printf(" | %8.0f\n", e.stats.level_bytes[l] / 1024.0);
+  }
+}
+
+double Percentile(std::vector<float>* values, double p) {
+  if (values->empty()) return 0;
+  const size_t k = std::min(values->size() - 1, static_cast<size_t>(p * values->size()));
+  std::nth_element(values->begin(), values->begin() + k, values->end());
+  return (*values)[k];
+}
+
+double AngleDeg(const float* a, const float* b) {
+  const double dot = double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2];
+  return std::acos(std::clamp(dot, -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// Errors of level `level` of the candidate against the reference package and
+// the master's values (the master's level 0 only).
+void PrintErrors(int level, const TwoLayerPanorama& reference, const TwoLayerPanorama& candidate,
+                 const TwoLayerPanorama* master) {
+  std::vector<float> normal_deg, depth_rel;
+  double normal_sum = 0, normal_to_master = 0;
+  for (int l = 0; l < kNumLayers; ++l) {
+    const LayerData& R = reference.layer(l);
+    const LayerData& C = candidate.layer(l);
+    for (size_t i = 0; i < R.present.size(); ++i) {
+      if (!R.present[i]) continue;
+      const float* nr = &R.normal[3 * i];
+      if (nr[0] != 0 || nr[1] != 0 || nr[2] != 0) {
+        normal_deg.push_back(static_cast<float>(AngleDeg(nr, &C.normal[3 * i])));
+        normal_sum += normal_deg.back();
+        if (master != nullptr)
+          normal_to_master = std::max(
+              normal_to_master, AngleDeg(&master->layer(l).normal[3 * i], &C.normal[3 * i]));
+      }
+      const float truth = master != nullptr ? master->layer(l).depth_m[i] : R.depth_m[i];
+      depth_rel.push_back(std::fabs(C.depth_m[i] / truth - 1.0f));
+    }
+  }
+  const double mean = normal_deg.empty() ? 0 : normal_sum / normal_deg.size();
+  const double normal_max = normal_deg.empty() ? 0 : *std::max_element(normal_deg.begin(), normal_deg.end());
+  const double depth_max = depth_rel.empty() ? 0 : *std::max_element(depth_rel.begin(), depth_rel.end());
+  std::printf("  level %d normals vs reference: mean %.2f, p99 %.2f, max %.2f deg", level, mean,
+              Percentile(&normal_deg, 0.99), normal_max);
+  if (master != nullptr) std::printf("; vs master: max %.2f deg", normal_to_master);
+  std::printf("; depth vs %s: p99 %.4f%%, max %.4f%%\n", master != nullptr ? "master" : "reference",
+              100 * Percentile(&depth_rel, 0.99), 100 * depth_max);
+}
+
+// Lambert shading (ambient 0.25, one light from the upper left in front of
+// the viewer) of the front layer's normals in the 90 x 45 degree window
+// around the forward direction, grey levels.
+void Shade(const TwoLayerPanorama& pano, int x0, Image8* out) {
+  const int w = pano.width() / 4, h = pano.height() / 4, y0 = pano.height() * 3 / 8;
+  const double light[3] = {-0.48, 0.48, 0.73};  // Unit vector; +Z points back at the viewer.
+  const LayerData& F = pano.layer(kFront);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t i = pano.index(pano.width() * 3 / 8 + x, y0 + y);
+      const float* n = &F.normal[3 * i];
+      const double lit = std::max(0.0, n[0] * light[0] + n[1] * light[1] + n[2] * light[2]);
+      const double shade = F.present[i] ? 0.25 + 0.75 * lit : 0.0;
+      out->at(x0 + x, y) = static_cast<uint8_t>(std::lround(255 * std::min(1.0, shade)));
+    }
+}
+
+int Main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: package_budget MASTER.exr [--normal-bits B] [--depth-bits B] "
+                         "[--lossless-effort F] "
+                         "[--lossless-method M] [--reference-only] [--shading out.png]\n");
+    return 2;
+  }
+  encoder::PackageOptions candidate = encoder::DeliveryPackageOptions();
+  std::string shading;
+  bool reference_only = false;
+  for (int a = 2; a < argc; ++a) {
+    const std::string arg = argv[a];
+    const bool has_value = a + 1 < argc;
+    if (arg == "--reference-only") reference_only = true;
+    else if (arg == "--normal-bits" && has_value) candidate.normal_bits = std::atoi(argv[++a]);
+    else if (arg == "--depth-bits" && has_value) candidate.depth_bits = std::atoi(argv[++a]);
+    else if (arg == "--lossless-effort" && has_value) candidate.lossless_effort = static_cast<float>(std::atof(argv[++a]));
+    else if (arg == "--lossless-method" && has_value) candidate.lossless_method = std::atoi(argv[++a]);
+    else if (arg == "--shading" && has_value) shading = argv[++a];
+    else {
+      std::fprintf(stderr, "package_budget: unknown or incomplete option %s\n", arg.c_str());
+      return 2;
+    }
+  }
+  if (Status s = candidate.Check(); !s.ok()) {
+    std::fprintf(stderr, "package_budget: %s\n", s.message().c_str());
+    return 2;
+  }
+  StatusOr<TwoLayerPanorama> master = encoder::ReadMasterFile(argv[1]);
+  if (!master.ok()) {
+    std::fprintf(stderr, "package_budget: %s\n", master.status().ToString().c_str());
+    return 1;
+  }
+  const Encoded reference = EncodeAndDecode(*master, encoder::PackageOptions());
+  if (reference_only) {
+    PrintSizes("reference", reference);
+    return 0;
+  }
+  PrintSizes("reference", reference);
+  const Encoded encoded = EncodeAndDecode(*master, candidate);
+  std::printf("candidate: normal bits %d, depth bits %d, lossless effort %g method %d\n",
+              candidate.normal_bits, candidate.depth_bits, candidate.lossless_effort,
+              candidate.lossless_method);
+  PrintSizes("candidate", encoded);
+  for (size_t l = 0; l < encoded.levels.size(); ++l)
+    PrintErrors(static_cast<int>(l), reference.levels[l], encoded.levels[l],
+                l == 0 ? &*master : nullptr);
+  if (!shading.empty()) {
+    const TwoLayerPanorama& a = reference.levels[0];
+    Image8 image(2 * (a.width() / 4) + 8, a.height() / 4, 1, 255);
+    Shade(a, 0, &image);
+    Shade(encoded.levels[0], a.width() / 4 + 8, &image);
+    io::WritePng(shading, image);
+    std::printf("wrote %s (reference | candidate)\n", shading.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace casual3d
+
+int main(int argc, char** argv) { return casual3d::Main(argc, argv); }
