@@ -78,15 +78,17 @@ bool ContentExtent(const Image8& fov_mask, ViewHints* hints) {
     return false;
   hints->content_pitch_max_deg = 90.0 - 180.0 * top / H;
   hints->content_pitch_min_deg = 90.0 - 180.0 * (bottom + 1) / H;
-  PeelContentBox(fov_mask, kMaxEmptyFraction, hints);
+  FitContentBox(fov_mask, kMaxEmptyFraction, hints);
   return true;
 }
 
-void PeelContentBox(const Image8& fov_mask, double max_empty_fraction, ViewHints* hints) {
+void FitContentBox(const Image8& fov_mask, double max_empty_fraction, ViewHints* hints) {
+  const double yaw_span = hints->content_yaw_max_deg - hints->content_yaw_min_deg;
+  if (yaw_span >= 360.0) return;  // Content all around: no side to move.
   const int W = fov_mask.width(), H = fov_mask.height();
-  // Cells of about 1/1024 of the circle; each holds its share of content
-  // and its solid angle (cos of the latitude).
-  const int cell = std::max(1, W / 1024);
+  // Cells of about 1/256 of the circle; each holds its solid angle (cos of
+  // the latitude) and the part of it outside the mask.
+  const int cell = std::max(1, W / 256);
   const int gw = (W + cell - 1) / cell, gh = (H + cell - 1) / cell;
   std::vector<double> full(size_t(gw) * gh, 0.0), empty(full.size(), 0.0);
   for (int y = 0; y < H; ++y) {
@@ -114,37 +116,32 @@ void PeelContentBox(const Image8& fov_mask, double max_empty_fraction, ViewHints
     return t[size_t(y1 + 1) * tw + x1 + 1] - t[size_t(y0) * tw + x1 + 1] -
            t[size_t(y1 + 1) * tw + x0] + t[size_t(y0) * tw + x0];
   };
-  const double yaw_span = hints->content_yaw_max_deg - hints->content_yaw_min_deg;
-  if (yaw_span >= 360.0) return;  // Content all around: no side to peel.
   // Cell columns of the extent, unwrapped (content across the seam starts
   // below 0), then moved into [0, gw) by `shift` whole turns.
   const int u0 = static_cast<int>(std::floor((hints->content_yaw_min_deg / 360.0 + 0.5) * gw));
   const int u1 = static_cast<int>(std::ceil((hints->content_yaw_max_deg / 360.0 + 0.5) * gw)) - 1;
   const int shift = u0 >= 0 ? -(u0 / gw) * gw : ((-u0 + gw - 1) / gw) * gw;
-  int x0 = u0 + shift, x1 = std::min(u1, u0 + gw - 1) + shift;
-  int y0 = std::clamp(static_cast<int>(std::floor((0.5 - hints->content_pitch_max_deg / 180.0) * gh)), 0, gh - 1);
-  int y1 = std::clamp(static_cast<int>(std::ceil((0.5 - hints->content_pitch_min_deg / 180.0) * gh)) - 1, y0, gh - 1);
-  while (x1 > x0 + 1 && y1 > y0 + 1) {
-    const double f = box(sum_full, x0, x1, y0, y1);
-    if (!(f > 0) || box(sum_empty, x0, x1, y0, y1) <= max_empty_fraction * f) break;
-    // The edge line with the largest empty share goes.
-    const auto share = [&](int a0, int a1, int b0, int b1) {
-      const double lf = box(sum_full, a0, a1, b0, b1);
-      return lf > 0 ? box(sum_empty, a0, a1, b0, b1) / lf : 0.0;
-    };
-    const double left = share(x0, x0, y0, y1), right = share(x1, x1, y0, y1);
-    const double top = share(x0, x1, y0, y0), bottom = share(x0, x1, y1, y1);
-    const double worst = std::max({left, right, top, bottom});
-    if (worst == left) ++x0;
-    else if (worst == right) --x1;
-    else if (worst == top) ++y0;
-    else --y1;
-  }
-  // Back to degrees, on the original extent's branch.
-  hints->content_yaw_min_deg = (double(x0 - shift) / gw - 0.5) * 360.0;
-  hints->content_yaw_max_deg = (double(x1 + 1 - shift) / gw - 0.5) * 360.0;
-  hints->content_pitch_max_deg = (0.5 - double(y0) / gh) * 180.0;
-  hints->content_pitch_min_deg = (0.5 - double(y1 + 1) / gh) * 180.0;
+  const int a0 = u0 + shift, a1 = std::min(u1, u0 + gw - 1) + shift;
+  const int b0 = std::clamp(static_cast<int>(std::floor((0.5 - hints->content_pitch_max_deg / 180.0) * gh)), 0, gh - 1);
+  const int b1 = std::clamp(static_cast<int>(std::ceil((0.5 - hints->content_pitch_min_deg / 180.0) * gh)) - 1, b0, gh - 1);
+  if (box(sum_empty, a0, a1, b0, b1) <= max_empty_fraction * box(sum_full, a0, a1, b0, b1)) return;
+  // Every box inside the extent: the one holding the most content with at
+  // most max_empty_fraction of it empty (ties: the earlier one).
+  double best = -1.0;
+  int bx0 = a0, bx1 = a1, by0 = b0, by1 = b1;
+  for (int y0 = b0; y0 <= b1; ++y0)
+    for (int y1 = y0; y1 <= b1; ++y1)
+      for (int x0 = a0; x0 <= a1; ++x0)
+        for (int x1 = x0; x1 <= a1; ++x1) {
+          const double f = box(sum_full, x0, x1, y0, y1), e = box(sum_empty, x0, x1, y0, y1);
+          if (e > max_empty_fraction * f) continue;
+          if (f - e > best) best = f - e, bx0 = x0, bx1 = x1, by0 = y0, by1 = y1;
+        }
+  if (best <= 0) return;  // Nothing fits: keep the extent.
+  hints->content_yaw_min_deg = (double(bx0 - shift) / gw - 0.5) * 360.0;
+  hints->content_yaw_max_deg = (double(bx1 + 1 - shift) / gw - 0.5) * 360.0;
+  hints->content_pitch_max_deg = (0.5 - double(by0) / gh) * 180.0;
+  hints->content_pitch_min_deg = (0.5 - double(by1 + 1) / gh) * 180.0;
 }
 
 ViewHints ComputeViewHints(const TwoLayerPanorama& pano, const Image8& fov_mask,

@@ -48,18 +48,17 @@ struct ViewVolumeOptions {
 
 // Content extent of a field-of-view mask (width x height x 1, non-zero
 // inside): sets the content_* members of `hints`; false, leaving them, when
-// the mask is empty. The box of the mask's longitudes and latitudes is then
-// peeled (PeelContentBox) until at most 0.5% of it is empty.
+// the mask is empty. When more than 0.5% of the box of the mask's
+// longitudes and latitudes is empty, the box becomes FitContentBox's.
 bool ContentExtent(const Image8& fov_mask, ViewHints* hints);
 
-// Shrinks the content box of `hints` (not all around) edge by edge, the
-// edge line (a column or a row of cells of about 1/1024 of the circle) with
-// the largest empty share first, until at most `max_empty_fraction` of the
-// box's solid angle is outside `fov_mask`, or the box is 2 cells wide or
-// high: the corners of a capture that is not a rectangle (sky above trees
-// that no photo saw) leave the box, so that a view kept inside it shows
-// content.
-void PeelContentBox(const Image8& fov_mask, double max_empty_fraction, ViewHints* hints);
+// Replaces the content box of `hints` (unless it goes all around) by the box
+// inside it, on a grid of cells of about 1/256 of the circle, that holds the
+// most content (solid angle inside `fov_mask`) with at most
+// `max_empty_fraction` of its solid angle outside: the corners of a capture
+// that is not a rectangle (sky above trees that no photo saw) leave the box,
+// so that a view kept inside it shows content. Unchanged when no box fits.
+void FitContentBox(const Image8& fov_mask, double max_empty_fraction, ViewHints* hints);
 
 // The hints for panorama `pano` whose photos are `views` (world poses) in
 // `frame`; `fov_mask` is the photos' field of view (coverage.h) at the

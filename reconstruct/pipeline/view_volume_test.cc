@@ -37,11 +37,12 @@ TEST(ContentExtent, AcrossTheSeamIsOneInterval) {
   EXPECT_TRUE(h.Validate().ok());
 }
 
-TEST(ContentExtent, EmptyCornerIsPeeledOff) {
+TEST(ContentExtent, EmptyCornerLeavesTheBox) {
   // Columns 96..160 (longitudes -45 .. 45), rows 32..96 (latitudes 45 ..
   // -45), without its top-left corner (columns 96..112, rows 32..48): sky
-  // above trees that no photo saw. The box loses the corner's rows or
-  // columns, until at most 0.5% of it is empty.
+  // above trees that no photo saw. The box loses the corner's rows or its
+  // columns, whichever keeps more content, so that at most 0.5% of it is
+  // empty.
   Image8 mask = MaskOfColumns(256, 128, 96, 160, 32, 96);
   for (int y = 32; y < 48; ++y)
     for (int x = 96; x < 112; ++x) mask.at(x, y) = 0;
