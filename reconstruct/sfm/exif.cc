@@ -100,7 +100,9 @@ ExifInfo ExifFromFileBytes(const std::string& bytes) {
   if (io::LooksLikeHeif(bytes)) {
     const std::string tiff = io::HeifExifTiff(bytes);
     if (tiff.empty()) return {};
-    exif = std::string("Exif\0\0", 6) + tiff;  // The header libexif looks for.
+    exif = std::string("Exif\0\0", 6) + tiff;  // The header exif_data_load_data looks for.
+    return FromExifData(std::unique_ptr<ExifData, ExifDataDeleter>(exif_data_new_from_data(
+        reinterpret_cast<const unsigned char*>(exif.data()), static_cast<unsigned int>(exif.size()))));
   }
   if (exif.empty()) return {};
   // The loader (as exif_data_new_from_file uses) yields no data when the bytes
