@@ -2,17 +2,30 @@
 // mesh builder (the browser's path, WebP via @jsquash/webp): every level of
 // every valid vector gives the native reader's and builder's mesh (geometry
 // byte-identical, colours within 2 levels of the lossy WebP), and every vector
-// under invalid/ is refused with a message.
+// under invalid/ (package folders through the tile reader, .c3d files
+// through the format entry) is refused for its content, with a message.
 
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { test } from 'node:test';
+import { pathToFileURL } from 'node:url';
 
 import { assertLevelMatchesNative } from './native-comparison.mjs';
-import { SOURCE_DIR, loadFormatModule } from './node-support.mjs';
+import { DIST_DIR, SOURCE_DIR, loadFormatModule } from './node-support.mjs';
 import { readPackageLevel } from './node-package.mjs';
+
+// The format entry of the npm package, as built, laid out as installed: the
+// built files with the viewer's npm packages (its WebP decoder) beside them.
+const installed = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-format-entry-'));
+process.on('exit', () => fs.rmSync(installed, { recursive: true, force: true }));
+fs.cpSync(DIST_DIR, path.join(installed, 'dist'), { recursive: true });
+fs.symlinkSync(path.join(SOURCE_DIR, 'wasm-viewer', 'node_modules'), path.join(installed, 'node_modules'));
+const { createFormat, openPackage } = await import(pathToFileURL(path.join(installed, 'dist', 'format-node.js')).href);
+
+let formatEntryModule;
+const formatEntry = async () => (formatEntryModule ??= await createFormat({ threads: false }));
 
 const VECTORS = path.join(SOURCE_DIR, 'spec', 'vectors');
 const format = await loadFormatModule();
@@ -33,11 +46,56 @@ for (const name of valid) {
   }
 }
 
+// The same path reads every valid vector's .c3d, so that a refusal below is
+// the invalid vector's own.
+const readC3d = async (file) => {
+  const opened = await openPackage(file, { format: await formatEntry() });
+  for (let level = opened.numLevels - 1; level >= 0; --level) (await opened.readLevel(level)).free?.();
+};
+for (const name of valid) {
+  test(`${name}.c3d reads through the format entry`, async () => {
+    await readC3d(path.join(VECTORS, `${name}.c3d`));
+  });
+}
+
 const invalidDir = path.join(VECTORS, 'invalid');
+// What each invalid vector's refusal names (package.md Sec. 9.1): the rule
+// it breaks, not a file the test failed to find.
+const RULE = {
+  'checksum-mismatch': /SHA-256 does not match/,
+  'container-unknown-major': /single file: version .* not supported/,
+  'depth-code-above-max': /depth code above the maximum/,
+  'duplicate-entry': /duplicate path/,
+  'entry-outside-file': /outside the .*file/,
+  'link-not-mutual': /not mutual/,
+  'lossy-data-tile': /must be lossless WebP/,
+  'manifest-not-first': /first entry/,
+  'near-equals-far': /near_m = far_m/,
+  'nesting-too-deep': /nesting deeper than 16/,
+  'normal-code-invalid': /invalid octahedral normal code/,
+  'path-escape': /unsafe path|not a safe relative path/,
+  'present-node-without-depth': /has no depth/,
+  'reserved-flag-bits': /reserved flag bits/,
+  'size-mismatch': /bytes, the manifest says/,
+  'unknown-major': /manifest.json: version .* not supported/,
+  'wrong-tile-size': /[0-9]+x[0-9]+( pixels)?, expected [0-9]+x[0-9]+/,
+};
+const refusedFor = (name) => (err) => {
+  const rule = RULE[name.replace(/\.c3d$/, '')];
+  assert.ok(rule, `invalid/${name}: no rule listed for it in this test`);
+  assert.match(err.message, rule);
+  return true;
+};
 for (const name of fs.existsSync(invalidDir) ? fs.readdirSync(invalidDir) : []) {
   test(`invalid/${name} is refused`, async () => {
     const pkg = path.join(invalidDir, name);
     const read = async () => {
+      if (name.endsWith('.c3d')) {
+        // The single file through the format entry (header, directory, then
+        // every level, the coarsest first).
+        await readC3d(pkg);
+        return;
+      }
       const manifest = JSON.parse(fs.readFileSync(path.join(pkg, 'manifest.json'), 'utf8'));
       const n = manifest.levels?.length ?? 1;
       for (let level = n - 1; level >= 0; --level) {
@@ -45,6 +103,6 @@ for (const name of fs.existsSync(invalidDir) ? fs.readdirSync(invalidDir) : []) 
         pano.free();
       }
     };
-    await assert.rejects(read(), (err) => err instanceof Error && err.message.length > 10);
+    await assert.rejects(read(), refusedFor(name));
   });
 }
