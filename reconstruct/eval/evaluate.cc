@@ -328,22 +328,30 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     eval.depth_scale = depth_scale;
   }
 
-  const auto mesh_start = std::chrono::steady_clock::now();
-  auto mesh = BuildMesh(photo3d.pano);
-  if (!mesh.ok()) throw std::runtime_error(photo3d.source + ": " + mesh.status().message());
-  const Image8 atlas = encoder::BuildColourAtlas(photo3d.pano);
-  eval.mesh_triangles = mesh->indices.size() / 3;
-  util::LogInfo("evaluate: " + photo3d_path + ": mesh of " + std::to_string(eval.mesh_triangles) +
-                " triangles in " + std::to_string(SecondsSince(mesh_start)) + " s; " +
-                std::to_string(selected.size()) + " photos");
+  // The mesh and its atlas, unless every rendering comes from elsewhere.
+  const bool render_here = options.rendered_dir.empty();
+  Mesh mesh;
+  Image8 atlas;
+  if (render_here) {
+    const auto mesh_start = std::chrono::steady_clock::now();
+    auto built = BuildMesh(photo3d.pano);
+    if (!built.ok()) throw std::runtime_error(photo3d.source + ": " + built.status().message());
+    mesh = std::move(*built);
+    atlas = encoder::BuildColourAtlas(photo3d.pano);
+    eval.mesh_triangles = mesh.indices.size() / 3;
+    util::LogInfo("evaluate: " + photo3d_path + ": mesh of " +
+                  std::to_string(eval.mesh_triangles) + " triangles in " +
+                  std::to_string(SecondsSince(mesh_start)) + " s; " +
+                  std::to_string(selected.size()) + " photos");
+  }
 
-  if (options.viewer_views && options.rendered_dir.empty()) {
+  if (options.viewer_views && render_here) {
     const auto viewer_start = std::chrono::steady_clock::now();
     ViewerViewsOptions viewer = options.viewer;
     viewer.num_threads = options.num_threads;
     viewer.keep_images = viewer.keep_images && options.keep_images;
     eval.viewer =
-        EvaluateViewerViews(photo3d.pano, *mesh, atlas.view(), photo3d.pano.view_hints(), viewer);
+        EvaluateViewerViews(photo3d.pano, mesh, std::as_const(atlas).view(), photo3d.pano.view_hints(), viewer);
     util::LogInfo("evaluate: " + photo3d_path + ": 17 viewer views in " +
                   std::to_string(SecondsSince(viewer_start)) + " s");
   }
@@ -394,8 +402,8 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     pe.has_distortion = camera.HasDistortion();
     const auto t = std::chrono::steady_clock::now();
     render::RenderResult r;
-    if (options.rendered_dir.empty()) {
-      r = render::RenderPhotoView(*mesh, atlas.view(), photo3d.pano.frame(), camera, image.pose,
+    if (render_here) {
+      r = render::RenderPhotoView(mesh, std::as_const(atlas).view(), photo3d.pano.frame(), camera, image.pose,
                                   render_options);
     } else {
       if (pe.has_distortion)
@@ -413,7 +421,7 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
                                        std::as_const(r.mask).view(), options.metrics,
                                        options.keep_images ? &error_map : nullptr);
     const fs::path truth = capture / "depth" / (fs::path(name).stem().string() + ".exr");
-    if (options.rendered_dir.empty() && fs::is_regular_file(truth, ec))
+    if (render_here && fs::is_regular_file(truth, ec))
       pe.depth = CompareDepth(io::ReadExrChannels(truth.string(), {"Z"}), r,
                               options.depth_tolerance, depth_scale);
     if (options.keep_images) {

@@ -63,7 +63,8 @@ struct EvaluateOptions {
   ViewerViewsOptions viewer;
   // Renderings made elsewhere (external_renders.h): when not empty, each
   // evaluated photo's rendering is read from this folder instead of rendered
-  // here, and the viewer views are skipped (they are this program's renders).
+  // here (no mesh is built: mesh_triangles stays 0), and the viewer views
+  // are skipped (they are this program's renders).
   // Needs cameras without lens distortion (the undistorted workspace).
   std::string rendered_dir;
 

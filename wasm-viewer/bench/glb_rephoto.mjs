@@ -34,6 +34,12 @@ try {
 if (cameras.format !== 'casual3d-rephoto-cameras' || cameras.version !== 1 || !Array.isArray(cameras.cameras)) {
   fail(`${camerasFile}: not a cameras file of \`casual3d evaluate --write-cameras\` (format casual3d-rephoto-cameras, version 1)`);
 }
+for (const c of cameras.cameras) {
+  if (!(c.width > 0 && c.height > 0) || c.view_matrix?.length !== 16 || c.projection_matrix?.length !== 16 ||
+      typeof c.image !== 'string' || c.image.includes('/') || c.image.includes('..')) {
+    fail(`${camerasFile}: camera ${JSON.stringify(c.name)} is malformed (write it again with casual3d evaluate --write-cameras)`);
+  }
+}
 fs.mkdirSync(out, { recursive: true });
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -91,10 +97,6 @@ try {
   const triangles = await tab.evaluate(() => window.ready);
   const t0 = performance.now();
   for (const c of cameras.cameras) {
-    if (!(c.width > 0 && c.height > 0) || c.view_matrix?.length !== 16 || c.projection_matrix?.length !== 16 ||
-        typeof c.image !== 'string' || c.image.includes('/') || c.image.includes('..')) {
-      fail(`${camerasFile}: camera ${JSON.stringify(c.name)} is malformed`);
-    }
     const url = await tab.evaluate((cam) => window.renderView(cam), c);
     const file = path.join(out, c.image);
     fs.writeFileSync(`${file}.tmp`, Buffer.from(url.slice(url.indexOf(',') + 1), 'base64'));
