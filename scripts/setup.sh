@@ -15,7 +15,7 @@ packages=(
   # toolchain
   build-essential cmake ninja-build pkg-config ccache dpkg-dev time
   # format/ and encoder/
-  libwebp-dev libopenexr-dev libdraco-dev libtinygltf-dev libmeshoptimizer-dev nlohmann-json3-dev
+  libwebp-dev libopenexr-dev libdraco-dev libtinygltf-dev nlohmann-json3-dev
   # reconstruct/
   colmap libsqlite3-dev libopencv-dev libeigen3-dev libmaxflow-dev libjpeg-dev libpng-dev libexif-dev
   # reconstruct/: HEIC photos (libheif; heif-enc for tests) and video (ffmpeg for tests)
