@@ -85,9 +85,8 @@ struct GltfExportOptions {
   int draco_normal_bits = 10;
   int draco_texcoord_bits = 14;
   // Draco compression level, 0..10 (Draco's encoding speed is 10 - level).
-  // Higher levels try costlier predictors, which do not always pay off: on the
-  // 4096x2048 synthetic panorama's simplified mesh (990k triangles), level 6
-  // gave 1.16 MB, level 4 1.33 MB, level 7 1.82 MB and level 10 1.78 MB.
+  // Higher levels try costlier predictors, which do not always give a
+  // smaller mesh (docs/DECISIONS.md, "GLB export: Draco compression level").
   int draco_compression_level = 6;
 
   // Returns InvalidArgument naming the first field out of range.

@@ -45,7 +45,7 @@ struct PackageOptions {
 
 // The settings for web delivery of reconstructed 3D photos, used by
 // `casual3d encode` and `casual3d reconstruct` (docs/PERFORMANCE.md, "Package
-// size"; docs/DECISIONS.md, "Delivery budget"): PackageOptions' defaults but
+// size of reconstructions"; docs/DECISIONS.md, "Delivery budget"): PackageOptions' defaults but
 // 5-bit normals (angular error at most 8.1 degrees, about 2.6 on average
 // against 8 bits on reconstructions, whose normals are noisier than that),
 // 10-bit depth (relative error at most exp(ln(far_m / near_m) / 2046) - 1:

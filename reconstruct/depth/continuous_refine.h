@@ -33,10 +33,9 @@
 namespace casual3d::depth {
 
 struct ContinuousRefineOptions {
-  // Off by default: on the default synthetic capture it moved no accuracy
-  // figure (within 3%: 63.76% -> 63.79%) for 2.9 s per photo
-  // (docs/PERFORMANCE.md); on toy planes it pays off at wide baselines
-  // (3.3 px per label: median error 0.081 -> 0.023 labels).
+  // Off by default: the search costs a ZNCC evaluation per step and
+  // neighbour at every pixel (docs/DECISIONS.md, "Dense: continuous search
+  // around each label").
   bool enabled = false;
   double search_labels = 1.0;  // Half-width of the search around the MRF label. (0, 4].
   double coarse_step = 0.25;   // Grid step of the first search, labels. (0, search_labels].

@@ -39,9 +39,9 @@ struct FullResRefineOptions {
   bool enabled = true;
   int window_radius = 5;             // Full-resolution pixels. [1, 15].
   double search_labels = 1.0;        // Half-width of the search, sweep label steps. (0, 8].
-  // Offsets over the search range (odd). [3, 65]. 7 against 9 on the
-  // synthetic capture: median error 0.496% / 0.493%, within 3% 87.06% /
-  // 87.12%, and 0.98 of the stage's time (docs/PERFORMANCE.md).
+  // Depths tried, evenly spaced over +-search_labels (odd, so that the
+  // current depth is one of them; docs/DECISIONS.md, "Dense: full-resolution
+  // search with 7 offsets"). [3, 65].
   int steps = 7;
   int best_k = 3;                    // Neighbours averaged per pixel. [1, 16].
   double occlusion_truncation = 0.4; // As the sweep's. [0, 1].
@@ -75,9 +75,11 @@ struct FullResRefineOptions {
 // side's depth outwards.
 struct BoundaryRelabelOptions {
   bool enabled = true;
-  // Full-resolution pixels. 20: the working resolution's fattening (the
-  // sweep's 5x5 window and the edge median's radius, doubled) plus the
-  // upsampling's. [1, 32].
+  // Full-resolution pixels: how far the working resolution's fattening
+  // (the sweep's window radius plus the edge median's radius, doubled for the
+  // working scale of 0.5) and the upsampling's reach. 20 was set with the
+  // earlier 5x5 window (2 + 8, doubled); with the 7x7 window the sum is 22.
+  // [1, 32].
   int radius = 20;
   // The window: the pixels at multiples of window_step from the centre (both
   // ways, the centre included) within window_radius of it. 6 and 2 (49

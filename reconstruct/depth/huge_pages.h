@@ -5,8 +5,8 @@
 // request (/sys/kernel/mm/transparent_hugepage/enabled = madvise, Debian's
 // default). A fresh allocation is zero-filled by the kernel on first touch,
 // and doing that through 4 KiB page faults took about 30% of the dense
-// stage's CPU time on a virtual machine (docs/PERFORMANCE.md, "Textureless
-// regions, full-resolution refinement, huge pages"); 2 MiB pages need 512
+// stage's CPU time on a virtual machine (docs/DECISIONS.md, "Dense: huge
+// pages and reused buffers"); 2 MiB pages need 512
 // times fewer faults. This holds for any caller of the library; the casual3d
 // program also sets glibc's malloc.hugetlb tunable (cli/main.cc), which
 // covers the smaller buffers too. Elsewhere (or when the kernel refuses)

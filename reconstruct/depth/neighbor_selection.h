@@ -22,7 +22,7 @@
 // follow by score. The first coverage_k picks are the best-scoring views. At
 // the ends of a partial rig the highest-scoring views all lie on one side,
 // and the plain score leaves the other side of the frame with one partner or
-// none (docs/PERFORMANCE.md, "Neighbour coverage and observable pixels").
+// none (docs/DECISIONS.md, "Dense: neighbours picked for coverage").
 
 #include <vector>
 
@@ -38,11 +38,9 @@ struct NeighborOptions {
   double max_angle_deg = 45.0;    // Median angle above which patches differ too much. (0, 180].
   int min_shared_points = 10;     // Shared sparse points for a ranked pair. [1, 1e6].
   // Partners each point should have before the next pick may favour the
-  // points already covered; 0 = rank by the plain score alone. 3 rather than
-  // the sweep's best_k of 2: with 6 swept neighbours on the default synthetic
-  // capture, 0 / 2 / 3 gave within 3% 69.8 / 71.5 / 70.9% and near floaters
-  // 5.08 / 5.27 / 4.91%; fern's held-out views 20.80 / 20.94 / 20.95 dB
-  // (docs/PERFORMANCE.md, "Neighbour coverage and observable pixels"). [0, 16].
+  // points already covered; 0 = rank by the plain score alone. One more than
+  // the sweep's best_k of 2 (measurements: docs/DECISIONS.md, "Dense:
+  // neighbours picked for coverage"). [0, 16].
   int coverage_k = 3;
   // Picks made greedily for coverage; later ranks go by score. [1, 64].
   int coverage_picks = 16;

@@ -38,20 +38,18 @@ namespace casual3d::depth {
 
 struct SweepOptions {
   int num_depths = 220;         // Sec. 4.3.1: depth hypotheses. Range [2, 4096].
-  // ZNCC window radius at working resolution, pixels. 3 (7x7): on fern's
-  // held-out views 2 (5x5) lost 0.43 dB, although on the synthetic capture it
-  // fattens near objects by one pixel less. [1, 15].
+  // ZNCC window radius at working resolution, pixels: a (2r + 1)^2 window.
+  // A smaller window fattens near objects less but matches less reliably
+  // (docs/DECISIONS.md, "Dense: 7x7 ZNCC window"). [1, 15].
   int window_radius = 3;
   int best_k = 2;               // Neighbours averaged per pixel (best costs first). [1, 16].
   // Each of the best_k costs is capped at the best one's plus this before
   // the mean: a neighbour that sees the best neighbour's surface hidden (an
   // occluder in front of it, the far side of a partial rig) counts as a
   // fixed penalty rather than as its full cost, whose noise would pick the
-  // label. 1 = the plain mean. On the default synthetic capture 1 / 0.4 /
-  // 0.2 / 0.1 / 0 gave within 3% 70.9 / 72.0 / 72.1 / 72.0 / 69.2% and near
-  // floaters 4.91 / 4.61 / 4.48 / 4.40 / 4.44%; on fern's held-out views
-  // 1 / 0.4 / 0.2 gave 20.95 / 20.95 / 20.79 dB (docs/PERFORMANCE.md,
-  // "Occlusion truncation"). [0, 1].
+  // label. In cost units (min(1, 1 - ZNCC), in [0, 1]): 1 = the plain mean,
+  // 0 = the best neighbour's cost alone (measurements: docs/DECISIONS.md,
+  // "Dense: occlusion truncation"). [0, 1].
   double occlusion_truncation = 0.4;
   double ncc_epsilon = 2.5e-5;  // Variance added to both windows (intensity^2); damps ZNCC of
                                 // flat, noisy windows towards 0. [0, 1].

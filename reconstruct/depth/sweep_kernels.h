@@ -8,8 +8,8 @@
 // loops that GCC and Clang vectorise, compiled for AVX2 too where GCC offers
 // it (avx2_clones.h). Results do not depend on the code path: every lane
 // computes the same IEEE float expression, in the same order, as the scalar
-// fallback. (An AVX2 warp with gathers was slower than the SSE2 one with
-// scalar corner loads: 1.06 of its time, docs/PERFORMANCE.md.)
+// fallback. (The warp stays SSE2 with scalar corner loads: docs/DECISIONS.md,
+// "Dense: loops that vectorise".)
 
 #include <algorithm>
 #include <cstddef>

@@ -10,7 +10,7 @@
 // envelope and the MRF is mostly of this kind: background in narrow
 // textureless gaps beside near objects, and blank strips at the image border,
 // which took a near object's depth where the reference photo alone cannot
-// tell (docs/PERFORMANCE.md, "Free-space check"). The other photos saw those
+// tell (docs/DECISIONS.md, "Dense: free-space check"). The other photos saw those
 // surfaces from elsewhere, often where they carry texture or a prior.
 //
 // A pixel is flagged when at least `min_violations` views see through it and
@@ -31,9 +31,8 @@
 // view at that depth,
 // against the window's own (mean absolute difference), averaged over the
 // better half of the views (the others may see an occluder), may not exceed
-// the same at the current depth by more than photo_margin. On the
-// default synthetic capture this keeps 40% of the wrong moves and loses 5%
-// of the right ones (docs/PERFORMANCE.md, "Free-space check").
+// the same at the current depth by more than photo_margin (how many wrong
+// and right moves it keeps: docs/DECISIONS.md, "Dense: free-space check").
 
 #include <vector>
 
@@ -46,12 +45,8 @@ namespace casual3d::depth {
 struct VisibilityFilterOptions {
   bool enabled = true;
   // Band of agreement in inverse depth around a depth z: the larger of
-  // tolerance / z (relative) and tolerance_labels label steps. A floor of a
-  // label, meant to spare far content whose depth is known only to about a
-  // label, left more near floaters (0.46% against 0.40%) and fewer pixels
-  // within 3% (87.4% against 88.8%) on the default synthetic capture, and
-  // fern's held-out views no better (docs/PERFORMANCE.md, "Free-space
-  // check"). (0, 1], [0, 100].
+  // tolerance / z (relative) and tolerance_labels label steps; 0 labels =
+  // no floor (docs/DECISIONS.md, "Dense: free-space check"). (0, 1], [0, 100].
   double tolerance = 0.03;
   double tolerance_labels = 0.0;
   int min_violations = 2;      // Views that must see through a point. [1, 255].

@@ -36,10 +36,9 @@ struct FuseOptions {
   // Sec. 4.4.3 uses 0.75 at 8192 px; at that ratio, edges of up to 33% in
   // depth (a tree 10 m in front of a wall at 12 m) would be closed and get no
   // back layer, so ratios below 0.95 link only where the surface is smooth
-  // (tau_grazing). 0.95 rather than 0.9: a reconstructed edge whose two depths
-  // are each a few percent off can reach a ratio above 0.9; on the synthetic
-  // sphere capture 47 of 8284 front links crossed a true depth edge of more
-  // than 10% with 0.9, 1 with 0.95 (docs/RESULTS.md, "Depth-ratio threshold").
+  // (tau_grazing). Above 0.9 because a reconstructed edge whose two depths
+  // are each a few percent off can reach a ratio above 0.9 (measurements:
+  // docs/DECISIONS.md, "Fusion: depth-ratio threshold 0.95").
   double tau_dratio = 0.95;
   // Neighbours whose depth ratio lies in (tau_grazing, tau_dratio] are linked
   // when the depths continue smoothly along the grid axis (a surface seen at a

@@ -43,9 +43,10 @@ struct WarpOptions {
   // min / max below this span a depth edge of the photo: they are not drawn,
   // so that no ramp of made-up depths between the two sides (a rubber sheet)
   // reaches the panorama; the gap is filled by other photos, the gap filling
-  // and the back layer. [0, 1); 0 draws every triangle. 0.9: on the demo
-  // capture it halves the stretched fill seen from the viewing volume's
-  // boundary against 0.75 (docs/DECISIONS.md, "Warp across depth edges").
+  // and the back layer. [0, 1); 0 draws every triangle. At 0.9 a floor
+  // keeps its triangles down to about 0.6 degrees of grazing (adjacent
+  // photo pixels 1 mrad apart); measurements: docs/DECISIONS.md, "Warp: no
+  // triangles across a photo's depth edges".
   double min_edge_depth_ratio = 0.9;
 
   // Returns an empty string if valid, else "field value: reason".
