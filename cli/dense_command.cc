@@ -1,5 +1,6 @@
 // `casual3d dense <workspace> -o <out>`: the dense stage (Sec. 4.3), a depth
-// map, confidence and near envelope per photo. See reconstruct/depth/dense_stage.h.
+// map, confidence and near envelope per photo. See reconstruct/depth/dense_stage.h;
+// with --pass, one unit of it (reconstruct/depth/dense_units.h).
 
 #include <cstdio>
 #include <stdexcept>
@@ -7,6 +8,7 @@
 
 #include "cli/command.h"
 #include "reconstruct/depth/dense_stage.h"
+#include "reconstruct/depth/dense_units.h"
 #include "reconstruct/util/log.h"
 
 namespace casual3d::cli {
@@ -22,8 +24,35 @@ struct DenseCommandOptions {
   bool no_relabel = false;
   bool no_fullres_refine = false;
   bool no_free_space_check = false;
+  std::string pass;    // Empty: the whole stage.
+  std::string photos;  // With --pass sweep or depth; empty: all.
   depth::DenseOptions dense;
 };
+
+void PrintReport(const depth::DenseReport& report, const std::string& out);
+
+// One unit of the stage (--pass).
+void RunUnit(const DenseCommandOptions& o, const depth::DenseOptions& opt) {
+  depth::DensePass pass;
+  if (!depth::DensePassFromName(o.pass, &pass))
+    throw std::invalid_argument("--pass " + o.pass + ": not a pass (plan, sweep, depth, finish)");
+  if (!o.photos.empty() && pass != depth::DensePass::kSweep && pass != depth::DensePass::kDepth)
+    throw std::invalid_argument("--photos applies to --pass sweep and --pass depth only");
+  const std::vector<int> photos = o.photos.empty() ? std::vector<int>() : depth::ParsePhotoList(o.photos);
+  const depth::DenseUnitResult r = depth::RunDenseUnit(o.workspace, o.out, opt, pass, photos);
+  switch (pass) {
+    case depth::DensePass::kPlan:
+      for (size_t i = 0; i < r.photos.size(); ++i) std::printf("%zu\t%s\n", i, r.photos[i].c_str());
+      break;
+    case depth::DensePass::kSweep:
+    case depth::DensePass::kDepth:
+      std::printf("dense: %s pass: %d photos done, %d already done\n", o.pass.c_str(), r.ran, r.skipped);
+      break;
+    case depth::DensePass::kFinish:
+      PrintReport(r.report, o.out);
+      break;
+  }
+}
 
 void RunDense(const DenseCommandOptions& o) {
   depth::DenseOptions opt = o.dense;
@@ -36,9 +65,16 @@ void RunDense(const DenseCommandOptions& o) {
   opt.visibility.enabled = !o.no_free_space_check;
   const Status st = opt.Check();
   if (!st.ok()) throw std::invalid_argument("dense: " + st.message());
-  const depth::DenseReport report = depth::RunDenseStage(o.workspace, o.out, opt);
+  if (!o.pass.empty()) {
+    RunUnit(o, opt);
+    return;
+  }
+  PrintReport(depth::RunDenseStage(o.workspace, o.out, opt), o.out);
+}
+
+void PrintReport(const depth::DenseReport& report, const std::string& out) {
   std::printf("dense: %zu depth maps in %s (%.1f s, peak memory %.0f MB)\n", report.photos.size(),
-              o.out.c_str(), report.seconds_total, report.peak_rss_bytes / 1048576.0);
+              out.c_str(), report.seconds_total, report.peak_rss_bytes / 1048576.0);
   std::printf("dense: cross-view consistency (depth within 2%% of >= 2 other views): %.1f%%\n",
               100 * report.cross_view_consistency);
   if (report.evaluated) {
@@ -135,6 +171,12 @@ void AddDenseCommand(CLI::App& app) {
                   "Neighbours are picked so that each part of the photo has this many partners "
                   "(0: by score alone)")
       ->capture_default_str();
+  cmd->add_option("--pass", opts->pass,
+                  "Run one unit of the stage over a shared OUT, for several processes or machines: "
+                  "plan (list the photos), sweep, depth (per photo, see --photos), finish (all "
+                  "photos); all units give the same files as one run without --pass");
+  cmd->add_option("--photos", opts->photos,
+                  "With --pass sweep or depth: the photos, by index in the plan, e.g. 0,3,5-9 (default: all)");
   cmd->add_option("--ground-truth", opts->dense.ground_truth_dir,
                   "Folder of ground-truth depth <stem>.exr (e.g. a synthetic capture's depth/) "
                   "to evaluate against; results go to dense.json");

@@ -1,0 +1,268 @@
+#include "reconstruct/depth/dense_units.h"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <filesystem>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "reconstruct/depth/dense_passes.h"
+#include "reconstruct/depth/dense_report.h"
+#include "reconstruct/io/exr_io.h"
+#include "reconstruct/io/file_util.h"
+
+namespace casual3d::depth {
+namespace fs = std::filesystem;
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// OUT/.dense-units/ and its files.
+struct UnitFolder {
+  fs::path root;
+  std::string Path(const char* sub, const std::string& stem, const char* ext) const {
+    return (root / sub / (stem + ext)).string();
+  }
+  std::string Dir(const char* sub) const { return (root / sub).string(); }
+};
+
+// What shapes the intermediate files: the photos and their sweeps.
+nlohmann::json PlanRecord(const DensePlan& plan, const DenseOptions& options) {
+  nlohmann::json j;
+  j["format"] = "casual3d-dense-units";
+  j["version"] = "1.0";
+  for (const DenseView& v : plan.ws.views) j["photos"].push_back(v.name);
+  j["num_labels"] = plan.num_labels;
+  j["working_scale"] = options.working_scale;
+  j["num_depths"] = options.sweep.num_depths;
+  j["num_neighbors"] = options.num_neighbors;
+  j["min_far_over_near"] = options.min_far_over_near;
+  j["use_gc_filter"] = options.use_gc_filter;
+  j["gc_max_views"] = options.gc.max_views;
+  return j;
+}
+
+// Writes plan.json, or checks that the one there matches.
+void CheckOrWritePlan(const UnitFolder& units, const DensePlan& plan, const DenseOptions& options) {
+  const std::string path = (units.root / "plan.json").string();
+  const nlohmann::json record = PlanRecord(plan, options);
+  std::error_code ec;
+  if (fs::exists(path, ec)) {
+    nlohmann::json previous;
+    try {
+      previous = nlohmann::json::parse(io::ReadFile(path));
+    } catch (const nlohmann::json::exception&) {
+      previous = nullptr;
+    }
+    if (previous != record)
+      throw std::runtime_error(path + ": made from other photos or with other options than this unit's; "
+                               "give every unit the same workspace and options, or remove " +
+                               units.root.string() + " to start afresh");
+    return;
+  }
+  io::WriteFileAtomic(path, record.dump(2) + "\n");
+}
+
+std::string MissingUnitMessage(const DensePlan& plan, int i, const char* pass, const UnitFolder& units) {
+  return "photo " + std::to_string(i) + " (" + plan.ws.views[i].name + ") has no " + pass + " result in " +
+         units.root.string() + "; run `casual3d dense ... --pass " + pass + " --photos " + std::to_string(i) +
+         "` first";
+}
+
+// Photo i's sweep record: its volume's sizes and depth grid, and the time taken.
+CostVolume ReadSweepRecord(const DensePlan& plan, int i, const UnitFolder& units, double* seconds) {
+  const std::string path = units.Path("sweep", OutputStem(plan.ws.views[i].name), ".json");
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw std::runtime_error(MissingUnitMessage(plan, i, "sweep", units));
+  const nlohmann::json j = nlohmann::json::parse(io::ReadFile(path));
+  CostVolume shell;
+  shell.width = j.at("width").get<int>();
+  shell.height = j.at("height").get<int>();
+  shell.num_labels = j.at("num_labels").get<int>();
+  shell.inv_near = j.at("inv_near").get<double>();
+  shell.inv_far = j.at("inv_far").get<double>();
+  if (seconds) *seconds = j.at("seconds").get<double>();
+  return shell;
+}
+
+void SweepUnit(const DensePlan& plan, const DenseOptions& options, const UnitFolder& units,
+               const std::vector<int>& todo, int outer, int inner) {
+  BufferPool pool(3);
+  ForEachPhoto(plan, todo, outer, [&](int i) {
+    const auto t0 = Clock::now();
+    const std::string stem = OutputStem(plan.ws.views[i].name);
+    ImageF wta;
+    const CostVolume shell = SweepPhoto(plan, i, options, inner, units.Path("cost", stem, ".cost"), &pool, &wta);
+    io::ExrWriteOptions plain;
+    plain.compression = io::ExrCompression::kNone;
+    io::WriteExr(units.Path("wta", stem, ".exr"), wta, {"Z"}, plain);
+    const nlohmann::json record = {{"width", shell.width},       {"height", shell.height},
+                                   {"num_labels", shell.num_labels}, {"inv_near", shell.inv_near},
+                                   {"inv_far", shell.inv_far},   {"seconds", Since(t0)}};
+    io::WriteFileAtomic(units.Path("sweep", stem, ".json"), record.dump(2) + "\n");
+  });
+}
+
+void DepthUnit(const DensePlan& plan, const DenseOptions& options, const UnitFolder& units,
+               const std::string& out_dir, const std::vector<int>& todo, int outer, int inner) {
+  BufferPool pool(3);
+  ForEachPhoto(plan, todo, outer, [&](int i) {
+    const std::string stem = OutputStem(plan.ws.views[i].name);
+    PhotoReport pr = PhotoHeader(plan, i);
+    const CostVolume shell = ReadSweepRecord(plan, i, units, &pr.t_sweep);
+    // The WTA maps the GC filter reads: this photo's and its first
+    // max_views ranked neighbours' (gc_filter.h).
+    std::vector<ImageF> wta(plan.size());
+    std::vector<const ImageF*> wta_ptrs(plan.size());
+    std::vector<int> needed = {i};
+    if (options.use_gc_filter)
+      for (int j : plan.ws.ranked_neighbors[i])
+        if (j != i && static_cast<int>(needed.size()) <= options.gc.max_views) needed.push_back(j);
+    for (int j : needed) {
+      ReadSweepRecord(plan, j, units, nullptr);
+      wta[j] = ReadDepthMap(units.Dir("wta"), OutputStem(plan.ws.views[j].name));
+    }
+    for (int j = 0; j < plan.size(); ++j) wta_ptrs[j] = &wta[j];
+    const ImageF ground_truth =
+        options.ground_truth_dir.empty() ? ImageF() : ReadDepthMap(options.ground_truth_dir, stem);
+    const ImageF depth = DepthPhoto(plan, i, options, inner, wta_ptrs, shell, units.Path("cost", stem, ".cost"),
+                                    ground_truth, out_dir, &pool, &pr);
+    io::ExrWriteOptions plain;
+    plain.compression = io::ExrCompression::kNone;
+    io::WriteExr(units.Path("depth", stem, ".exr"), depth, {"Z"}, plain);
+    io::WriteFileAtomic(units.Path("depth", stem, ".json"), PhotoReportToJson(pr).dump(2) + "\n");
+  });
+}
+
+DenseReport FinishUnit(const DensePlan& plan, const DenseOptions& options, const UnitFolder& units,
+                       const std::string& out_dir, Clock::time_point start, double seconds_load) {
+  const int n = plan.size();
+  std::vector<int> missing;
+  for (int i = 0; i < n; ++i) {
+    std::error_code ec;
+    if (!fs::exists(units.Path("depth", OutputStem(plan.ws.views[i].name), ".json"), ec)) missing.push_back(i);
+  }
+  if (!missing.empty()) {
+    std::string list;
+    for (int i : missing) list += (list.empty() ? "" : ",") + std::to_string(i);
+    throw std::runtime_error(units.root.string() + ": " + std::to_string(missing.size()) + " of " +
+                             std::to_string(n) + " photos have no depth result (photos " + list +
+                             "); run `casual3d dense ... --pass depth --photos " + list + "` first");
+  }
+  std::vector<ImageF> depth(n), ground_truth(n);
+  std::vector<PhotoReport> photos(n);
+  std::vector<CostVolume> shells(n);
+  for (int i = 0; i < n; ++i) {
+    const std::string stem = OutputStem(plan.ws.views[i].name);
+    shells[i] = ReadSweepRecord(plan, i, units, nullptr);
+    depth[i] = ReadDepthMap(units.Dir("depth"), stem);
+    photos[i] = PhotoReportFromJson(nlohmann::json::parse(io::ReadFile(units.Path("depth", stem, ".json"))));
+    if (!options.ground_truth_dir.empty()) ground_truth[i] = ReadDepthMap(options.ground_truth_dir, stem);
+  }
+  DenseReport report = FinishDense(plan, options, std::move(depth), std::move(photos), shells, ground_truth,
+                                   out_dir, start, seconds_load);
+  // dense.json exists: the stage is complete and its intermediates are spent.
+  std::error_code ec;
+  fs::remove_all(units.root, ec);
+  return report;
+}
+
+}  // namespace
+
+bool DensePassFromName(const std::string& name, DensePass* pass) {
+  if (name == "plan") *pass = DensePass::kPlan;
+  else if (name == "sweep") *pass = DensePass::kSweep;
+  else if (name == "depth") *pass = DensePass::kDepth;
+  else if (name == "finish") *pass = DensePass::kFinish;
+  else return false;
+  return true;
+}
+
+std::vector<int> ParsePhotoList(const std::string& text) {
+  const auto bad = [&](const std::string& item) {
+    return std::invalid_argument("--photos " + text + ": '" + item +
+                                 "' is not an index or an increasing range (expected e.g. 0,3,5-9)");
+  };
+  // A whole string of digits as an int; false otherwise.
+  const auto parse = [](const std::string& s, int* value) {
+    const char* end = s.data() + s.size();
+    const auto r = std::from_chars(s.data(), end, *value);
+    return !s.empty() && r.ec == std::errc() && r.ptr == end && *value >= 0;
+  };
+  std::vector<int> out;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    const size_t comma = std::min(text.find(',', pos), text.size());
+    const std::string item = text.substr(pos, comma - pos);
+    const size_t dash = item.find('-');
+    int first = 0, last = 0;
+    if (!parse(item.substr(0, dash), &first)) throw bad(item);
+    last = first;
+    if (dash != std::string::npos && !parse(item.substr(dash + 1), &last)) throw bad(item);
+    if (last < first || last >= 1000000) throw bad(item);
+    for (int i = first; i <= last; ++i) out.push_back(i);
+    pos = comma + 1;
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string& out_dir,
+                             const DenseOptions& options, DensePass pass, const std::vector<int>& photos) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument(st.message());
+  if (!options.ground_truth_dir.empty() && !fs::is_directory(options.ground_truth_dir))
+    throw std::runtime_error(options.ground_truth_dir + ": ground-truth folder does not exist");
+  const auto start = Clock::now();
+  const DensePlan plan = PlanDense(workspace_dir, options);
+  const double seconds_load = Since(start);
+  const int n = plan.size();
+  for (int i : photos)
+    if (i >= n)
+      throw std::invalid_argument("--photos: no photo " + std::to_string(i) + " (the workspace has " +
+                                  std::to_string(n) + " photos, numbered 0-" + std::to_string(n - 1) + ")");
+
+  DenseUnitResult result;
+  for (const DenseView& v : plan.ws.views) result.photos.push_back(v.name);
+  const UnitFolder units{fs::path(out_dir) / ".dense-units"};
+  CreateDenseOutputFolders(out_dir, options);
+  for (const char* sub : {"cost", "wta", "sweep", "depth"}) io::CreateDirectories(units.Dir(sub));
+  CheckOrWritePlan(units, plan, options);
+  if (pass == DensePass::kPlan) return result;
+  if (pass == DensePass::kFinish) {
+    result.report = FinishUnit(plan, options, units, out_dir, start, seconds_load);
+    result.ran = n;
+    return result;
+  }
+
+  // The photos of this unit not yet done: their record is written last.
+  const char* sub = pass == DensePass::kSweep ? "sweep" : "depth";
+  std::vector<int> todo;
+  for (int i : photos.empty() ? AllPhotos(n) : photos) {
+    std::error_code ec;
+    if (fs::exists(units.Path(sub, OutputStem(plan.ws.views[i].name), ".json"), ec)) {
+      ++result.skipped;
+    } else {
+      todo.push_back(i);
+    }
+  }
+  result.ran = static_cast<int>(todo.size());
+  if (todo.empty()) return result;
+  const int threads = ResolveThreads(options.num_threads);
+  const int outer = std::min<int>(threads, static_cast<int>(todo.size()));
+  const int inner = std::max(1, threads / outer);
+  if (pass == DensePass::kSweep) {
+    SweepUnit(plan, options, units, todo, outer, inner);
+  } else {
+    DepthUnit(plan, options, units, out_dir, todo, outer, inner);
+  }
+  return result;
+}
+
+}  // namespace casual3d::depth
