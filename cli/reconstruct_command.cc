@@ -91,11 +91,13 @@ void AddReconstructCommand(CLI::App& app) {
     options.panorama.pano_width = args->pano_width;
     options.panorama.back_layer = !args->front_only;
     if (args->no_gc_filter) options.panorama.stitch.lambda_gc = 0.0;
-    options.finish_web_package = [](const std::string& web_dir) {
+    options.finish_web_package = [](const std::string& web_dir,
+                                    const std::vector<std::string>& capture_advice) {
       // As `casual3d encode`: without a built viewer the package is still
-      // complete and valid; say how to get the page.
+      // complete and valid; say how to get the page. The page's info panel
+      // shows the capture's advice.
       try {
-        WriteViewerPage(web_dir);
+        WriteViewerPage(web_dir, capture_advice);
       } catch (const std::exception& e) {
         util::LogWarning(std::string(e.what()) + "; wrote the package without index.html");
       }
@@ -107,6 +109,8 @@ void AddReconstructCommand(CLI::App& app) {
                   run.ran ? (std::to_string(run.seconds).substr(0, 6) + " s").c_str()
                           : (run.cached ? "cached" : "skipped"));
     }
+    // The capture's description (its warnings were logged as they came).
+    if (!report.capture_advice.empty()) std::printf("capture: %s\n", report.capture_advice[0].c_str());
     if (!report.web_dir.empty()) {
       std::printf("wrote the 3D photo to %s (total %.1f s)\nview it with: casual3d view %s\n",
                   report.web_dir.c_str(), report.seconds_total, report.web_dir.c_str());

@@ -16,12 +16,13 @@ void AddSynthCommand(CLI::App& app) {
   auto out_dir = std::make_shared<std::string>("capture");
   CLI::App* cmd = app.add_subcommand(
       "synth", "Render a synthetic capture (photos, COLMAP model, depth, ground-truth panorama)");
-  cmd->add_option("--rig", *rig_name, "Capture rig: partial (phone, 4x4 grid) or sphere (DSLR, 2 rings)")
+  cmd->add_option("--rig", *rig_name, "Capture rig: partial (phone, 4x4 grid), sphere (DSLR, 2 rings) or walk-around (12 photos "
+                 "on a 90-degree arc around a subject 1.3 m ahead: a capture 3D photos are not made from)")
       ->capture_default_str();
   cmd->add_option("-o,--output", *out_dir, "Capture folder to write")->capture_default_str();
   cmd->add_option("--width", options->width, "Photo width in pixels (default: 1152)");
   cmd->add_option("--height", options->height, "Photo height in pixels (default: width * 3 / 4)");
-  cmd->add_option("--photos", options->num_photos, "Number of photos (default: partial 16, sphere 50)");
+  cmd->add_option("--photos", options->num_photos, "Number of photos (default: partial 16, sphere 50, walk-around 12)");
   cmd->add_option("--noise", options->noise_sigma, "Sensor noise sigma, 8-bit code values")
       ->capture_default_str();
   cmd->add_option("--exposure-jitter", options->exposure_jitter_stops,
@@ -39,7 +40,7 @@ void AddSynthCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->callback([options, rig_name, out_dir] {
     if (!synth::RigKindFromName(*rig_name, &options->rig)) {
-      throw std::invalid_argument("--rig '" + *rig_name + "' is not partial or sphere");
+      throw std::invalid_argument("--rig '" + *rig_name + "' is not partial, sphere or walk-around");
     }
     if (std::string why = options->Check(); !why.empty()) throw std::invalid_argument(why);
     const synth::CaptureSummary s = synth::GenerateCapture(*options, *out_dir);

@@ -88,9 +88,21 @@ fs::path FindViewerDir() {
                            searched + "; build the wasm-viewer target or set CASUAL3D_VIEWER_DIR");
 }
 
-std::string ViewerPageHtml(const std::string& title, const std::string& viewer_url_prefix) {
+std::string ViewerPageHtml(const std::string& title, const std::string& viewer_url_prefix,
+                           const std::vector<std::string>& capture_advice) {
   const std::string t = util::HtmlEscape(title);
   const std::string p = util::HtmlEscape(viewer_url_prefix);
+  // The capture's advice in the element's info slot: the page's own data,
+  // so the package format stays as it is.
+  std::string info;
+  if (!capture_advice.empty()) {
+    info = "<div slot=\"info\">\n<h2>About this capture</h2>\n";
+    for (size_t k = 0; k < capture_advice.size(); ++k)
+      info += std::string(k == 0 ? "<p>" : "<p class=\"warning\">") +
+              util::HtmlEscape(capture_advice[k]) + "</p>\n";
+    info += "</div>\n";
+  }
+  const std::string open = capture_advice.size() > 1 ? " info-open" : "";
   return "<!DOCTYPE html>\n"
          "<html lang=\"en\">\n"
          "<head>\n"
@@ -103,15 +115,20 @@ std::string ViewerPageHtml(const std::string& title, const std::string& viewer_u
          p + kViewerEntry +
          "\"></script>\n"
          "<style>html,body{margin:0;height:100%;background:#000}"
-         "casual3d-viewer{display:block;width:100%;height:100%}</style>\n"
+         "casual3d-viewer{display:block;width:100%;height:100%}" +
+         (info.empty() ? "" : "casual3d-viewer h2{font-size:14px;margin:0 0 6px}"
+                              "casual3d-viewer p{margin:0 0 6px}casual3d-viewer .warning{color:#ffd166}") +
+         "</style>\n"
          "</head>\n"
          "<body>\n"
-         "<casual3d-viewer src=\"manifest.json\" controls></casual3d-viewer>\n"
+         "<casual3d-viewer src=\"manifest.json\" controls" +
+         open + ">" + (info.empty() ? "" : "\n" + info) +
+         "</casual3d-viewer>\n"
          "</body>\n"
          "</html>\n";
 }
 
-void WriteViewerPage(const fs::path& package_dir) {
+void WriteViewerPage(const fs::path& package_dir, const std::vector<std::string>& capture_advice) {
   std::error_code ec;
   if (!fs::is_directory(package_dir, ec)) {
     throw std::runtime_error(package_dir.string() + ": not a folder; write the package first");
@@ -129,7 +146,7 @@ void WriteViewerPage(const fs::path& package_dir) {
   std::string title = fs::absolute(package_dir).lexically_normal().filename().string();
   if (title.empty())
     title = fs::absolute(package_dir).lexically_normal().parent_path().filename().string();
-  WriteFileAtomically(package_dir / "index.html", ViewerPageHtml(title + " - casual3d", "viewer/"));
+  WriteFileAtomically(package_dir / "index.html", ViewerPageHtml(title + " - casual3d", "viewer/", capture_advice));
 }
 
 }  // namespace casual3d::cli

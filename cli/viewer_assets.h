@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace casual3d::cli {
 
@@ -26,12 +27,18 @@ std::filesystem::path FindViewerDir();
 
 // The index.html of a package folder: one <casual3d-viewer> element showing
 // manifest.json, loading the viewer from `viewer_url_prefix` (e.g. "viewer/").
-std::string ViewerPageHtml(const std::string& title, const std::string& viewer_url_prefix);
+// `capture_advice` (pipeline::PipelineReport::capture_advice: a description,
+// then warnings), when not empty, fills the element's info panel ("About
+// this capture", its slot "info"), open at load when there are warnings.
+std::string ViewerPageHtml(const std::string& title, const std::string& viewer_url_prefix,
+                           const std::vector<std::string>& capture_advice = {});
 
 // Copies the viewer files into <package_dir>/viewer/ and writes
-// <package_dir>/index.html. Files are written under temporary names and renamed,
-// so an interrupted run never leaves a half-written file. Throws
-// std::runtime_error naming the file on failure (package_dir must exist).
-void WriteViewerPage(const std::filesystem::path& package_dir);
+// <package_dir>/index.html (with `capture_advice` as above). Files are written
+// under temporary names and renamed, so an interrupted run never leaves a
+// half-written file. Throws std::runtime_error naming the file on failure
+// (package_dir must exist).
+void WriteViewerPage(const std::filesystem::path& package_dir,
+                     const std::vector<std::string>& capture_advice = {});
 
 }  // namespace casual3d::cli

@@ -13,6 +13,7 @@
 #include "format/sha256.h"
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/io/file_util.h"
+#include "reconstruct/pipeline/capture_shape.h"
 #include "reconstruct/pipeline/holdout.h"
 #include "reconstruct/util/log.h"
 
@@ -253,8 +254,24 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
   PipelineReport report;
   nlohmann::json stage_json = nlohmann::json::object();
   std::optional<TwoLayerPanorama> fresh_panorama;  // Made by this run's panorama stage.
+  // The capture's shape and advice (capture_shape.h), once the sparse
+  // output is current; advice, not a requirement: a failure only warns.
+  nlohmann::json capture_json;
+  const auto measure_capture = [&] {
+    if (!fs::exists(dirs[0], ec) || ReadKey(key_paths[0]) != keys[0]) return;
+    try {
+      const CaptureShape shape = MeasureWorkspaceCaptureShape(dirs[0].string());
+      capture_json = CaptureShapeJson(shape);
+      report.capture_advice = shape.advice;
+      for (size_t k = 0; k < shape.advice.size(); ++k)
+        (k == 0 ? util::LogInfo : util::LogWarning)("capture: " + shape.advice[k]);
+    } catch (const std::exception& e) {
+      util::LogWarning(std::string("capture: not measured (") + e.what() + ")");
+    }
+  };
   for (int s = 0; s < kNumStages; ++s) {
     const Stage stage = static_cast<Stage>(s);
+    if (stage == Stage::kDense) measure_capture();
     StageRun run;
     run.stage = StageName(stage);
     const bool current = fs::exists(dirs[s], ec) && ReadKey(key_paths[s]) == keys[s];
@@ -348,7 +365,8 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
         fs::remove(key_paths[s], ec);
         Status st = encoder::WritePackageFolder(*files, dirs[s].string());
         if (!st.ok()) throw std::runtime_error(st.ToString());
-        if (options.finish_web_package) options.finish_web_package(dirs[s].string());
+        if (options.finish_web_package)
+          options.finish_web_package(dirs[s].string(), report.capture_advice);
         st = encoder::WritePackageSingleFile(*files, (root / "photo.c3d").string());
         if (!st.ok()) throw std::runtime_error(st.ToString());
         // The archival master and the previews next to the package.
@@ -406,6 +424,7 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
       stage_json[name] = previous["results"][name];
   }
   j["results"] = stage_json;
+  if (!capture_json.is_null()) j["capture"] = capture_json;
   // Files of the input the import left out (bad or duplicate), at the top level.
   if (stage_json.contains("sparse") && stage_json["sparse"].contains("skipped"))
     j["skipped"] = stage_json["sparse"]["skipped"];

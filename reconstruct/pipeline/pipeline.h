@@ -14,7 +14,8 @@
 //   OUT/preview/        stitched colour, depth, normals and labels as PNG
 //   OUT/report.json     timings and statistics of every stage, with the key of
 //                       its cache; a cached stage keeps the figures of the run
-//                       that computed it
+//                       that computed it; "capture": the capture's shape and
+//                       advice (capture_shape.h)
 //   OUT/work/{sparse,dense,panorama}/ and OUT/work/<stage>.key   stage caches
 
 #include <functional>
@@ -50,9 +51,12 @@ struct PipelineOptions {
   // report.json as "holdout"), for `casual3d evaluate`. [0, 1000]; 0 = none.
   int holdout_every = 0;
   int num_threads = 0; // 0 = all cores; passed to every stage.
-  // Called with OUT/web after the package is written there (the command-line
-  // program adds the viewer page and its files); may be empty.
-  std::function<void(const std::string& web_dir)> finish_web_package;
+  // Called with OUT/web after the package is written there, and the
+  // capture's advice (capture_shape.h; empty if not measured): the
+  // command-line program adds the viewer page, its files and an info panel
+  // with the advice; may be empty.
+  std::function<void(const std::string& web_dir, const std::vector<std::string>& capture_advice)>
+      finish_web_package;
 
   std::string Check() const;  // Empty if valid.
 };
@@ -69,6 +73,9 @@ struct PipelineReport {
   double seconds_total = 0.0;
   std::string web_dir;     // OUT/web, when the encode stage ran or was cached.
   uint64_t package_bytes = 0;
+  // The capture's shape in plain words (capture_shape.h), the description
+  // first; report.json's "capture" holds the measures.
+  std::vector<std::string> capture_advice;
 };
 
 // Runs the pipeline on `input` (a folder of photos or a COLMAP workspace) into

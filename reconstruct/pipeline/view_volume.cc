@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "format/equirect.h"
+#include "reconstruct/pipeline/capture_shape.h"
 #include "reconstruct/render/derived_view_hints.h"
 
 namespace casual3d::pipeline {
@@ -155,22 +156,21 @@ ViewHints ComputeViewHints(const TwoLayerPanorama& pano, const Image8& fov_mask,
   hints.metric = metric;
   ContentExtent(fov_mask, &hints);
 
-  // Frame rotation and centre.
+  // Frame rotation.
   Eigen::Matrix3d R;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) R(r, c) = frame.rotation[3 * r + c];
-  const Eigen::Vector3d centre(frame.centre[0], frame.centre[1], frame.centre[2]);
 
-  // Mean optical axis, median short-side field of view, camera spread.
+  // Mean optical axis, median short-side field of view, camera spread
+  // (capture_shape.h, where the capture's advice measures it too).
   Eigen::Vector3d axis_sum = Eigen::Vector3d::Zero();
   std::vector<double> fovs;
-  double spread = 0.0;
+  const double spread = CameraSpread(views, frame);
   for (const CoverageView& v : views) {
     const Eigen::Matrix3d Rwc = v.pose.R();  // World to camera.
     axis_sum += R * Rwc.row(2).transpose();
     const double short_fov = std::min(v.camera.FovXDeg(), v.camera.FovYDeg());
     if (std::isfinite(short_fov) && short_fov > 0) fovs.push_back(short_fov);
-    spread = std::max(spread, (R * (v.pose.Center() - centre)).norm());
   }
   double yaw = 0.5 * (hints.content_yaw_min_deg + hints.content_yaw_max_deg);
   double pitch = 0.5 * (hints.content_pitch_min_deg + hints.content_pitch_max_deg);

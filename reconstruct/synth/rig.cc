@@ -45,10 +45,24 @@ bool RigKindFromName(const std::string& name, RigKind* kind) {
     *kind = RigKind::kSphere;
     return true;
   }
+  if (name == "walk-around") {
+    *kind = RigKind::kWalkAround;
+    return true;
+  }
   return false;
 }
 
-const char* RigKindName(RigKind kind) { return kind == RigKind::kSphere ? "sphere" : "partial"; }
+const char* RigKindName(RigKind kind) {
+  switch (kind) {
+    case RigKind::kSphere:
+      return "sphere";
+    case RigKind::kWalkAround:
+      return "walk-around";
+    case RigKind::kPartial:
+      break;
+  }
+  return "partial";
+}
 
 RigOptions RigOptions::Defaults(RigKind kind) {
   RigOptions o;
@@ -56,6 +70,9 @@ RigOptions RigOptions::Defaults(RigKind kind) {
   if (kind == RigKind::kSphere) {
     o.num_photos = 50;
     o.fov_x_deg = 110.0;
+  } else if (kind == RigKind::kWalkAround) {
+    o.num_photos = 12;
+    o.yaw_span_deg = 90.0;
   }
   return o;
 }
@@ -75,6 +92,7 @@ std::string RigOptions::Check() const {
     return "pitch_span_deg must be in [0, 120]";
   }
   if (!(ring_pitch_deg >= 0.0 && ring_pitch_deg <= 60.0)) return "ring_pitch_deg must be in [0, 60]";
+  if (!(walk_distance_m >= 0.3 && walk_distance_m <= 20.0)) return "walk_distance_m must be in [0.3, 20]";
   if (!(jitter_deg >= 0.0 && jitter_deg <= 10.0)) return "jitter_deg must be in [0, 10]";
   if (!(jitter_m >= 0.0 && jitter_m <= 0.2)) return "jitter_m must be in [0, 0.2]";
   return "";
@@ -92,7 +110,13 @@ Rig MakeRig(const RigOptions& options, const Eigen::Vector3d& centre) {
   // Nominal viewing directions (yaw, pitch) in capture order.
   std::vector<std::pair<double, double>> directions;
   const int n = options.num_photos;
-  if (options.kind == RigKind::kPartial) {
+  if (options.kind == RigKind::kWalkAround) {
+    // Looking at the subject from the arc, left to right (positions below).
+    for (int i = 0; i < n; ++i) {
+      directions.emplace_back(n > 1 ? (static_cast<double>(i) / (n - 1) - 0.5) * options.yaw_span_deg : 0.0,
+                              0.0);
+    }
+  } else if (options.kind == RigKind::kPartial) {
     // A grid about as wide as tall (4 x 4 for 16 photos), swept row by row in
     // a serpentine as a person would.
     const int cols = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n)) - 1e-9)));
@@ -128,7 +152,11 @@ Rig MakeRig(const RigOptions& options, const Eigen::Vector3d& centre) {
     const Eigen::Vector3d forward = Direction(yaw + jr * normal(0), pitch + jr * normal(1));
     const Eigen::Vector3d offset =
         options.jitter_m * Eigen::Vector3d(normal(2), normal(3), normal(4));
-    const Eigen::Vector3d c = centre + options.radius_m * radial + offset;
+    // Turning rigs sit on a sphere around the centre, looking out; the
+    // walk-around one on the circle around the subject, looking in.
+    Eigen::Vector3d c = centre + options.radius_m * radial + offset;
+    if (options.kind == RigKind::kWalkAround)
+      c = centre + options.walk_distance_m * (Direction(0.0, 0.0) - radial) + offset;
     geometry::Pose pose = LookAlong(c, forward);
     // Roll about the optical axis (camera Z).
     const Eigen::Matrix3d roll =

@@ -9,7 +9,12 @@
 //   sphere: a DSLR turned on a monopod: two rings (pitched up and down by
 //     `ring_pitch_deg`) of photos all around, 110 degrees horizontal field of
 //     view by default, full 360 degree coverage.
-// Both add a small hand-held jitter (seeded) to every orientation and position.
+//   walk-around: what a 3D photo is not made from, for the capture advice: a
+//     person walking around a subject `walk_distance_m` ahead of the rig
+//     centre, on a circle of that radius through the rig centre, over
+//     `yaw_span_deg` (default 90 degrees) of it, each photo looking at the
+//     subject; 12 photos by default.
+// All add a small hand-held jitter (seeded) to every orientation and position.
 
 #include <cstdint>
 #include <string>
@@ -22,9 +27,9 @@
 
 namespace casual3d::synth {
 
-enum class RigKind { kPartial, kSphere };
+enum class RigKind { kPartial, kSphere, kWalkAround };
 
-// "partial" / "sphere"; false for anything else.
+// "partial" / "sphere" / "walk-around"; false for anything else.
 bool RigKindFromName(const std::string& name, RigKind* kind);
 const char* RigKindName(RigKind kind);
 
@@ -32,12 +37,13 @@ struct RigOptions {
   RigKind kind = RigKind::kPartial;
   int width = 1152;          // Photo width, pixels.
   int height = 864;          // Photo height, pixels.
-  int num_photos = 16;       // > 0; partial: 16 (4 x 4), sphere: 50 (2 x 25).
+  int num_photos = 16;       // > 0; partial: 16 (4 x 4), sphere: 50 (2 x 25), walk-around: 12.
   double fov_x_deg = 65.0;   // Horizontal field of view, degrees, (10, 150).
   double radius_m = 0.3;     // Camera centres' distance from the rig centre, metres, [0, 2].
-  double yaw_span_deg = 54.0;    // partial: yaw range of the grid, degrees.
+  double yaw_span_deg = 54.0;    // partial: yaw range of the grid; walk-around: of the arc; degrees.
   double pitch_span_deg = 36.0;  // partial: pitch range of the grid, degrees.
   double ring_pitch_deg = 22.0;  // sphere: pitch of the upper (+) and lower (-) ring, degrees.
+  double walk_distance_m = 1.3;  // walk-around: the subject's distance ahead, metres, [0.3, 20].
   double jitter_deg = 1.0;   // Hand-held rotation jitter (standard deviation), degrees.
   double jitter_m = 0.01;    // Hand-held position jitter (standard deviation), metres.
   uint64_t seed = 1;

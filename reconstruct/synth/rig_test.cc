@@ -61,6 +61,26 @@ TEST(RigTest, SphereRigSeesEveryHorizontalDirection) {
   }
 }
 
+TEST(RigTest, WalkAroundCirclesTheSubjectLookingAtIt) {
+  const RigOptions o = RigOptions::Defaults(RigKind::kWalkAround);
+  const Rig rig = MakeRig(o, Eigen::Vector3d::Zero());
+  ASSERT_EQ(rig.poses.size(), 12u);
+  const Eigen::Vector3d subject(0, 0, -1.3);
+  double extent = 0.0;
+  for (const geometry::Pose& p : rig.poses) {
+    EXPECT_NEAR((p.Center() - subject).norm(), 1.3, 0.05);
+    const Eigen::Vector3d axis = p.R().row(2).transpose();
+    EXPECT_GT(axis.dot((subject - p.Center()).normalized()), std::cos(4.0 / kRadToDeg));
+    extent = std::max(extent, (p.Center() - rig.poses[0].Center()).norm());
+  }
+  // The ends of a 90-degree arc of radius 1.3 m: 1.84 m apart.
+  EXPECT_NEAR(extent, 2 * 1.3 * std::sin(45.0 / kRadToDeg), 0.05);
+  RigKind kind;
+  EXPECT_TRUE(RigKindFromName("walk-around", &kind));
+  EXPECT_EQ(kind, RigKind::kWalkAround);
+  EXPECT_STREQ(RigKindName(kind), "walk-around");
+}
+
 TEST(RigTest, JitterIsSeededAndOptionsAreChecked) {
   RigOptions o = RigOptions::Defaults(RigKind::kPartial);
   const Rig a = MakeRig(o, Eigen::Vector3d::Zero());

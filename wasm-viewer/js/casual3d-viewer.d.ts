@@ -156,12 +156,17 @@ export class Casual3dViewer extends EventTarget {
     options?: boolean | AddEventListenerOptions): void;
 }
 
-/** <casual3d-viewer src="manifest.json" controls effects="lighting water object" yaw pitch fov max-level-width> */
+/** <casual3d-viewer src="manifest.json" controls info-open effects="lighting water object" yaw pitch fov max-level-width>;
+ * children with slot="info" fill the info panel. */
 export class Casual3dViewerElement extends HTMLElement {
   readonly viewer: Casual3dViewer | null;
   src: string;
   /** The error message on display, or ''. */
   readonly errorMessage: string;
+  /** The info panel's text while it shows, or ''. */
+  readonly infoText: string;
+  /** Shows (default) or hides the info panel; it shows only with children in slot "info". */
+  showInfo(show?: boolean): void;
   load(url?: string): Promise<void>;
   setCamera(camera: Partial<CameraState>): void;
   getCamera(): CameraState | undefined;

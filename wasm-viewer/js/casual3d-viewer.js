@@ -5,7 +5,9 @@
 //   <script type="module" src="viewer/casual3d-viewer.js"></script>
 //   <casual3d-viewer src="manifest.json" controls></casual3d-viewer>
 //
-// Attributes: src (manifest.json or .c3d URL), controls (show the toolbar), effects (any of
+// Attributes: src (manifest.json or .c3d URL), controls (show the toolbar), info-open (show the
+// info panel at load: the element's children in slot "info", e.g. the capture's advice that
+// `casual3d reconstruct` writes into index.html; an Info button toggles it), effects (any of
 // "lighting water object", space separated), yaw, pitch, fov (degrees; without
 // them a package opens framed on its captured content), max-level-width
 // (finest level loaded, pixels).
@@ -33,11 +35,15 @@ const STYLE = `
 .toolbar button { background: rgba(0,0,0,.55); color: #fff; border: 1px solid rgba(255,255,255,.35); border-radius: 4px;
   padding: 3px 8px; cursor: pointer; font: inherit; }
 .toolbar button[aria-pressed="true"] { background: rgba(78,161,255,.75); }
+.info { position: absolute; left: 8px; top: 8px; max-width: min(32em, calc(100% - 16px)); max-height: calc(100% - 60px);
+  overflow: auto; box-sizing: border-box; padding: 10px 30px 4px 12px; border-radius: 4px; background: rgba(0,0,0,.72); }
+.info[hidden] { display: none; }
+.info > button { position: absolute; right: 6px; top: 4px; background: none; border: 0; color: #fff; font-size: 16px; cursor: pointer; }
 `;
 
 export class Casual3dViewerElement extends HTMLElement {
   static get observedAttributes() {
-    return ['src', 'controls', 'effects', 'yaw', 'pitch', 'fov'];
+    return ['src', 'controls', 'info-open', 'effects', 'yaw', 'pitch', 'fov'];
   }
 
   constructor() {
@@ -48,12 +54,14 @@ export class Casual3dViewerElement extends HTMLElement {
       <div class="status" part="status" hidden></div>
       <div class="progress" part="progress" hidden><div></div></div>
       <div class="error" part="error" role="alert" hidden><button type="button" aria-label="Dismiss">×</button><span></span></div>
+      <div class="info" part="info" role="note" hidden><button type="button" aria-label="Close">×</button><slot name="info"></slot></div>
       <div class="toolbar" part="toolbar" hidden>
         <button type="button" data-effect="lighting" aria-pressed="false" title="Moving lights">Light</button>
         <button type="button" data-effect="water" aria-pressed="false" title="Rising water">Water</button>
         <button type="button" data-effect="object" aria-pressed="false" title="Inserted object">Object</button>
         <button type="button" data-action="motion" hidden title="Look around by moving the phone">Motion</button>
         <button type="button" data-action="vr" hidden title="Immersive VR">VR</button>
+        <button type="button" data-action="info" hidden aria-pressed="false" title="About this capture">Info</button>
         <button type="button" data-action="reset" title="Reset view (R)">Reset</button>
       </div>`;
     this._els = {
@@ -64,6 +72,9 @@ export class Casual3dViewerElement extends HTMLElement {
       error: root.querySelector('.error'),
       errorText: root.querySelector('.error span'),
       toolbar: root.querySelector('.toolbar'),
+      info: root.querySelector('.info'),
+      infoSlot: root.querySelector('slot[name="info"]'),
+      infoButton: root.querySelector('[data-action="info"]'),
     };
     this._viewer = null;
   }
@@ -100,6 +111,7 @@ export class Casual3dViewerElement extends HTMLElement {
     }
     this._bindToolbar();
     this._applyAttributes();
+    this.showInfo(this.hasAttribute('info-open'));
     // After the running script: a page that registered the element in the same
     // script may still call setAssetBase() or set src.
     queueMicrotask(() => {
@@ -115,6 +127,7 @@ export class Casual3dViewerElement extends HTMLElement {
   attributeChangedCallback(name, oldValue, newValue) {
     if (!this._viewer || oldValue === newValue) return;
     if (name === 'src') this._load();
+    else if (name === 'info-open') this.showInfo(newValue !== null);
     else this._applyAttributes();
   }
 
@@ -144,6 +157,22 @@ export class Casual3dViewerElement extends HTMLElement {
   /** See Casual3dViewer.getViewHints: null until the first level shows. */
   getViewHints() {
     return this._viewer?.getViewHints() ?? null;
+  }
+
+  /** Shows or hides the info panel (the children in slot "info"). */
+  showInfo(show = true) {
+    this._els.info.hidden = !(show && this._hasInfo());
+    this._els.infoButton.setAttribute('aria-pressed', String(!this._els.info.hidden));
+  }
+
+  /** The info panel's text while it shows, or '' (for tests and embedding pages). */
+  get infoText() {
+    if (this._els.info.hidden) return '';
+    return this._els.infoSlot.assignedElements().map((e) => e.innerText).join('\n');
+  }
+
+  _hasInfo() {
+    return this._els.infoSlot.assignedElements().length > 0;
   }
 
   setEffects(effects) {
@@ -190,6 +219,14 @@ export class Casual3dViewerElement extends HTMLElement {
       });
     }
     root.querySelector('[data-action="reset"]').addEventListener('click', () => this._viewer.resetView());
+    const els = this._els;
+    els.infoButton.hidden = !this._hasInfo();
+    els.infoSlot.addEventListener('slotchange', () => {
+      els.infoButton.hidden = !this._hasInfo();
+      this.showInfo(this._hasInfo() && (this.hasAttribute('info-open') || !els.info.hidden));
+    });
+    els.infoButton.addEventListener('click', () => this.showInfo(els.info.hidden));
+    els.info.querySelector('button').addEventListener('click', () => this.showInfo(false));
     const vr = root.querySelector('[data-action="vr"]');
     this._viewer.isVRSupported().then((ok) => { vr.hidden = !ok; });
     vr.addEventListener('click', () => this._viewer.enterVR().catch((err) => this._showError(err.message)));
