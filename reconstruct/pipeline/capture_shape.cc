@@ -338,6 +338,9 @@ CaptureShape MeasureWorkspaceCaptureShape(const std::string& sparse_dir,
   const PanoramaFrame frame = sfm::ReadPanoramaFrame((dir / "frame.json").string());
   std::vector<std::string> unregistered;
   std::error_code ec;
+  // Synthetic captures (capture.json) are in metres, also when the stage
+  // read one as a workspace; COLMAP's models of photos are not.
+  bool metric = fs::exists(dir / "capture.json", ec);
   const fs::path stage = dir / "stage.json";
   if (fs::exists(stage, ec)) {
     nlohmann::json j;
@@ -349,9 +352,9 @@ CaptureShape MeasureWorkspaceCaptureShape(const std::string& sparse_dir,
     if (j.contains("unregistered") && j["unregistered"].is_array())
       for (const auto& name : j["unregistered"])
         if (name.is_string()) unregistered.push_back(name.get<std::string>());
+    if (j.value("input_type", "") == "workspace" && j.contains("input") && j["input"].is_string())
+      metric = metric || fs::exists(fs::path(j["input"].get<std::string>()) / "capture.json", ec);
   }
-  // Synthetic captures (capture.json) are in metres; COLMAP's models are not.
-  const bool metric = fs::exists(dir / "capture.json", ec);
   return MeasureCaptureShape(model, frame, unregistered, metric, options);
 }
 

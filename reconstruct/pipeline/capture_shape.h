@@ -115,7 +115,8 @@ CaptureShape MeasureCaptureShape(const geometry::SparseModel& model, const Panor
                                  const CaptureShapeOptions& options = CaptureShapeOptions());
 
 // The same for a sparse stage output (spec/stage-sparse.md: sparse/,
-// frame.json, stage.json; capture.json marks a metric model). Throws
+// frame.json, stage.json; a capture.json in it or in the workspace it read
+// marks a metric model). Throws
 // std::runtime_error naming the file when one is missing or unreadable.
 CaptureShape MeasureWorkspaceCaptureShape(const std::string& sparse_dir,
                                           const CaptureShapeOptions& options = CaptureShapeOptions());
