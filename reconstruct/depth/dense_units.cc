@@ -166,9 +166,13 @@ DenseReport FinishUnit(const DensePlan& plan, const DenseOptions& options, const
   }
   DenseReport report = FinishDense(plan, options, std::move(depth), std::move(photos), shells, ground_truth,
                                    out_dir, start, seconds_load);
-  // dense.json exists: the stage is complete and its intermediates are spent.
+  // dense.json exists: the stage is complete and its intermediates are
+  // spent, as are the temporary files of units killed while writing.
   std::error_code ec;
   fs::remove_all(units.root, ec);
+  for (const char* sub : {"depth", "confidence", "envelope"})
+    for (const auto& e : fs::directory_iterator(fs::path(out_dir) / sub, ec))
+      if (e.path().filename().string().find(".tmp-") != std::string::npos) fs::remove(e.path(), ec);
   return report;
 }
 

@@ -1,0 +1,265 @@
+#!/usr/bin/python3
+"""Converts captures to 3D photos on a Dask distributed cluster.
+
+    casual3d_dask.py --scheduler tcp://HOST:8786 CAPTURE... -o OUT
+    casual3d_dask.py --scheduler-file sched.json --captures-in DIR -o OUT
+
+Each capture (a folder of photos, a video or a COLMAP workspace) becomes
+OUT/<name>/web/ (the package), OUT/<name>/photo.c3d and OUT/<name>/master.exr,
+with the same bytes as `casual3d reconstruct` on one machine gives. Its work
+is split into units that the scheduler spreads over the workers:
+
+    sparse    casual3d reconstruct CAPTURE -o OUT/<name> --to sparse
+    plan      casual3d dense WS -o OUT/<name>/dense --pass plan     (lists the photos)
+    sweep     casual3d dense ... --pass sweep --photos a-b          (one unit per group of photos)
+    depth     casual3d dense ... --pass depth --photos a-b          (after every sweep of the capture)
+    finish    casual3d dense ... --pass finish
+    panorama  casual3d panorama WS --depth OUT/<name>/dense -o OUT/<name>/panorama
+    encode    casual3d encode OUT/<name>/panorama/master.exr -o OUT/<name>/web --single-file ...
+
+OUT must be a folder every worker sees at the same path (NFS, CephFS, a
+Kubernetes volume). A unit whose worker dies is run again on another worker
+by the scheduler; a unit that fails is retried --retries times; either way
+the units' outputs are written atomically and a rerun skips what is done, so
+the result is the same. A capture whose unit keeps failing is reported with
+the unit's message and the others go on. Exit status: 0 when every capture
+was converted, 1 when some failed (OUT/batch.json lists them), 2 on bad
+arguments. See docs/SCALE.md.
+"""
+
+import argparse
+import ctypes
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+
+class UnitFailed(Exception):
+    """A casual3d command that exited non-zero; the message is its error line."""
+
+
+def _end_with_parent():
+    # PR_SET_PDEATHSIG: the unit's process is killed when the worker that
+    # started it dies, so a retried unit never races an orphan of itself.
+    ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)
+
+
+def run_unit(casual3d, args, label, *after):
+    """Runs `casual3d args` on a worker; `after` only orders the unit after others."""
+    del after
+    proc = subprocess.run([casual3d] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          preexec_fn=_end_with_parent, check=False)
+    if proc.returncode != 0:
+        lines = [line for line in proc.stderr.splitlines() if line.strip()]
+        reason = lines[-1] if lines else "exit status %d" % proc.returncode
+        if reason.startswith("casual3d: error: "):
+            reason = reason[len("casual3d: error: "):]
+        raise UnitFailed("%s: %s" % (label, reason))
+    return proc.stdout
+
+
+def run_into_folder(casual3d, args, label, folder, *after):
+    """Runs a command that writes `folder` into a temporary sibling, then renames it."""
+    del after
+    folder = Path(folder)
+    tmp = folder.with_name("%s.tmp-%d" % (folder.name, os.getpid()))
+    shutil.rmtree(tmp, ignore_errors=True)
+    run_unit(casual3d, [a.replace("{OUT}", str(tmp)) for a in args], label)
+    shutil.rmtree(folder, ignore_errors=True)
+    os.replace(tmp, folder)
+    return str(folder)
+
+
+def photo_groups(count, per_unit):
+    """[(first, last)] covering 0..count-1 in groups of per_unit."""
+    return [(a, min(count, a + per_unit) - 1) for a in range(0, count, per_unit)]
+
+
+class Capture:
+    """One capture's paths and its units' futures."""
+
+    def __init__(self, source, out_root):
+        self.source = Path(source)
+        self.name = self.source.stem if self.source.is_file() else self.source.name
+        self.root = Path(out_root) / self.name
+        self.workspace = self.root / "work" / "sparse"
+        self.dense = self.root / "dense"
+        self.panorama = self.root / "panorama"
+        self.web = self.root / "web"
+        self.final = None  # The future whose success means the capture is done.
+        self.error = None
+
+    def dense_args(self, cfg, *rest):
+        args = ["dense", str(self.workspace), "-o", str(self.dense), "--threads", str(cfg.unit_threads)]
+        return args + cfg.dense_options + list(rest)
+
+
+def submit_start(client, cfg, cap):
+    """Sparse and plan units (or nothing when the capture is already done)."""
+    if cap.web.is_dir() and (cap.root / "photo.c3d").is_file():
+        return None
+    submit = lambda fn, *a, key: client.submit(fn, *a, key=key, retries=cfg.retries, pure=False)
+    sparse = submit(run_unit, cfg.casual3d,
+                    ["reconstruct", str(cap.source), "-o", str(cap.root), "--to", "sparse",
+                     "--threads", str(cfg.unit_threads)] + cfg.sparse_options,
+                    "%s: sparse" % cap.name, key="sparse-%s" % cap.name)
+    return submit(run_unit, cfg.casual3d, cap.dense_args(cfg, "--pass", "plan"), "%s: dense plan" % cap.name,
+                  sparse, key="plan-%s" % cap.name)
+
+
+def submit_rest(client, cfg, cap, plan_output):
+    """The dense units, panorama and encode, once the plan has listed the photos."""
+    submit = lambda fn, *a, key: client.submit(fn, *a, key=key, retries=cfg.retries, pure=False)
+    count = len([line for line in plan_output.splitlines() if line.strip()])
+    done = None
+    if not (cap.dense / "dense.json").is_file():
+        groups = photo_groups(count, cfg.photos_per_unit)
+        sweeps = [submit(run_unit, cfg.casual3d, cap.dense_args(cfg, "--pass", "sweep", "--photos", "%d-%d" % g),
+                         "%s: dense sweep of photos %d-%d" % ((cap.name,) + g), key="sweep-%s-%d" % (cap.name, g[0]))
+                  for g in groups]
+        depths = [submit(run_unit, cfg.casual3d, cap.dense_args(cfg, "--pass", "depth", "--photos", "%d-%d" % g),
+                         "%s: dense depth of photos %d-%d" % ((cap.name,) + g), *sweeps,
+                         key="depth-%s-%d" % (cap.name, g[0]))
+                  for g in groups]
+        done = submit(run_unit, cfg.casual3d, cap.dense_args(cfg, "--pass", "finish"), "%s: dense finish" % cap.name,
+                      *depths, key="finish-%s" % cap.name)
+    if not (cap.panorama / "master.exr").is_file():
+        done = submit(run_into_folder, cfg.casual3d,
+                      ["panorama", str(cap.workspace), "--depth", str(cap.dense), "-o", "{OUT}",
+                       "--threads", str(cfg.unit_threads)] + cfg.panorama_options,
+                      "%s: panorama" % cap.name, str(cap.panorama), *([done] if done else []),
+                      key="panorama-%s" % cap.name)
+    single = cap.root / "photo.c3d"
+    encode = ["encode", str(cap.panorama / "master.exr"), "-o", "{OUT}", "--single-file", "{OUT}/photo.c3d",
+              "--threads", str(cfg.unit_threads)]
+    return submit(finish_capture, cfg.casual3d, encode, "%s: encode" % cap.name, str(cap.web), str(single),
+                  str(cap.panorama / "master.exr"), str(cap.root / "master.exr"), *([done] if done else []),
+                  key="encode-%s" % cap.name)
+
+
+def finish_capture(casual3d, args, label, web, single, master, master_copy, *after):
+    """Encodes into web/ atomically; photo.c3d and master.exr beside it as reconstruct leaves them."""
+    run_into_folder(casual3d, args, label, web)
+    os.replace(os.path.join(web, "photo.c3d"), single + ".tmp")
+    os.replace(single + ".tmp", single)
+    shutil.copyfile(master, master_copy + ".tmp")
+    os.replace(master_copy + ".tmp", master_copy)
+    return web
+
+
+def message_of(future):
+    try:
+        exc = future.exception()
+    except Exception as e:  # The scheduler gave up on the unit (e.g. KilledWorker).
+        exc = e
+    return str(exc) or type(exc).__name__
+
+
+def run_batch(client, cfg, captures):
+    from distributed import as_completed
+
+    plans = {}
+    for cap in captures:
+        f = submit_start(client, cfg, cap)
+        if f is None:
+            print("%s: already converted" % cap.name, flush=True)
+        else:
+            plans[f] = cap
+    finals = []
+    for f in as_completed(list(plans)):
+        cap = plans[f]
+        if f.status != "finished":
+            cap.error = message_of(f)
+            print("%s: failed: %s" % (cap.name, cap.error), file=sys.stderr, flush=True)
+            continue
+        cap.final = submit_rest(client, cfg, cap, f.result())
+        finals.append(cap.final)
+    for f in as_completed(finals):
+        cap = next(c for c in captures if c.final is f)
+        if f.status == "finished":
+            print("%s: converted into %s" % (cap.name, cap.web), flush=True)
+        else:
+            cap.error = message_of(f)
+            print("%s: failed: %s" % (cap.name, cap.error), file=sys.stderr, flush=True)
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("captures", nargs="*", help="capture folders or videos")
+    p.add_argument("--captures-in", help="convert every capture folder or video in this folder")
+    p.add_argument("-o", "--out", required=True, help="output folder, shared by every worker")
+    where = p.add_mutually_exclusive_group(required=True)
+    where.add_argument("--scheduler", help="scheduler address, e.g. tcp://10.0.0.5:8786")
+    where.add_argument("--scheduler-file", help="scheduler file written by dask-scheduler --scheduler-file")
+    p.add_argument("--casual3d", default=shutil.which("casual3d") or "casual3d",
+                   help="the casual3d program, at the same path on every worker (default: from PATH)")
+    p.add_argument("--photos-per-unit", type=int, default=4, help="photos per sweep and depth unit (default 4)")
+    p.add_argument("--unit-threads", type=int, default=0,
+                   help="threads of each unit's process (default 0: all of the worker's cores)")
+    p.add_argument("--retries", type=int, default=1, help="reruns of a unit that fails (default 1)")
+    p.add_argument("--dense-option", dest="dense_options", action="append", default=[],
+                   help="an option for every dense unit, e.g. --dense-option=--depths=128 (repeatable)")
+    p.add_argument("--sparse-option", dest="sparse_options", action="append", default=[],
+                   help="an option for the sparse unit's casual3d reconstruct (repeatable)")
+    p.add_argument("--panorama-option", dest="panorama_options", action="append", default=[],
+                   help="an option for the panorama unit (repeatable)")
+    cfg = p.parse_args(argv)
+    if cfg.photos_per_unit < 1:
+        p.error("--photos-per-unit %d: must be at least 1" % cfg.photos_per_unit)
+    if cfg.unit_threads < 0:
+        p.error("--unit-threads %d: must be 0 (all cores) or more" % cfg.unit_threads)
+    sources = [Path(c) for c in cfg.captures]
+    if cfg.captures_in:
+        folder = Path(cfg.captures_in)
+        if not folder.is_dir():
+            p.error("--captures-in %s: not a folder" % folder)
+        sources += sorted(e for e in folder.iterdir() if not e.name.startswith("."))
+    if not sources:
+        p.error("no captures: name capture folders or give --captures-in DIR")
+    for s in sources:
+        if not s.exists():
+            p.error("%s: no such capture folder or video" % s)
+    names = [Capture(s, cfg.out).name for s in sources]
+    dupes = sorted({n for n in names if names.count(n) > 1})
+    if dupes:
+        p.error("captures named alike would share an output folder: %s; rename them" % ", ".join(dupes))
+    cfg.sources = [s.resolve() for s in sources]
+    return cfg
+
+
+def main(argv):
+    cfg = parse_args(argv)
+    try:
+        from distributed import Client
+    except ImportError:
+        print("casual3d_dask: error: Dask distributed is not installed (Debian: apt-get install "
+              "python3-distributed)", file=sys.stderr)
+        return 2
+    out = Path(cfg.out).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    captures = [Capture(s, out) for s in cfg.sources]
+    start = time.time()
+    with Client(address=cfg.scheduler, scheduler_file=cfg.scheduler_file) as client:
+        run_batch(client, cfg, captures)
+    failed = [c for c in captures if c.error]
+    batch = {"seconds": round(time.time() - start, 1),
+             "captures": [{"name": c.name, "source": str(c.source),
+                           "status": "failed" if c.error else "converted",
+                           **({"error": c.error} if c.error else {"web": str(c.web)})} for c in captures]}
+    tmp = out / ("batch.json.tmp-%d" % os.getpid())
+    tmp.write_text(json.dumps(batch, indent=2) + "\n")
+    os.replace(tmp, out / "batch.json")
+    print("%d of %d captures converted in %.0f s%s" % (len(captures) - len(failed), len(captures),
+                                                      batch["seconds"], "; failed: " + ", ".join(c.name for c in failed)
+                                                      if failed else ""), flush=True)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
