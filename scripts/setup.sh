@@ -26,6 +26,8 @@ packages=(
   pybind11-dev python3-dev python3-numpy python3-pytest
   # wasm-viewer/ and its browser test
   emscripten chromium
+  # scale/: the distributed workflow and its test (Dask scheduler and workers)
+  python3-distributed
 )
 
 missing=()
