@@ -53,6 +53,9 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_option("--working-megapixels", args->working_megapixels,
                   "Photos are downscaled to about this size before matching and depth")
       ->capture_default_str();
+  cmd->add_option("--focal-px", args->options.sparse.import.focal_px,
+                  "Focal length prior in pixels at the photos' (or video's) original size; default: "
+                  "EXIF (a video has none: give it when its frames do not register)");
   AddSiftOptions(cmd, &args->options.sparse);
   AddPhotoInputOptions(cmd, &args->options.sparse);
   cmd->add_flag("--no-gap-fill", "Leave the front layer's gaps inside the photos' field of view empty")

@@ -75,6 +75,26 @@ TEST_F(ViewerAssetsTest, EscapesTheTitle) {
   EXPECT_NE(html.find("<title>a&lt;b&gt;&amp;&quot;c&quot;</title>"), std::string::npos);
 }
 
+TEST_F(ViewerAssetsTest, CaptureAdviceFillsTheInfoPanel) {
+  // Without advice: no info slot, the panel closed.
+  const std::string plain = ViewerPageHtml("t", "viewer/");
+  EXPECT_EQ(plain.find("slot=\"info\""), std::string::npos);
+  EXPECT_EQ(plain.find("info-open"), std::string::npos);
+  // A description alone: the panel is there, closed.
+  const std::string quiet = ViewerPageHtml("t", "viewer/", {"The camera moved 0.30 m."});
+  EXPECT_NE(quiet.find("<div slot=\"info\">\n<h2>About this capture</h2>\n<p>The camera moved 0.30 m.</p>"),
+            std::string::npos)
+      << quiet;
+  EXPECT_EQ(quiet.find("info-open"), std::string::npos);
+  // With warnings: open at load, each warning marked, the text escaped.
+  WriteViewerPage(root_ / "package", {"The camera moved 1.84 m.", "Photos a<b>.jpg & c.jpg overlap nothing."});
+  const std::string html = Read(root_ / "package" / "index.html");
+  EXPECT_NE(html.find("<casual3d-viewer src=\"manifest.json\" controls info-open>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<p class=\"warning\">Photos a&lt;b&gt;.jpg &amp; c.jpg overlap nothing.</p>"),
+            std::string::npos)
+      << html;
+}
+
 TEST_F(ViewerAssetsTest, RefusesAMissingPackageFolder) {
   try {
     WriteViewerPage(root_ / "nope");

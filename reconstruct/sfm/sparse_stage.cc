@@ -106,9 +106,22 @@ std::string LastLines(const std::string& text) {
   return pos == std::string::npos ? s : s.substr(pos + 1);
 }
 
-std::string NothingRegisteredMessage(int num_photos) {
-  return "COLMAP registered none of the " + std::to_string(num_photos) +
-         " photos (no initial pair found); take more photos with more overlap (each scene "
+// `focal_unknown`: some photos had no focal length (no EXIF, no --focal-px),
+// which COLMAP's default guess (1.2 times the long side, a 45-degree view)
+// often fails to start from; a video never carries one.
+std::string NothingRegisteredMessage(int num_photos, const std::string& input_type = "photos",
+                                     bool focal_unknown = false) {
+  const bool video = input_type == "video";
+  const std::string what = std::to_string(num_photos) + (video ? " frames" : " photos");
+  if (focal_unknown) {
+    return "COLMAP registered none of the " + what + " (no initial pair found); " +
+           (video ? "a video carries no focal length" : "the photos carry no focal length (EXIF)") +
+           ": give the camera's with --focal-px (pixels at the " + (video ? "video's" : "photos'") +
+           " size; about 0.8 times the long side for a phone's main camera)" +
+           (video ? "" : ", or take more photos with more overlap of a textured scene");
+  }
+  return "COLMAP registered none of the " + what +
+         " (no initial pair found); take more photos with more overlap (each scene "
          "point in 3 or more photos) of a textured scene, and move the camera between shots";
 }
 
@@ -176,6 +189,9 @@ class ColmapSteps {
       : colmap_(std::move(colmap)), log_path_(std::move(log_path)), num_images_(num_images),
         result_(result) {}
 
+  // The error when the mapper registers nothing; empty: the generic one.
+  std::string nothing_registered;
+
   void Run(const std::string& command, const std::vector<std::string>& args,
            const std::string& label) {
     util::Progress progress(label, 1000);
@@ -189,7 +205,8 @@ class ColmapSteps {
     if (InterruptRequested()) throw std::runtime_error("interrupted during COLMAP " + command);
     if (r.signal == 0 && r.exit_code != 0 && command == "mapper" &&
         r.last_lines.find("failed to create sparse model") != std::string::npos) {
-      throw std::runtime_error(NothingRegisteredMessage(num_images_));
+      throw std::runtime_error(nothing_registered.empty() ? NothingRegisteredMessage(num_images_)
+                                                          : nothing_registered);
     }
     if (r.signal != 0 || r.exit_code != 0) {
       throw std::runtime_error("COLMAP " + command + " failed (" + DescribeExit(r) +
@@ -445,6 +462,9 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
     image_dir = work / "images";
     const int n = static_cast<int>(photos.photos.size());
     ColmapSteps steps(colmap, log_path, n, &result);
+    const bool focal_unknown = std::any_of(photos.groups.begin(), photos.groups.end(),
+                                           [](const CameraGroup& g) { return !(g.focal_px > 0); });
+    steps.nothing_registered = NothingRegisteredMessage(n, result.input_type, focal_unknown);
 
     // 2. Features, one extractor run per camera group so each gets its own
     // calibration and focal prior (TOOLCHAIN.md: resized photos lost their EXIF).
@@ -512,7 +532,7 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
       if (entry.is_directory() && HasModelFiles(entry.path())) models.push_back(entry.path());
     }
     std::sort(models.begin(), models.end());
-    if (models.empty()) throw std::runtime_error(NothingRegisteredMessage(n));
+    if (models.empty()) throw std::runtime_error(steps.nothing_registered);
     auto [dir, model] = LargestModel(models);
     model_dir = dir;
     raw_model = std::move(model);

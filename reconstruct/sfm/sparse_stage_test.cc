@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 namespace casual3d::sfm {
 namespace {
@@ -101,6 +103,25 @@ TEST_F(SparseStageTest, NothingRegistered) {
   // The stand-in colmap succeeds at every step but maps nothing.
   WritePhotos(3);
   ExpectFailure({"registered none of the 3 photos", "overlap"});
+}
+
+TEST_F(SparseStageTest, NothingRegisteredFromAVideoAsksForTheFocalLength) {
+  // A clip (a textured image panned sideways) carries no focal length; the
+  // stand-in colmap maps nothing.
+  cv::Mat texture(480, 1200, CV_8UC3);
+  cv::randu(texture, 0, 255);
+  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.5);
+  cv::VideoWriter writer((root_ / "photos" / "clip.avi").string(),
+                         cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, cv::Size(320, 240));
+  ASSERT_TRUE(writer.isOpened());
+  for (int i = 0; i < 40; ++i) {
+    cv::Mat frame;
+    cv::resize(texture(cv::Rect(20 * i, 0, 320, 240)), frame, cv::Size(320, 240));
+    writer.write(frame);
+  }
+  writer.release();
+  ExpectFailure({"COLMAP registered none of the ", " frames (no initial pair found); a video carries no "
+                 "focal length: give the camera's with --focal-px"});
 }
 
 TEST_F(SparseStageTest, ExtractorThatLeftNoDatabaseIsReported) {
