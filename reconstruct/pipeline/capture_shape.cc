@@ -92,13 +92,13 @@ void AddAdvice(const std::vector<std::string>& order, CaptureShape* s) {
     const std::string who = (one ? "Photo " : "Photos ") + NameRuns(s->groups[g], order);
     if (s->group_links[g - 1] == 0) {
       s->advice.push_back(who + (one ? " overlaps" : " overlap") +
-                          " nothing the other photos saw: take them with more overlap (about two "
-                          "thirds with each neighbour).");
+                          " nothing the other photos saw: take " + (one ? "it" : "them") +
+                          " with more overlap (about two thirds with each neighbour).");
     } else {
       s->advice.push_back(who + (one ? " is" : " are") + " tied to the other photos by only " +
-                          std::to_string(s->group_links[g - 1]) +
-                          " shared points: take them with more overlap (about two thirds with "
-                          "each neighbour).");
+                          std::to_string(s->group_links[g - 1]) + " shared points: take " +
+                          (one ? "it" : "them") +
+                          " with more overlap (about two thirds with each neighbour).");
     }
   }
   if (!s->unregistered.empty()) {
@@ -106,8 +106,8 @@ void AddAdvice(const std::vector<std::string>& order, CaptureShape* s) {
     s->advice.push_back((one ? "Photo " : "Photos ") + NameRuns(s->unregistered, order) +
                         (one ? " overlaps" : " overlap") +
                         " nothing the other photos saw and " + (one ? "was" : "were") +
-                        " left out: take them with more overlap (about two thirds with each "
-                        "neighbour).");
+                        " left out: take " + (one ? "it" : "them") +
+                        " with more overlap (about two thirds with each neighbour).");
   }
 }
 

@@ -269,7 +269,7 @@ TEST(CaptureShape, WeakLinkIsCountedAndNamed) {
   bool named = false;
   for (const std::string& a : s.advice)
     named |= a.rfind("Photo img_16.jpg is tied to the other photos by only 10 shared points: take "
-                     "them with more overlap",
+                     "it with more overlap",
                      0) == 0;
   EXPECT_TRUE(named);
   // With 40 shared points (above min_link_points, and 5% of either photo's)
