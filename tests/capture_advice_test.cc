@@ -4,7 +4,6 @@
 // the default synthetic capture (turning on the spot) gets no warning. Runs
 // COLMAP twice on 640x480 photos (under a minute on 2 cores).
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -17,28 +16,15 @@
 #include <nlohmann/json.hpp>
 
 #include "reconstruct/io/file_util.h"
+#include "tests/casual3d_cli.h"
 
 namespace casual3d {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string output;
-};
-
-CommandRun Casual3d(const std::string& args) {
-  const std::string cmd = std::string(std::getenv("CASUAL3D_BINARY_DIR")) + "/cli/casual3d " + args + " 2>&1";
-  CommandRun run;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  size_t n;
-  while (pipe && (n = fread(buf, 1, sizeof(buf), pipe)) > 0) run.output.append(buf, n);
-  const int status = pipe ? pclose(pipe) : -1;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+using testing::Casual3d;
+using testing::CommandRun;
 
 class CaptureAdviceTest : public ::testing::Test {
  protected:

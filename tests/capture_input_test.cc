@@ -3,7 +3,6 @@
 // MP4 clip (FFmpeg), and among bad files; each registered or refused with one
 // line. Runs COLMAP three times on 640x480 photos (about a minute and a half).
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -18,28 +17,15 @@
 
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/io/image_io.h"
+#include "tests/casual3d_cli.h"
 
 namespace casual3d {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string output;
-};
-
-CommandRun Casual3d(const std::string& args) {
-  const std::string cmd = std::string(std::getenv("CASUAL3D_BINARY_DIR")) + "/cli/casual3d " + args + " 2>&1";
-  CommandRun run;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  size_t n;
-  while (pipe && (n = fread(buf, 1, sizeof(buf), pipe)) > 0) run.output.append(buf, n);
-  const int status = pipe ? pclose(pipe) : -1;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+using testing::Casual3d;
+using testing::CommandRun;
 
 heif_error Append(heif_context*, const void* data, size_t size, void* out) {
   static_cast<std::string*>(out)->append(static_cast<const char*>(data), size);

@@ -12,6 +12,8 @@
 
 #include <Eigen/Dense>
 
+#include "reconstruct/util/union_find.h"
+
 namespace casual3d::depth {
 namespace {
 
@@ -36,20 +38,6 @@ bool SampleRgb(const ImageF& img, float u, float v, float out[3]) {
   }
   return true;
 }
-
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int Find(int a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  }
-  void Union(int a, int b) {
-    a = Find(a);
-    b = Find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-};
 
 // Per neighbour: the plane-induced homography and per-channel exposure gain
 // (reference colour / neighbour colour) estimated at confident anchors.
@@ -531,7 +519,7 @@ std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_wei
   // Join regions of similar colour that a thin occluder separates: from
   // each region pixel, look along the four axes across at most merge_gap
   // pixels of other content for another region.
-  UnionFind uf(num_regions);
+  util::UnionFind uf(num_regions);
   {
     const double mc2 = options.merge_color * options.merge_color;
     auto similar = [&](int a, int b) {

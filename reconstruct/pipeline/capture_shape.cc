@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
-#include <numeric>
 #include <stdexcept>
 
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/sfm/scene_setup.h"
+#include "reconstruct/util/union_find.h"
 
 namespace casual3d::pipeline {
 namespace {
@@ -31,16 +31,6 @@ std::string Format(const char* format, double value) {
 }
 
 std::string Percent(double fraction) { return Format("%.0f%%", 100.0 * fraction); }
-
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int Find(int i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  }
-  void Join(int a, int b) { parent[Find(a)] = Find(b); }
-};
 
 // Directions spread evenly over the sphere (Fibonacci lattice).
 std::vector<Eigen::Vector3d> SphereDirections(int n) {
@@ -303,12 +293,12 @@ CaptureShape MeasureCaptureShape(const geometry::SparseModel& model, const Panor
       }
     }
   }
-  UnionFind sets(n);
+  util::UnionFind sets(n);
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j) {
       const int k = shared[size_t(i) * n + j];
       if (k >= options.min_link_points && k >= options.min_link_fraction * std::min(points[i], points[j]))
-        sets.Join(i, j);
+        sets.Union(i, j);
     }
   std::map<int, std::vector<int>> members;
   for (int i = 0; i < n; ++i) members[sets.Find(i)].push_back(i);
