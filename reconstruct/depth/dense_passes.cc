@@ -24,9 +24,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 size_t PeakRssBytes() {
   std::ifstream f("/proc/self/status");
@@ -162,7 +159,7 @@ MrfResult SolveDepthMrf(const DensePlan& plan, int i, const DenseOptions& option
     for (const DenseView* nb : swept) fn.push_back({&nb->color, nb->camera});
     FlatRegionStats flat_stats;
     r.flat_prior = FlatRegionPriors(v.color, vol.photo_weight, v.camera, wta, fn, vol, options.flat, &flat_stats);
-    pr->t_flat = Since(tf);
+    pr->t_flat = SecondsSince(tf);
     pr->flat_groups = flat_stats.groups;
     pr->flat_fitted = flat_stats.fitted;
     pr->flat_pixels = flat_stats.pixels;
@@ -186,7 +183,7 @@ MrfResult SolveDepthMrf(const DensePlan& plan, int i, const DenseOptions& option
   const std::vector<int> labels = EdgeAwareMedian(std::vector<int>(res.labels.begin(), res.labels.end()), L,
                                                   v.color, options.edge_median, threads);
   std::vector<float> fl = FitSubLabel(vol, labels, options.sublabel, threads);
-  pr->t_mrf = Since(t0);
+  pr->t_mrf = SecondsSince(t0);
   if (options.debug) {
     r.trws_depth = ImageF(w, h, 1);
     for (size_t p = 0; p < np; ++p) r.trws_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(res.labels[p]));
@@ -210,7 +207,7 @@ MrfResult SolveDepthMrf(const DensePlan& plan, int i, const DenseOptions& option
   pool->Give(&vol.cost);
   r.photo_weight = std::move(vol.photo_weight);
   r.grid = std::move(vol);
-  pr->t_refine = Since(t0);
+  pr->t_refine = SecondsSince(t0);
   return r;
 }
 
@@ -236,7 +233,7 @@ ImageF UpsampleDepth(const DensePlan& plan, int i, const DenseOptions& options, 
                                    &rs);
       pr->refined = rs.refined;
     }
-    pr->t_fullres = Since(tf);
+    pr->t_fullres = SecondsSince(tf);
   }
   return depth;
 }
@@ -277,6 +274,10 @@ std::vector<const DenseView*> DensePlan::SweptViews(int i) const {
   std::vector<const DenseView*> out;
   for (int j : swept[i]) out.push_back(&ws.views[j]);
   return out;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 std::vector<int> AllPhotos(int n) {
@@ -370,7 +371,7 @@ ImageF DepthPhoto(const DensePlan& plan, int i, const DenseOptions& options, int
   const LabelGrid grid{shell.inv_near, shell.inv_far, shell.num_labels};
   auto t0 = Clock::now();
   const EnvelopeResult env = BuildEnvelope(plan, i, options, threads, wta, grid, pr);
-  pr->t_envelope = Since(t0);
+  pr->t_envelope = SecondsSince(t0);
   const MrfResult mrf =
       SolveDepthMrf(plan, i, options, threads, *wta[i], env.envelope, shell, cost_path, pool, pr);
 
@@ -390,7 +391,7 @@ ImageF DepthPhoto(const DensePlan& plan, int i, const DenseOptions& options, int
   io::WriteExr(StemPath(out_dir, "envelope", stem, ".exr"), env_full.view(), {"Z"}, plain);
   if (options.debug)
     WriteDepthDebug((fs::path(out_dir) / "debug").string(), stem, v.range, *wta[i], env, mrf, depth);
-  pr->t_upsample = Since(t0);
+  pr->t_upsample = SecondsSince(t0);
 
   // Ground truth: the anchors and the envelope (Fig. 6); the final depth
   // is evaluated after pass 3.
@@ -443,7 +444,7 @@ void CheckFreeSpaceAll(const DensePlan& plan, const DenseOptions& options, int t
       PhotoReport& pr = (*photos)[i];
       pr.seen_through += vs.flagged;
       pr.moved_back += vs.replaced;
-      pr.t_visibility += Since(t0);
+      pr.t_visibility += SecondsSince(t0);
       check_progress.Advance();
     });
     for (int i = 0; i < n; ++i)
@@ -516,7 +517,7 @@ DenseReport FinishDense(const DensePlan& plan, const DenseOptions& options, std:
       const Image8 rgb = Colorize(depth[i], v.range);
       io::WritePng((fs::path(debug_dir) / (stem + "_depth.png")).string(), rgb.view());
     }
-    pr.t_upsample += Since(t0);
+    pr.t_upsample += SecondsSince(t0);
     if (!options.ground_truth_dir.empty() && !ground_truth[i].empty())
       EvaluateFinalDepth(plan, i, depth[i], ground_truth, shells[i], debug_dir, options.debug, &pr);
   });
@@ -542,7 +543,7 @@ DenseReport FinishDense(const DensePlan& plan, const DenseOptions& options, std:
   report.photos = std::move(photos);
   report.seconds_load = seconds_load;
   SummariseDenseReport(&report);
-  report.seconds_total = Since(start);
+  report.seconds_total = SecondsSince(start);
   report.peak_rss_bytes = PeakRssBytes();
   WriteDenseJson((fs::path(out_dir) / "dense.json").string(), report, options);
   return report;

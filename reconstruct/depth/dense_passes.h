@@ -100,4 +100,7 @@ void ForEachPhoto(const DensePlan& plan, const std::vector<int>& photos, int out
 // 0, 1, ..., n - 1.
 std::vector<int> AllPhotos(int n);
 
+// Seconds from `t0` to now (steady clock), for the report's timings.
+double SecondsSince(std::chrono::steady_clock::time_point t0);
+
 }  // namespace casual3d::depth

@@ -53,7 +53,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
 
   const DensePlan plan = PlanDense(workspace_dir, options);
   const int n = plan.size();
-  const double seconds_load = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  const double seconds_load = SecondsSince(t_start);
 
   CreateDenseOutputFolders(out_dir, options);
   const std::string cache_dir = (fs::path(out_dir) / ".dense-cache").string();
@@ -96,7 +96,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   ForEachPhoto(plan, AllPhotos(n), outer, [&](int i) {
     const auto t0 = std::chrono::steady_clock::now();
     shells[i] = SweepPhoto(plan, i, options, inner, cache_path(i), &pool, &wta[i]);
-    photos[i].t_sweep = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    photos[i].t_sweep = SecondsSince(t0);
     sweep_progress.Advance();
   });
   sweep_progress.Finish();

@@ -18,9 +18,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // OUT/.dense-units/ and its files.
 struct UnitFolder {
@@ -103,7 +100,7 @@ void SweepUnit(const DensePlan& plan, const DenseOptions& options, const UnitFol
     io::WriteExr(units.Path("wta", stem, ".exr"), wta, {"Z"}, plain);
     const nlohmann::json record = {{"width", shell.width},       {"height", shell.height},
                                    {"num_labels", shell.num_labels}, {"inv_near", shell.inv_near},
-                                   {"inv_far", shell.inv_far},   {"seconds", Since(t0)}};
+                                   {"inv_far", shell.inv_far},   {"seconds", SecondsSince(t0)}};
     io::WriteFileAtomic(units.Path("sweep", stem, ".json"), record.dump(2) + "\n");
   });
 }
@@ -225,7 +222,7 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
     throw std::runtime_error(options.ground_truth_dir + ": ground-truth folder does not exist");
   const auto start = Clock::now();
   const DensePlan plan = PlanDense(workspace_dir, options);
-  const double seconds_load = Since(start);
+  const double seconds_load = SecondsSince(start);
   const int n = plan.size();
   for (int i : photos)
     if (i >= n)
