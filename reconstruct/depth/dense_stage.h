@@ -25,6 +25,10 @@
 // boundary relabelling and a full-resolution search (fullres_refine.h). Once
 // every photo has its map: the free-space check of the maps against each
 // other (visibility_filter.h).
+//
+// These run as three passes (dense_passes.h): sweep and depth per photo,
+// finish over all. RunDenseStage runs them in one process; dense_units.h
+// runs them as separate units of work over a shared OUT, with the same files.
 
 #include <string>
 #include <vector>

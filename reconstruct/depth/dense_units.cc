@@ -87,6 +87,21 @@ CostVolume ReadSweepRecord(const DensePlan& plan, int i, const UnitFolder& units
   return shell;
 }
 
+// The sweeps photo i's depth unit reads: its own and, for the GC filter's
+// WTA maps, those of its first max_views ranked neighbours (gc_filter.h).
+std::vector<int> SweepsNeeded(const DensePlan& plan, const DenseOptions& options, int i) {
+  std::vector<int> needed = {i};
+  if (options.use_gc_filter)
+    for (int j : plan.ws.ranked_neighbors[i])
+      if (j != i && static_cast<int>(needed.size()) <= options.gc.max_views) needed.push_back(j);
+  return needed;
+}
+
+bool HasRecord(const UnitFolder& units, const char* pass, const DensePlan& plan, int i) {
+  std::error_code ec;
+  return fs::exists(units.Path(pass, OutputStem(plan.ws.views[i].name), ".json"), ec);
+}
+
 void SweepUnit(const DensePlan& plan, const DenseOptions& options, const UnitFolder& units,
                const std::vector<int>& todo, int outer, int inner) {
   BufferPool pool(3);
@@ -112,15 +127,9 @@ void DepthUnit(const DensePlan& plan, const DenseOptions& options, const UnitFol
     const std::string stem = OutputStem(plan.ws.views[i].name);
     PhotoReport pr = PhotoHeader(plan, i);
     const CostVolume shell = ReadSweepRecord(plan, i, units, &pr.t_sweep);
-    // The WTA maps the GC filter reads: this photo's and its first
-    // max_views ranked neighbours' (gc_filter.h).
     std::vector<ImageF> wta(plan.size());
     std::vector<const ImageF*> wta_ptrs(plan.size());
-    std::vector<int> needed = {i};
-    if (options.use_gc_filter)
-      for (int j : plan.ws.ranked_neighbors[i])
-        if (j != i && static_cast<int>(needed.size()) <= options.gc.max_views) needed.push_back(j);
-    for (int j : needed) {
+    for (int j : SweepsNeeded(plan, options, i)) {
       ReadSweepRecord(plan, j, units, nullptr);
       wta[j] = ReadDepthMap(units.Dir("wta"), OutputStem(plan.ws.views[j].name));
     }
@@ -136,14 +145,12 @@ void DepthUnit(const DensePlan& plan, const DenseOptions& options, const UnitFol
   });
 }
 
-DenseReport FinishUnit(const DensePlan& plan, const DenseOptions& options, const UnitFolder& units,
-                       const std::string& out_dir, Clock::time_point start, double seconds_load) {
+// Throws unless every photo's depth unit is done.
+void CheckDepthUnitsDone(const DensePlan& plan, const UnitFolder& units) {
   const int n = plan.size();
   std::vector<int> missing;
-  for (int i = 0; i < n; ++i) {
-    std::error_code ec;
-    if (!fs::exists(units.Path("depth", OutputStem(plan.ws.views[i].name), ".json"), ec)) missing.push_back(i);
-  }
+  for (int i = 0; i < n; ++i)
+    if (!HasRecord(units, "depth", plan, i)) missing.push_back(i);
   if (!missing.empty()) {
     std::string list;
     for (int i : missing) list += (list.empty() ? "" : ",") + std::to_string(i);
@@ -151,6 +158,11 @@ DenseReport FinishUnit(const DensePlan& plan, const DenseOptions& options, const
                              std::to_string(n) + " photos have no depth result (photos " + list +
                              "); run `casual3d dense ... --pass depth --photos " + list + "` first");
   }
+}
+
+DenseReport FinishUnit(const DensePlan& plan, const DenseOptions& options, const UnitFolder& units,
+                       const std::string& out_dir, Clock::time_point start, double seconds_load) {
+  const int n = plan.size();
   std::vector<ImageF> depth(n), ground_truth(n);
   std::vector<PhotoReport> photos(n);
   std::vector<CostVolume> shells(n);
@@ -232,6 +244,24 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
   DenseUnitResult result;
   for (const DenseView& v : plan.ws.views) result.photos.push_back(v.name);
   const UnitFolder units{fs::path(out_dir) / ".dense-units"};
+  // The photos of this unit not yet done (their record is written last),
+  // and what they need, checked before anything is written.
+  std::vector<int> todo;
+  if (pass == DensePass::kSweep || pass == DensePass::kDepth) {
+    for (int i : photos.empty() ? AllPhotos(n) : photos) {
+      if (HasRecord(units, pass == DensePass::kSweep ? "sweep" : "depth", plan, i)) {
+        ++result.skipped;
+      } else {
+        todo.push_back(i);
+      }
+    }
+  }
+  if (pass == DensePass::kDepth)
+    for (int i : todo)
+      for (int j : SweepsNeeded(plan, options, i))
+        if (!HasRecord(units, "sweep", plan, j)) throw std::runtime_error(MissingUnitMessage(plan, j, "sweep", units));
+  if (pass == DensePass::kFinish) CheckDepthUnitsDone(plan, units);
+
   CreateDenseOutputFolders(out_dir, options);
   for (const char* sub : {"cost", "wta", "sweep", "depth"}) io::CreateDirectories(units.Dir(sub));
   CheckOrWritePlan(units, plan, options);
@@ -240,18 +270,6 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
     result.report = FinishUnit(plan, options, units, out_dir, start, seconds_load);
     result.ran = n;
     return result;
-  }
-
-  // The photos of this unit not yet done: their record is written last.
-  const char* sub = pass == DensePass::kSweep ? "sweep" : "depth";
-  std::vector<int> todo;
-  for (int i : photos.empty() ? AllPhotos(n) : photos) {
-    std::error_code ec;
-    if (fs::exists(units.Path(sub, OutputStem(plan.ws.views[i].name), ".json"), ec)) {
-      ++result.skipped;
-    } else {
-      todo.push_back(i);
-    }
   }
   result.ran = static_cast<int>(todo.size());
   if (todo.empty()) return result;

@@ -134,6 +134,10 @@ TEST_F(DenseUnitsTest, RefusesUnitsWithOtherOptionsOrPhotos) {
         << e.what();
   }
   EXPECT_THROW(Unit("mixed", DensePass::kSweep, {9}), std::invalid_argument);
+  // A unit refused for what it lacks writes nothing.
+  EXPECT_THROW(Unit("fresh", DensePass::kDepth, {2}), std::runtime_error);
+  EXPECT_THROW(Unit("fresh", DensePass::kFinish), std::runtime_error);
+  EXPECT_FALSE(fs::exists(*root_ / "fresh"));
 }
 
 TEST(ParsePhotoListTest, IndicesAndRanges) {
