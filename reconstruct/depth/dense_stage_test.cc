@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "reconstruct/depth/depth_metrics.h"
+#include "reconstruct/depth/testing/toy_dense_options.h"
 #include "reconstruct/depth/testing/toy_scene.h"
 #include "reconstruct/io/exr_io.h"
 
@@ -28,13 +29,7 @@ class DenseStageTest : public ::testing::Test {
     fs::remove_all(*root_, ec);
     delete root_;
   }
-  static DenseOptions Options() {
-    DenseOptions o;
-    o.working_scale = 0.5;
-    o.num_threads = 2;
-    o.ground_truth_dir = (*root_ / "ws" / "gt").string();
-    return o;
-  }
+  static DenseOptions Options() { return testing::ToyDenseOptions((*root_ / "ws" / "gt").string()); }
   static fs::path* root_;
 };
 fs::path* DenseStageTest::root_ = nullptr;

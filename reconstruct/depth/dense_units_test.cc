@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "reconstruct/depth/dense_report.h"
+#include "reconstruct/depth/testing/toy_dense_options.h"
 #include "reconstruct/depth/testing/toy_scene.h"
 #include "reconstruct/io/file_util.h"
 
@@ -32,13 +33,7 @@ class DenseUnitsTest : public ::testing::Test {
     delete reference_;
   }
   static std::string Workspace() { return (*root_ / "ws").string(); }
-  static DenseOptions Options() {
-    DenseOptions o;
-    o.working_scale = 0.5;
-    o.num_threads = 2;
-    o.ground_truth_dir = (*root_ / "ws" / "gt").string();
-    return o;
-  }
+  static DenseOptions Options() { return testing::ToyDenseOptions((*root_ / "ws" / "gt").string()); }
   static DenseUnitResult Unit(const std::string& out, DensePass pass, const std::vector<int>& photos = {},
                               const DenseOptions& options = Options()) {
     return RunDenseUnit(Workspace(), (*root_ / out).string(), options, pass, photos);
