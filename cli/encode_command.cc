@@ -1,5 +1,6 @@
 // `casual3d encode <master.exr> -o <package> [--quality Q] [--tile-size N]
-// [--levels N] [--depth-bits B] [--normal-bits B] [--single-file out.c3d]`: turns a master file into a web package
+// [--levels N] [--depth-bits B] [--normal-bits B] [--single-file out.c3d]
+// [--capture SPARSE_DIR] [--title T]`: turns a master file into a web package
 // (spec/package.md), optionally also as one .c3d file.
 
 #include <chrono>
@@ -10,6 +11,7 @@
 #include "cli/viewer_assets.h"
 #include "encoder/master_file.h"
 #include "encoder/package_writer.h"
+#include "reconstruct/pipeline/capture_shape.h"
 #include "reconstruct/util/log.h"
 
 namespace casual3d::cli {
@@ -20,6 +22,8 @@ struct EncodeCommandOptions {
   std::string output;        // Output package folder.
   std::string single_file;   // Optional .c3d output.
   bool viewer = true;        // Add index.html and the viewer to the folder.
+  std::string capture;       // Optional sparse stage output whose advice the page shows.
+  std::string title;         // The page's title; empty: the output folder's name.
   // Web delivery settings; --depth-bits 12 --normal-bits 8 keep each node's
   // value as closely as PackageOptions' defaults.
   encoder::PackageOptions package = encoder::DeliveryPackageOptions();
@@ -30,6 +34,17 @@ void RunEncode(const EncodeCommandOptions& o) {
     throw std::runtime_error("encode: give an output folder with -o (and/or --single-file)");
   Status check = o.package.Check();
   if (!check.ok()) throw std::runtime_error("encode: " + check.message());
+  // The capture's advice for the page's info panel, as reconstruct gives it;
+  // measured before anything is written so that a wrong folder leaves nothing.
+  std::vector<std::string> advice;
+  if (!o.capture.empty()) {
+    try {
+      advice = pipeline::MeasureWorkspaceCaptureShape(o.capture).advice;
+    } catch (const std::exception& e) {
+      throw std::runtime_error("encode: --capture " + o.capture + ": " + e.what() +
+                               " (give the sparse stage output, e.g. <output>/work/sparse)");
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
   StatusOr<TwoLayerPanorama> pano = encoder::ReadMasterFile(o.master);
   if (!pano.ok()) throw std::runtime_error(pano.status().message());
@@ -43,7 +58,7 @@ void RunEncode(const EncodeCommandOptions& o) {
     if (!s.ok()) throw std::runtime_error(s.message());
     if (o.viewer) {
       try {
-        WriteViewerPage(o.output);
+        WriteViewerPage(o.output, advice, o.title);
       } catch (const std::exception& e) {
         util::LogWarning(std::string("package written without index.html: ") + e.what());
       }
@@ -87,6 +102,11 @@ void AddEncodeCommand(CLI::App& app) {
                   "most 8.1 degrees; 8 for 1 degree)");
   cmd->add_option("--threads", options->package.num_threads, "Encoding threads; 0 = all cores");
   cmd->add_flag("!--no-viewer", options->viewer, "Do not add index.html and the viewer");
+  cmd->add_option("--title", options->title,
+                  "Title of the viewer page (default: the output folder's name)");
+  cmd->add_option("--capture", options->capture,
+                  "Sparse stage output (reconstruct's <output>/work/sparse) whose capture advice "
+                  "the viewer page's info panel shows, as reconstruct's page does");
   cmd->callback([options] { RunEncode(*options); });
 }
 

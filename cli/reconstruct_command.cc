@@ -94,13 +94,16 @@ void AddReconstructCommand(CLI::App& app) {
     options.panorama.pano_width = args->pano_width;
     options.panorama.back_layer = !args->front_only;
     if (args->no_gc_filter) options.panorama.stitch.lambda_gc = 0.0;
-    options.finish_web_package = [](const std::string& web_dir,
+    // The page is titled after the output folder (the capture's name), not
+    // its web/ subfolder.
+    const std::string title = FolderName(args->output);
+    options.finish_web_package = [title](const std::string& web_dir,
                                     const std::vector<std::string>& capture_advice) {
       // As `casual3d encode`: without a built viewer the package is still
       // complete and valid; say how to get the page. The page's info panel
       // shows the capture's advice.
       try {
-        WriteViewerPage(web_dir, capture_advice);
+        WriteViewerPage(web_dir, capture_advice, title);
       } catch (const std::exception& e) {
         util::LogWarning(std::string(e.what()) + "; wrote the package without index.html");
       }

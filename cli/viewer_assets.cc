@@ -128,7 +128,14 @@ std::string ViewerPageHtml(const std::string& title, const std::string& viewer_u
          "</html>\n";
 }
 
-void WriteViewerPage(const fs::path& package_dir, const std::vector<std::string>& capture_advice) {
+std::string FolderName(const fs::path& folder) {
+  const fs::path normal = fs::absolute(folder).lexically_normal();
+  const std::string name = normal.filename().string();
+  return name.empty() ? normal.parent_path().filename().string() : name;
+}
+
+void WriteViewerPage(const fs::path& package_dir, const std::vector<std::string>& capture_advice,
+                     const std::string& title) {
   std::error_code ec;
   if (!fs::is_directory(package_dir, ec)) {
     throw std::runtime_error(package_dir.string() + ": not a folder; write the package first");
@@ -143,10 +150,9 @@ void WriteViewerPage(const fs::path& package_dir, const std::vector<std::string>
   }
   if (ec)
     throw std::runtime_error(source.string() + ": cannot list the viewer files: " + ec.message());
-  std::string title = fs::absolute(package_dir).lexically_normal().filename().string();
-  if (title.empty())
-    title = fs::absolute(package_dir).lexically_normal().parent_path().filename().string();
-  WriteFileAtomically(package_dir / "index.html", ViewerPageHtml(title + " - casual3d", "viewer/", capture_advice));
+  const std::string name = title.empty() ? FolderName(package_dir) : title;
+  WriteFileAtomically(package_dir / "index.html",
+                      ViewerPageHtml(name + " - casual3d", "viewer/", capture_advice));
 }
 
 }  // namespace casual3d::cli

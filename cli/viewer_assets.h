@@ -34,11 +34,17 @@ std::string ViewerPageHtml(const std::string& title, const std::string& viewer_u
                            const std::vector<std::string>& capture_advice = {});
 
 // Copies the viewer files into <package_dir>/viewer/ and writes
-// <package_dir>/index.html (with `capture_advice` as above). Files are written
+// <package_dir>/index.html (with `capture_advice` as above), titled `title`
+// (empty: the folder's name). Files are written
 // under temporary names and renamed, so an interrupted run never leaves a
 // half-written file. Throws std::runtime_error naming the file on failure
 // (package_dir must exist).
 void WriteViewerPage(const std::filesystem::path& package_dir,
-                     const std::vector<std::string>& capture_advice = {});
+                     const std::vector<std::string>& capture_advice = {},
+                     const std::string& title = "");
+
+// The name of `folder` as a person reads it: its last component, ignoring a
+// trailing separator and "." ("out/fern/" -> "fern").
+std::string FolderName(const std::filesystem::path& folder);
 
 }  // namespace casual3d::cli

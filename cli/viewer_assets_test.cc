@@ -70,6 +70,15 @@ TEST_F(ViewerAssetsTest, CopiesTheViewerAndWritesTheIndexPage) {
   EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-viewer.js"), "export const v = 2;\n");
 }
 
+TEST_F(ViewerAssetsTest, TitlesThePageAsAsked) {
+  WriteViewerPage(root_ / "package", {}, "fern");
+  EXPECT_NE(Read(root_ / "package" / "index.html").find("<title>fern - casual3d</title>"),
+            std::string::npos);
+  EXPECT_EQ(FolderName(root_ / "out" / "fern" / ""), "fern");
+  EXPECT_EQ(FolderName(root_ / "out" / "fern" / "."), "fern");
+  EXPECT_EQ(FolderName("out/fern"), "fern");
+}
+
 TEST_F(ViewerAssetsTest, EscapesTheTitle) {
   const std::string html = ViewerPageHtml("a<b>&\"c\"", "viewer/");
   EXPECT_NE(html.find("<title>a&lt;b&gt;&amp;&quot;c&quot;</title>"), std::string::npos);

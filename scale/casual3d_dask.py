@@ -136,7 +136,8 @@ def submit_rest(client, cfg, cap, plan_output):
                       key="panorama-%s" % cap.name)
     single = cap.root / "photo.c3d"
     encode = ["encode", str(cap.panorama / "master.exr"), "-o", "{OUT}", "--single-file", "{OUT}/photo.c3d",
-              "--threads", str(cfg.unit_threads)]
+              "--threads", str(cfg.unit_threads), "--capture", str(cap.workspace),
+              "--title", cap.root.name]
     return submit(finish_capture, cfg.casual3d, encode, "%s: encode" % cap.name, str(cap.web), str(single),
                   str(cap.panorama / "master.exr"), str(cap.root / "master.exr"), *([done] if done else []),
                   key="encode-%s" % cap.name)
