@@ -1,6 +1,6 @@
 // `casual3d evaluate <capture> <3d-photo> [more 3d photos] [-o report.html]
 // [--json out.json] [--width 900] [--photos names...] [--holdout-every N]
-// [--labels names...] [--reference NAME:PSNR:SSIM] [--no-viewer-views]
+// [--labels names...] [--reference NAME:PSNR:SSIM] [--no-viewer-views] [--no-backdrop]
 // [--viewer-width 640] [--viewer-height 400] [--viewer-images DIR]
 // [--write-cameras cameras.json] [--rendered DIR]`:
 // virtual rephotography (paper Sec. 6.3) of one or more 3D photos of the same
@@ -35,6 +35,7 @@ void AddEvaluateCommand(CLI::App& app) {
     std::vector<std::string> labels;
     std::vector<std::string> references;
     bool no_viewer_views = false;
+    bool no_backdrop = false;
     std::string viewer_images;
     std::string write_cameras;
   };
@@ -74,6 +75,9 @@ void AddEvaluateCommand(CLI::App& app) {
                   "Published result on the same protocol shown in the report, NAME:PSNR_DB:SSIM "
                   "(repeatable; e.g. LLFF:23.22:0.753)");
   cmd->add_option("--title", args->report.title, "Title of the HTML report")->capture_default_str();
+  cmd->add_flag("--no-backdrop", args->no_backdrop,
+                 "Viewer views: the mesh alone, without the backdrop the viewer draws behind "
+                 "it (format/backdrop.h); the photos are always rendered without it");
   cmd->add_flag("--no-viewer-views", args->no_viewer_views,
                 "Skip the viewer-side measure (tears and stretched fill seen from 17 eyes over "
                 "the viewing volume)");
@@ -102,6 +106,7 @@ void AddEvaluateCommand(CLI::App& app) {
                   "--write-cameras");
   cmd->callback([args] {
     args->options.viewer_views = !args->no_viewer_views;
+    args->options.backdrop = !args->no_backdrop;
     if (const std::string why = args->options.Check(); !why.empty())
       throw std::invalid_argument("evaluate: --" + why);
     if (!args->labels.empty() && args->labels.size() != args->photo3d.size())

@@ -14,6 +14,7 @@
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
 #include "encoder/webp_codec.h"
+#include "format/backdrop.h"
 #include "format/file_source.h"
 #include "format/mesh_builder.h"
 #include "format/package_reader.h"
@@ -330,7 +331,8 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
 
   // The mesh and its atlas, unless every rendering comes from elsewhere.
   const bool render_here = options.rendered_dir.empty();
-  Mesh mesh;
+  Mesh mesh;         // spec/mesh.md's mesh: the rephotographs.
+  Mesh viewer_mesh;  // The mesh with the viewer's backdrop: the viewer views.
   Image8 atlas;
   if (render_here) {
     const auto mesh_start = std::chrono::steady_clock::now();
@@ -339,8 +341,17 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     mesh = std::move(*built);
     atlas = encoder::BuildColourAtlas(photo3d.pano);
     eval.mesh_triangles = mesh.indices.size() / 3;
+    if (options.backdrop && options.viewer_views) {
+      auto backdrop = BuildBackdrop(photo3d.pano);
+      if (!backdrop.ok())
+        throw std::runtime_error(photo3d.source + ": backdrop: " + backdrop.status().message());
+      eval.backdrop_triangles = backdrop->indices.size() / 3;
+      viewer_mesh = mesh;
+      AppendMesh(*backdrop, &viewer_mesh);
+    }
     util::LogInfo("evaluate: " + photo3d_path + ": mesh of " +
-                  std::to_string(eval.mesh_triangles) + " triangles in " +
+                  std::to_string(eval.mesh_triangles) + " triangles (and " +
+                  std::to_string(eval.backdrop_triangles) + " of the backdrop) in " +
                   std::to_string(SecondsSince(mesh_start)) + " s; " +
                   std::to_string(selected.size()) + " photos");
   }
@@ -350,8 +361,10 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     ViewerViewsOptions viewer = options.viewer;
     viewer.num_threads = options.num_threads;
     viewer.keep_images = viewer.keep_images && options.keep_images;
-    eval.viewer =
-        EvaluateViewerViews(photo3d.pano, mesh, std::as_const(atlas).view(), photo3d.pano.view_hints(), viewer);
+    if (options.backdrop) viewer.vertex_colors_from_triangle = eval.mesh_triangles;
+    eval.viewer = EvaluateViewerViews(photo3d.pano, options.backdrop ? viewer_mesh : mesh,
+                                      std::as_const(atlas).view(), photo3d.pano.view_hints(), viewer);
+    viewer_mesh = Mesh();
     util::LogInfo("evaluate: " + photo3d_path + ": 17 viewer views in " +
                   std::to_string(SecondsSince(viewer_start)) + " s");
   }

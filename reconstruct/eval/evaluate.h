@@ -61,6 +61,13 @@ struct EvaluateOptions {
   // views over the viewing volume. Needs the 3D photo only.
   bool viewer_views = true;
   ViewerViewsOptions viewer;
+  // Draw the 3D photo's backdrop (format/backdrop.h) with its mesh in the
+  // viewer views, as the viewer does from inside the viewing volume; false:
+  // the mesh alone. The rephotographs always render the mesh alone
+  // (spec/mesh.md's, as exported): photos' poses can lie outside the volume,
+  // where the backdrop, made for eyes inside it, can hide what lies behind a
+  // near object.
+  bool backdrop = true;
   // Renderings made elsewhere (external_renders.h): when not empty, each
   // evaluated photo's rendering is read from this folder instead of rendered
   // here (no mesh is built: mesh_triangles stays 0), and the viewer views
@@ -109,7 +116,8 @@ struct PhotoModelEvaluation {
   std::string source;      // What was read: "master.exr" path or package path.
   std::string poses_from;  // The sparse model folder used.
   int pano_width = 0, pano_height = 0;
-  size_t mesh_triangles = 0;
+  size_t mesh_triangles = 0;      // spec/mesh.md's mesh.
+  size_t backdrop_triangles = 0;  // The backdrop drawn with it in the viewer views.
   uint64_t package_bytes = 0;  // Of the package next to it (OUT/photo.c3d) or the one read, if any.
   std::vector<PhotoEvaluation> photos;
   // Timings per stage read from ROOT/report.json or panorama.json (seconds).

@@ -159,6 +159,7 @@ ViewerViewsEvaluation EvaluateViewerViews(const TwoLayerPanorama& pano, const Me
   render::RenderOptions render_options;
   render_options.num_threads = options.num_threads;
   render_options.want_triangle_ids = true;
+  render_options.vertex_colors_from_triangle = options.vertex_colors_from_triangle;
   // Clipping planes around the content whatever its unit (models from
   // structure from motion have arbitrary scale), as the viewer sets them.
   double near_m = 0, far_m = 0;

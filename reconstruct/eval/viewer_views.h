@@ -67,6 +67,9 @@ struct ViewerViewsOptions {
   // Keep the rendering and the heatmap of each view (for the report).
   bool keep_images = true;
   int num_threads = 0;  // Rendering threads; 0 = all cores. [0, 256].
+  // Triangles of the mesh from this index on are a backdrop drawn in its
+  // vertex colours (render::RenderOptions::vertex_colors_from_triangle).
+  uint64_t vertex_colors_from_triangle = UINT64_MAX;
 
   std::string Check() const;  // Empty if valid, else "field: reason".
 };

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <functional>
 #include <set>
+#include <utility>
 
+#include "format/backdrop.h"
 #include "format/colour_atlas.h"
 #include "format/mesh_builder.h"
 #include "format/testing/test_panoramas.h"
@@ -226,6 +228,34 @@ TEST(ViewerViewsTest, HoleInsideTheContentTearsTheCentreView) {
   EXPECT_EQ(f.centre_tears, 0.0);
   EXPECT_EQ(f.boundary_tears_max, 0.0);
   EXPECT_EQ(f.boundary_stretched_max, 0.0);
+}
+
+// The same hole with the backdrop drawn behind the mesh (format/backdrop.h),
+// as the viewer draws it: no tear from anywhere in the volume, and the hole
+// shows the backdrop's colour (the sphere's), not the background.
+TEST(ViewerViewsTest, TheBackdropClosesAHoleFromEverywhere) {
+  const int w = 256, h = 128;
+  TwoLayerPanorama pano = testing::MakeSpherePanorama(w, h, 2.0f);
+  for (int y = 58; y < 66; ++y)
+    for (int x = 124; x < 134; ++x) CutLinks(&pano, x, y);
+  MeshAndAtlas m = Build(pano);
+  const size_t mesh_triangles = m.mesh.num_triangles();
+  ViewerViewsOptions options = SmallViews();
+  const ViewerViewsEvaluation torn = EvaluateViewerViews(pano, m.mesh, std::as_const(m.atlas).view(), Ahead(0.2), options);
+  ASSERT_GT(torn.centre_tears, 0.01);
+  const StatusOr<Mesh> backdrop = BuildBackdrop(pano);
+  ASSERT_TRUE(backdrop.ok());
+  AppendMesh(*backdrop, &m.mesh);
+  options.vertex_colors_from_triangle = mesh_triangles;
+  const ViewerViewsEvaluation e = EvaluateViewerViews(pano, m.mesh, std::as_const(m.atlas).view(), Ahead(0.2), options);
+  EXPECT_EQ(e.centre_tears, 0.0);
+  EXPECT_EQ(e.boundary_tears_max, 0.0);
+  EXPECT_EQ(e.boundary_stretched_max, 0.0);
+  // The centre pixel looks into the hole: drawn in the backdrop's colour.
+  const Image8& centre = e.views[0].render;
+  const uint8_t* p = &centre.at(160, 100, 0);
+  const uint8_t* c = &backdrop->colors[0];
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(p[k], c[k], 2) << k;
 }
 
 TEST(ViewerViewsTest, BlackBeyondTheCapturedContentIsNotATear) {

@@ -142,10 +142,14 @@ class Rasterizer {
     });
   }
 
-  ClipVertex LoadVertex(uint32_t index) const {
+  bool UsesAtlas(size_t triangle) const {
+    return options_.color_source == ColorSource::kAtlas && triangle < options_.vertex_colors_from_triangle;
+  }
+
+  ClipVertex LoadVertex(uint32_t index, bool atlas) const {
     ClipVertex v;
     for (int k = 0; k < 3; ++k) v.p[k] = cam_[3 * size_t{index} + k];
-    if (options_.color_source == ColorSource::kAtlas) {
+    if (atlas) {
       v.attr[0] = mesh_.uvs[2 * size_t{index}];
       v.attr[1] = mesh_.uvs[2 * size_t{index} + 1];
       v.attr[2] = v.attr[3] = v.attr[4] = 0.0;
@@ -164,7 +168,7 @@ class Rasterizer {
     int count = 3;
     bool all_inside = true;
     for (int k = 0; k < 3; ++k) {
-      poly[k] = LoadVertex(mesh_.indices[3 * t + k]);
+      poly[k] = LoadVertex(mesh_.indices[3 * t + k], UsesAtlas(t));
       for (int c = 0; c < 3; ++c) {
         if (!std::isfinite(poly[k].p[c])) return 0;
       }
@@ -341,7 +345,7 @@ class Rasterizer {
                     inv_z;
         }
         uint8_t* out = color_->row(j) + 3 * i;
-        if (options_.color_source == ColorSource::kAtlas) {
+        if (UsesAtlas(triangle)) {
           SampleAtlas(attr[0], attr[1], out);
         } else {
           for (int c = 0; c < 3; ++c) {
@@ -421,7 +425,10 @@ void CheckInputs(const Mesh& mesh, ImageView<const uint8_t> atlas, const Pinhole
                                   Dims(atlas.width(), atlas.height()) + " with " +
                                   std::to_string(atlas.channels()) + " channels");
     }
-  } else if (mesh.colors.size() != 3 * n) {
+  }
+  if ((options.color_source != ColorSource::kAtlas ||
+       options.vertex_colors_from_triangle < mesh.num_triangles()) &&
+      mesh.colors.size() != 3 * n) {
     throw std::invalid_argument("mesh: colors has " + std::to_string(mesh.colors.size()) +
                                 " bytes for " + std::to_string(n) + " vertices (need 3 each)");
   }

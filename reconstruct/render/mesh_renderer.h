@@ -45,6 +45,9 @@ enum class ColorSource {
 
 struct RenderOptions {
   ColorSource color_source = ColorSource::kAtlas;
+  // With kAtlas: triangles from this index on take Mesh::colors instead (a
+  // backdrop appended to the mesh, format/backdrop.h, as the viewer draws it).
+  uint64_t vertex_colors_from_triangle = UINT64_MAX;
   // Clipping planes, metres along the optical axis; 0 < near_m < far_m. The
   // defaults are the WebGL viewer's (wasm-viewer/js/camera.js).
   double near_m = 0.05;

@@ -75,6 +75,8 @@ export interface ViewerOptions {
   keepInContent?: boolean;
   /** A blurred continuation of the photo where no surface is; false: black. Default true. */
   softBackground?: boolean;
+  /** Draw the backdrop behind the mesh (a coarse surface at the background's depth), so that tears show the background. Default true. */
+  backdrop?: boolean;
 }
 
 export interface ProgressDetail { loadedBytes: number; totalBytes: number; level: number; levels: number; }

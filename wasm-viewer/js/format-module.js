@@ -163,9 +163,26 @@ export class FormatModule {
    * {positions, normals, uvs, colors, indices, maxRelativeError}.
    */
   buildMesh(pano, { maxTriangles = 0, maxRelativeError = 0 } = {}) {
-    const m = this.m;
-    const handle = m._c3d_build_mesh(pano.ptr, maxTriangles, maxRelativeError);
+    const handle = this.m._c3d_build_mesh(pano.ptr, maxTriangles, maxRelativeError);
     if (!handle) throw this._error('mesh');
+    return this._takeMesh(handle);
+  }
+
+  /**
+   * Builds the backdrop of a panorama (format/backdrop.h): a coarse hole-free
+   * surface behind every node, drawn with the mesh so that its tears show the
+   * background instead of nothing. cellPx: cell side in pixels, 0 for the
+   * library's default. Returns the arrays of buildMesh (maxRelativeError 0).
+   */
+  buildBackdrop(pano, { cellPx = 0 } = {}) {
+    const handle = this.m._c3d_build_backdrop(pano.ptr, cellPx);
+    if (!handle) throw this._error('backdrop');
+    return this._takeMesh(handle);
+  }
+
+  /** Copies a native mesh's arrays out and frees it. */
+  _takeMesh(handle) {
+    const m = this.m;
     try {
       const nv = m._c3d_mesh_num_vertices(handle);
       const ni = m._c3d_mesh_num_indices(handle);

@@ -73,6 +73,8 @@ export class FormatModule {
   /** Threads the library's loops use (1: the single-threaded build). */
   readonly numThreads: number;
   buildMesh(pano: Panorama, options?: MeshOptions): Mesh;
+  /** The backdrop drawn behind the mesh (format/backdrop.h); cellPx 0: the default cell. */
+  buildBackdrop(pano: Panorama, options?: { cellPx?: number }): Mesh;
 }
 
 export class Casual3dPackage {

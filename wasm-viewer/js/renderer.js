@@ -20,16 +20,19 @@ const SCENE_VS = `#version 300 es
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
 layout(location = 2) in vec2 aUv;
+layout(location = 3) in vec4 aColor;  // Alpha 1: drawn in this colour (the backdrop), else textured.
 uniform mat4 uViewProjection;
 uniform mat4 uModel;  // Translation and uniform scale only.
 out vec3 vPosition;
 out vec3 vNormal;
 out vec2 vUv;
+out vec4 vColor;
 void main() {
   vec4 world = uModel * vec4(aPosition, 1.0);
   vPosition = world.xyz;
   vNormal = aNormal;
   vUv = aUv;
+  vColor = aColor;
   gl_Position = uViewProjection * world;
 }`;
 
@@ -59,11 +62,12 @@ precision highp float;
 in vec3 vPosition;
 in vec3 vNormal;
 in vec2 vUv;
+in vec4 vColor;
 uniform sampler2D uAtlas;
 ${LIGHTING}
 out vec4 fragColor;
 void main() {
-  vec3 albedo = texture(uAtlas, vUv).rgb;
+  vec3 albedo = vColor.a > 0.5 ? vColor.rgb : texture(uAtlas, vUv).rgb;
   vec3 color = albedo;
   // Unlit where the node has no normal (sky): interpolated length drops below 0.5.
   if (uLightCount > 0 && length(vNormal) > 0.5) color = shade(albedo, vPosition, vNormal);
@@ -211,23 +215,25 @@ export class Renderer {
     this.texture = null;
   }
 
-  _upload({ positions, normals, uvs, indices }) {
+  _upload({ positions, normals, uvs, colors, indices }) {
     const gl = this.gl;
     const vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
     const buffers = [];
-    const attribute = (location, data, size) => {
+    const attribute = (location, data, size, type = gl.FLOAT, normalized = false) => {
       const b = gl.createBuffer();
       gl.bindBuffer(gl.ARRAY_BUFFER, b);
       gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW);
       gl.enableVertexAttribArray(location);
-      gl.vertexAttribPointer(location, size, gl.FLOAT, false, 0, 0);
+      gl.vertexAttribPointer(location, size, type, normalized, 0, 0);
       buffers.push(b);
     };
     attribute(0, positions, 3);
     attribute(1, normals, 3);
     if (uvs) attribute(2, uvs, 2);
     else gl.vertexAttrib2f(2, 0, 0);
+    if (colors) attribute(3, colors, 4, gl.UNSIGNED_BYTE, true);
+    else gl.vertexAttrib4f(3, 0, 0, 0, 0);
     const ib = gl.createBuffer();
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
@@ -244,7 +250,7 @@ export class Renderer {
 
   /**
    * Replaces the photo's mesh and colour atlas.
-   * @param mesh {positions: Float32Array, normals: Float32Array, uvs: Float32Array, indices: Uint32Array}
+   * @param mesh {positions: Float32Array, normals: Float32Array, uvs: Float32Array, indices: Uint32Array, colors?: Uint8Array (RGBA; alpha 255: a backdrop vertex drawn in its colour)}
    * @param atlas {width, height, data: Uint8Array (RGBA)} or an ImageBitmap
    */
   setMesh(mesh, atlas) {

@@ -43,6 +43,7 @@ export const DEFAULT_OPTIONS = Object.freeze({
   mouseParallax: true,       // Moving the mouse over the view moves the eye.
   keepInContent: true,       // Soft limits keep the view on the captured content.
   softBackground: true,      // A blurred continuation of the photo where no surface is (else black).
+  backdrop: true,            // Draw the backdrop behind the mesh (format/backdrop.h): tears show the background.
 });
 
 /** Radius of the eye's ball before a package's volume is known (unit of the depths). */
@@ -109,6 +110,7 @@ export class Casual3dViewer extends EventTarget {
       this._worker.postMessage({
         type: 'load', id, url: manifestUrl, yawDeg: this.camera.yawDeg,
         maxLevelWidth: this.options.maxLevelWidth, maxTriangles: this.options.maxTriangles,
+        backdrop: this.options.backdrop,
       });
     });
   }

@@ -16,7 +16,7 @@
 // Finer levels are fetched once the page has drawn the first one (it says so
 // with 'shown'), so that nothing competes with the first frame.
 //
-// Messages in:  {type: 'load', id, url, yawDeg, maxLevelWidth, maxTriangles}
+// Messages in:  {type: 'load', id, url, yawDeg, maxLevelWidth, maxTriangles, backdrop}
 //               {type: 'view', yawDeg}
 //               {type: 'shown', id}   (the first level of load `id` is on screen)
 // Messages out: {type: 'progress', id, progress: {loadedBytes, totalBytes, level, levels}}
@@ -75,7 +75,7 @@ self.onmessage = (e) => {
   });
 };
 
-async function load({ id, url, maxLevelWidth, maxTriangles }) {
+async function load({ id, url, maxLevelWidth, maxTriangles, backdrop: withBackdrop = true }) {
   const check = () => {
     if (id !== currentId) throw new Superseded();
   };
@@ -155,11 +155,12 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
         });
         timing.fetchDecodeMs = performance.now() - t0;
         const t1 = performance.now();
-        let mesh, atlas;
+        let mesh, backdrop, atlas;
         try {
           // The full mesh has about 2 triangles per node; simplify above the budget.
           const fullEstimate = 2 * info.width * info.height;
           mesh = format.buildMesh(pano, { maxTriangles: fullEstimate > maxTriangles ? maxTriangles : 0 });
+          if (withBackdrop) backdrop = format.buildBackdrop(pano, { cellPx: backdropCell(info.width, info.height, maxTriangles) });
           atlas = pano.atlas();
         } finally {
           pano.free();
@@ -167,13 +168,18 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
         timing.meshMs = performance.now() - t1;
         check();
         const view = shown === 0 ? viewOfLevel(packageView, mesh, atlas, info.width, info.height) : undefined;
+        if (backdrop) mesh = appendMesh(mesh, backdrop);
         progress(level, true);
         const transfer = [mesh.positions.buffer, mesh.normals.buffer, mesh.uvs.buffer, mesh.indices.buffer, atlas.data.buffer];
+        if (mesh.colors && backdrop) transfer.push(mesh.colors.buffer);
         if (view) transfer.push(view.environment.data.buffer);
         self.postMessage(
           {
             type: 'level', id, level, levels: numLevels, width: info.width, height: info.height, depthFarM,
-            mesh: { positions: mesh.positions, normals: mesh.normals, uvs: mesh.uvs, indices: mesh.indices },
+            mesh: {
+              positions: mesh.positions, normals: mesh.normals, uvs: mesh.uvs, indices: mesh.indices,
+              colors: backdrop ? mesh.colors : undefined,
+            },
             atlas, timing, view,
           },
           transfer,
@@ -191,6 +197,53 @@ async function load({ id, url, maxLevelWidth, maxTriangles }) {
   } finally {
     pkg.close();
   }
+}
+
+/**
+ * The backdrop's cell side for a level: the library's default (0) unless a
+ * backdrop over the whole sphere would then exceed a quarter of the triangle
+ * budget, in which case the smallest cell that keeps it within.
+ */
+function backdropCell(width, height, maxTriangles) {
+  const defaultCell = Math.max(1, Math.round(width / 1024));
+  const fullSphere = (cell) => 2 * Math.ceil(width / cell) * Math.ceil(height / cell);
+  if (!(maxTriangles > 0) || fullSphere(defaultCell) <= maxTriangles / 4) return 0;
+  let cell = defaultCell;
+  while (fullSphere(cell) > maxTriangles / 4 && cell < 256) ++cell;
+  return cell;
+}
+
+/**
+ * The arrays of mesh `a` followed by those of backdrop `b` (b's indices
+ * offset), with per-vertex RGBA colours: alpha 255 marks the backdrop's
+ * vertices, drawn in their own colour; 0 the mesh's, textured from the atlas.
+ */
+function appendMesh(a, b) {
+  const cat = (Type, x, y) => {
+    const out = new Type(x.length + y.length);
+    out.set(x);
+    out.set(y, x.length);
+    return out;
+  };
+  const indices = cat(Uint32Array, a.indices, b.indices);
+  const offset = a.positions.length / 3;
+  for (let i = a.indices.length; i < indices.length; ++i) indices[i] += offset;
+  const nb = b.positions.length / 3;
+  const colors = new Uint8Array(4 * (offset + nb));
+  for (let v = 0; v < nb; ++v) {
+    const o = 4 * (offset + v);
+    colors[o] = b.colors[3 * v];
+    colors[o + 1] = b.colors[3 * v + 1];
+    colors[o + 2] = b.colors[3 * v + 2];
+    colors[o + 3] = 255;
+  }
+  return {
+    positions: cat(Float32Array, a.positions, b.positions),
+    normals: cat(Float32Array, a.normals, b.normals),
+    uvs: cat(Float32Array, a.uvs, b.uvs),
+    colors,
+    indices,
+  };
 }
 
 /**

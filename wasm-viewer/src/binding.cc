@@ -22,6 +22,7 @@
 #include "format/colour_atlas.h"
 #include "format/image.h"
 #include "format/manifest.h"
+#include "format/backdrop.h"
 #include "format/mesh.h"
 #include "format/mesh_builder.h"
 #include "format/mesh_simplify.h"
@@ -179,6 +180,21 @@ EMSCRIPTEN_KEEPALIVE MeshResult* c3d_build_mesh(const Panorama* p, double max_tr
     return r;
   }
   auto mesh = casual3d::BuildMesh(p->pano, options);
+  if (!mesh.ok()) {
+    SetError(mesh.status());
+    return nullptr;
+  }
+  auto* r = new MeshResult();
+  r->mesh = std::move(mesh).value();
+  return r;
+}
+
+// Builds the backdrop drawn behind the mesh (format/backdrop.h) with cells of
+// cell_px pixels (0: the library's default). Null on error.
+EMSCRIPTEN_KEEPALIVE MeshResult* c3d_build_backdrop(const Panorama* p, int cell_px) {
+  casual3d::BackdropOptions options;
+  options.cell_px = cell_px;
+  auto mesh = casual3d::BuildBackdrop(p->pano, options);
   if (!mesh.ok()) {
     SetError(mesh.status());
     return nullptr;

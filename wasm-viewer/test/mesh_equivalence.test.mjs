@@ -1,4 +1,4 @@
-// The wasm mesh builder and simplifier give the same meshes as the native ones:
+// The wasm mesh builder, simplifier and backdrop give the same meshes as the native ones:
 // byte-identical vertices (positions, normals, uvs, colours) and indices. Native meshes come
 // from viewer_mesh_dump (tools/mesh_dump.cc), which also writes the panorama
 // blob the wasm side builds from, so both start from identical bytes. Both wasm
@@ -35,21 +35,24 @@ for (const [kind, w, h] of CASES) {
     const base = path.join(dir, `${kind}_${w}x${h}`);
     const native = parseMeshBlob(fs.readFileSync(`${base}.mesh`));
     const nativeSimplified = parseMeshBlob(fs.readFileSync(`${base}.smesh`));
+    const nativeBackdrop = parseMeshBlob(fs.readFileSync(`${base}.bmesh`));
     const meshes = (f) => {
       const pano = f.parsePanoramaBlob(fs.readFileSync(`${base}.pano`));
       try {
         pano.validate();
-        return [f.buildMesh(pano), f.buildMesh(pano, { maxTriangles: info.budget })];
+        return [f.buildMesh(pano), f.buildMesh(pano, { maxTriangles: info.budget }), f.buildBackdrop(pano)];
       } finally {
         pano.free();
       }
     };
-    const [wasm, wasmSimplified] = meshes(format);
-    const [threaded, threadedSimplified] = meshes(formatThreaded);
+    const [wasm, wasmSimplified, wasmBackdrop] = meshes(format);
+    const [threaded, threadedSimplified, threadedBackdrop] = meshes(formatThreaded);
+    assert.ok(nativeBackdrop.indices.length > 0, 'the native backdrop has triangles');
     assert.ok(native.indices.length > 0, 'the native mesh has triangles');
     assert.ok(nativeSimplified.indices.length < native.indices.length, 'simplification removed triangles');
     for (const [name, a, b] of [['full', wasm, native], ['simplified', wasmSimplified, nativeSimplified],
-      ['full, threaded', threaded, native], ['simplified, threaded', threadedSimplified, nativeSimplified]]) {
+      ['full, threaded', threaded, native], ['simplified, threaded', threadedSimplified, nativeSimplified],
+      ['backdrop', wasmBackdrop, nativeBackdrop], ['backdrop, threaded', threadedBackdrop, nativeBackdrop]]) {
       for (const field of ['positions', 'normals', 'uvs', 'colors', 'indices']) {
         const r = compareArrays(a[field], b[field]);
         assert.ok(r.sameLength, `${name} ${field}: ${a[field].length} (wasm) vs ${b[field].length} (native) elements`);

@@ -7,7 +7,8 @@
 //
 // Writes <out_dir>/<name>_<w>x<h>.pano, .mesh (BuildMesh) and .smesh
 // (BuildSimplifiedMesh with a budget of a quarter of the full mesh's triangles
-// and the default error bound; the budget is printed).
+// and the default error bound; the budget is printed) and .bmesh (BuildBackdrop
+// with its default cell).
 
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "format/backdrop.h"
 #include "format/mesh_builder.h"
 #include "format/mesh_simplify.h"
 #include "format/package_test_scene.h"
@@ -74,11 +76,14 @@ int main(int argc, char** argv) {
   simplify.max_triangles = static_cast<int64_t>(mesh->num_triangles() / 4);
   auto simplified = casual3d::BuildSimplifiedMesh(pano, simplify);
   if (!simplified.ok()) return Fail(kind + ": " + simplified.status().ToString());
+  auto backdrop = casual3d::BuildBackdrop(pano);
+  if (!backdrop.ok()) return Fail(kind + ": " + backdrop.status().ToString());
   const std::string base =
       out_dir + "/" + kind + "_" + std::to_string(width) + "x" + std::to_string(height);
   if (!WriteFile(base + ".pano", casual3d::viewer::SerializePanorama(pano)) ||
       !WriteFile(base + ".mesh", casual3d::viewer::SerializeMesh(*mesh)) ||
-      !WriteFile(base + ".smesh", casual3d::viewer::SerializeMesh(simplified->mesh))) {
+      !WriteFile(base + ".smesh", casual3d::viewer::SerializeMesh(simplified->mesh)) ||
+      !WriteFile(base + ".bmesh", casual3d::viewer::SerializeMesh(*backdrop))) {
     return Fail(out_dir + ": cannot write the blobs (does the folder exist?)");
   }
   std::printf(
