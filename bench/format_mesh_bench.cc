@@ -1,10 +1,11 @@
 // Speed of the data model and mesh construction on a 4096 x 2048 procedural
-// room (spec/mesh.md): validation, the full mesh, and the simplified mesh at
-// the default budget. Run: build/bench/format_mesh_bench
+// room (spec/mesh.md): validation, the full mesh, the simplified mesh at
+// the default budget, and the viewer's backdrop (format/backdrop.h). Run: build/bench/format_mesh_bench
 // (--benchmark_filter=... to pick one).
 
 #include <benchmark/benchmark.h>
 
+#include "format/backdrop.h"
 #include "format/mesh_builder.h"
 #include "format/mesh_simplify.h"
 #include "format/testing/test_panoramas.h"
@@ -70,6 +71,18 @@ BENCHMARK(BM_BuildSimplifiedMesh)
     ->Args({4096, 500000})
     ->ArgNames({"width", "budget"})
     ->Unit(benchmark::kMillisecond);
+
+void BM_BuildBackdrop(benchmark::State& state) {
+  const TwoLayerPanorama& pano = Room(static_cast<int>(state.range(0)));
+  size_t triangles = 0;
+  for (auto _ : state) {
+    auto mesh = BuildBackdrop(pano);
+    if (!mesh.ok()) state.SkipWithError(mesh.status().ToString().c_str());
+    triangles = mesh->num_triangles();
+  }
+  state.counters["triangles"] = static_cast<double>(triangles);
+}
+BENCHMARK(BM_BuildBackdrop)->Arg(1024)->Arg(4096)->ArgName("width")->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace casual3d

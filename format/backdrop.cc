@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -59,39 +60,48 @@ Cells CellFarDepths(const TwoLayerPanorama& pano, int cell, int cells_x, int cel
 }
 
 // For each cell, the index of the cell of largest far depth within `r` cells
-// (square window; columns wrap, rows clamp; the first in scan order among
-// equals), by two separable passes; SIZE_MAX where the window has no node.
+// (square window; columns wrap, rows clamp; the first in row-major order
+// among equals), by two separable passes; SIZE_MAX where the window has no
+// node. A cell is keyed by its far depth's bits (positive floats order as
+// their bits do) above its inverted index, so one integer maximum picks it.
 std::vector<size_t> SpreadFar(const Cells& cells, int r) {
   const int nx = cells.nx, ny = cells.ny;
-  const size_t kNone = SIZE_MAX;
-  auto better = [&](size_t a, size_t b) {  // Whether b beats a.
-    if (b == kNone || cells.far[b] <= 0.0f) return false;
-    return a == kNone || cells.far[b] > cells.far[a] || (cells.far[b] == cells.far[a] && b < a);
-  };
-  std::vector<size_t> rows(cells.far.size(), kNone), out(cells.far.size(), kNone);
+  const size_t n = cells.far.size();
+  std::vector<uint64_t> key(n), rows(n);
+  for (size_t c = 0; c < n; ++c) {
+    uint32_t bits;
+    std::memcpy(&bits, &cells.far[c], sizeof bits);
+    key[c] = cells.far[c] > 0.0f ? (uint64_t{bits} << 32) | (UINT32_MAX - static_cast<uint32_t>(c)) : 0;
+  }
   const int left = std::min(r, nx / 2), right = std::min(r, (nx - 1) / 2);
   for (int y = 0; y < ny; ++y) {
+    const uint64_t* in = &key[static_cast<size_t>(y) * nx];
+    uint64_t* out = &rows[static_cast<size_t>(y) * nx];
     for (int x = 0; x < nx; ++x) {
-      size_t m = kNone;
-      for (int d = -left; d <= right; ++d) {
-        const size_t c = static_cast<size_t>(y) * nx + ((x + d) % nx + nx) % nx;
-        if (better(m, c)) m = c;
+      uint64_t m = 0;
+      if (x - left >= 0 && x + right < nx) {
+        for (int k = x - left; k <= x + right; ++k) m = std::max(m, in[k]);
+      } else {
+        for (int d = -left; d <= right; ++d) m = std::max(m, in[((x + d) % nx + nx) % nx]);
       }
-      rows[static_cast<size_t>(y) * nx + x] = m;
+      out[x] = m;
     }
   }
+  std::vector<uint64_t> column(static_cast<size_t>(nx));
+  std::vector<size_t> result(n, SIZE_MAX);
   for (int y = 0; y < ny; ++y) {
     const int y0 = std::max(0, y - r), y1 = std::min(ny - 1, y + r);
+    std::fill(column.begin(), column.end(), 0);
+    for (int k = y0; k <= y1; ++k) {
+      const uint64_t* row = &rows[static_cast<size_t>(k) * nx];
+      for (int x = 0; x < nx; ++x) column[x] = std::max(column[x], row[x]);
+    }
     for (int x = 0; x < nx; ++x) {
-      size_t m = kNone;
-      for (int k = y0; k <= y1; ++k) {
-        const size_t c = rows[static_cast<size_t>(k) * nx + x];
-        if (better(m, c)) m = c;
-      }
-      out[static_cast<size_t>(y) * nx + x] = m;
+      if (column[x] != 0)
+        result[static_cast<size_t>(y) * nx + x] = UINT32_MAX - static_cast<uint32_t>(column[x] & UINT32_MAX);
     }
   }
-  return out;
+  return result;
 }
 
 }  // namespace
