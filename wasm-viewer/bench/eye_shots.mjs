@@ -12,7 +12,7 @@ import path from 'node:path';
 import { chromium } from 'playwright-core';
 
 import { DIST_DIR } from '../test/node-support.mjs';
-import { chromiumArgs, startServer } from '../test/static-server.mjs';
+import { chromiumArgs, startServer, viewerCorePage } from '../test/static-server.mjs';
 
 const [pkg, out] = process.argv.slice(2, 4);
 if (!pkg || !out) throw new Error('usage: eye_shots.mjs <package_dir> <out_dir> [width] [height]');
@@ -20,17 +20,7 @@ if (!fs.existsSync(path.join(pkg, 'manifest.json'))) throw new Error(`${pkg}: no
 const W = Number(process.argv[4] ?? 960), H = Number(process.argv[5] ?? 540);
 fs.mkdirSync(out, { recursive: true });
 
-const page = (options) => `<!DOCTYPE html><html><head><meta charset="utf-8">
-<style>html,body{margin:0}#c{width:${W}px;height:${H}px}</style></head><body><div id="c"></div>
-<script type="module">
-  import { Casual3dViewer } from '/viewer/viewer-core.js';
-  const v = new Casual3dViewer(document.getElementById('c'), ${JSON.stringify(options)});
-  window.viewer = v;
-  window.loaded = v.load('/pkg/manifest.json').then(() => new Promise((resolve) => {
-    v.addEventListener('load', resolve);
-    v.addEventListener('error', resolve);
-  }));
-</script></body></html>`;
+const page = (options) => viewerCorePage(options, W, H);
 
 const server = await startServer({ '/viewer/': DIST_DIR, '/pkg/': pkg }, {
   '/with.html': page({ mouseParallax: false }), '/without.html': page({ mouseParallax: false, backdrop: false }),

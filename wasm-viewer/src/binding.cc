@@ -81,10 +81,22 @@ std::string JsonString(const std::string& s) {
   return out + "\"";
 }
 
+// A built mesh as a MeshResult, or null with the error recorded.
+MeshResult* TakeMesh(StatusOr<Mesh> mesh) {
+  if (!mesh.ok()) {
+    SetError(mesh.status());
+    return nullptr;
+  }
+  auto* r = new MeshResult();
+  r->mesh = std::move(mesh).value();
+  return r;
+}
+
 }  // namespace
 }  // namespace casual3d::viewer
 
 using casual3d::viewer::MeshResult;
+using casual3d::viewer::TakeMesh;
 using casual3d::viewer::Panorama;
 using casual3d::viewer::Reader;
 using casual3d::viewer::SetError;
@@ -179,14 +191,7 @@ EMSCRIPTEN_KEEPALIVE MeshResult* c3d_build_mesh(const Panorama* p, double max_tr
     r->max_error = simplified->error_bound;
     return r;
   }
-  auto mesh = casual3d::BuildMesh(p->pano, options);
-  if (!mesh.ok()) {
-    SetError(mesh.status());
-    return nullptr;
-  }
-  auto* r = new MeshResult();
-  r->mesh = std::move(mesh).value();
-  return r;
+  return TakeMesh(casual3d::BuildMesh(p->pano, options));
 }
 
 // Builds the backdrop drawn behind the mesh (format/backdrop.h) with cells of
@@ -194,14 +199,7 @@ EMSCRIPTEN_KEEPALIVE MeshResult* c3d_build_mesh(const Panorama* p, double max_tr
 EMSCRIPTEN_KEEPALIVE MeshResult* c3d_build_backdrop(const Panorama* p, int cell_px) {
   casual3d::BackdropOptions options;
   options.cell_px = cell_px;
-  auto mesh = casual3d::BuildBackdrop(p->pano, options);
-  if (!mesh.ok()) {
-    SetError(mesh.status());
-    return nullptr;
-  }
-  auto* r = new MeshResult();
-  r->mesh = std::move(mesh).value();
-  return r;
+  return TakeMesh(casual3d::BuildBackdrop(p->pano, options));
 }
 
 EMSCRIPTEN_KEEPALIVE void c3d_mesh_free(MeshResult* m) { delete m; }

@@ -125,3 +125,23 @@ export function viewerPage(src, { width = 640, height = 400, maxLevelWidth = 409
 <script type="module" src="/viewer/casual3d-viewer.js"></script>
 </head><body><casual3d-viewer id="v" src="${src}" max-level-width="${maxLevelWidth}" ${attributes}></casual3d-viewer></body></html>`;
 }
+
+/**
+ * A page with one Casual3dViewer (viewer-core.js, no custom element) built
+ * with `options` in a width x height box, opening /pkg/manifest.json;
+ * window.viewer is the viewer and window.loaded settles once the first level
+ * is shown (or loading failed). The browser benchmarks load it.
+ */
+export function viewerCorePage(options, width, height) {
+  return `<!DOCTYPE html><html><head><meta charset="utf-8">
+<style>html,body{margin:0}#c{width:${width}px;height:${height}px}</style></head><body><div id="c"></div>
+<script type="module">
+  import { Casual3dViewer } from '/viewer/viewer-core.js';
+  const v = new Casual3dViewer(document.getElementById('c'), ${JSON.stringify(options)});
+  window.viewer = v;
+  window.loaded = v.load('/pkg/manifest.json').then(() => new Promise((resolve) => {
+    v.addEventListener('load', resolve);
+    v.addEventListener('error', resolve);
+  }));
+</script></body></html>`;
+}
