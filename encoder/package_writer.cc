@@ -11,6 +11,7 @@
 #include <system_error>
 #include <thread>
 
+#include "encoder/absent_fill.h"
 #include "encoder/level_of_detail.h"
 #include "encoder/webp_codec.h"
 #include "format/sha256.h"
@@ -100,6 +101,7 @@ PackageOptions DeliveryPackageOptions() {
   options.depth_bits = 10;
   options.lossless_method = 4;
   options.lossless_effort = 75.0f;
+  options.fill_absent = true;
   return options;
 }
 
@@ -186,13 +188,17 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
       Job& job = jobs[j];
       int x, y, w, h;
       manifest.TileRect(job.level, job.tile, &x, &y, &w, &h);
-      const Image8 image =
+      Image8 image =
           EncodeTileImage(*level_pano[job.level], x, y, w, h, job.kind, manifest.quantization());
+      if (options.fill_absent &&
+          (job.kind == TileImageKind::kDepth || job.kind == TileImageKind::kNormal))
+        FillAbsentCodes(*level_pano[job.level], x, y, w, h, &image);
       WebpEncodeOptions webp;
       webp.lossless = TileImageIsLossless(job.kind);
       webp.quality = webp.lossless ? options.lossless_effort : options.color_quality;
       webp.method = webp.lossless ? options.lossless_method : options.color_method;
-      StatusOr<std::vector<uint8_t>> bytes = EncodeWebp(image.view(), webp);
+      StatusOr<std::vector<uint8_t>> bytes =
+          EncodeWebp(static_cast<const Image8&>(image).view(), webp);
       if (!bytes.ok()) {
         std::lock_guard<std::mutex> lock(error_mutex);
         if (!failed.exchange(true))

@@ -173,6 +173,7 @@ TEST_F(PackageWriterTest, DeliveryOptionsKeepTheirBoundsAndShrinkThePackage) {
   ASSERT_TRUE(options_.Check().ok());
   const PackageFiles files = Encode(&delivery_stats);
   EXPECT_LT(delivery_stats.total_bytes, exact_stats.total_bytes * 3 / 4);
+  EXPECT_TRUE(options_.fill_absent);
   MemoryFileSource source;
   for (const auto& [path, bytes] : files) source.Add(path, bytes);
   TwoLayerPanorama expected = pano_;
@@ -189,6 +190,64 @@ TEST_F(PackageWriterTest, DeliveryOptionsKeepTheirBoundsAndShrinkThePackage) {
     const double min_psnr[3] = {37.5, 35.5, 33.5};
     ExpectDecodedMatches(expected, *decoded, manifest.depth, min_psnr[level], 8.1);
     if (level < 2) expected = *HalvePanorama(expected);
+  }
+}
+
+// Bytes of the tile files whose name ends in `suffix`.
+uint64_t BytesOfKind(const PackageFiles& files, const std::string& suffix) {
+  uint64_t sum = 0;
+  for (const auto& [path, bytes] : files)
+    if (path.size() > suffix.size() &&
+        path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0)
+      sum += bytes.size();
+  return sum;
+}
+
+TEST_F(PackageWriterTest, FilledAbsentNodesDecodeToTheSamePanoramaInFewerBytes) {
+  const PackageFiles zeros = Encode();
+  options_.fill_absent = true;
+  const PackageFiles filled = Encode();
+  // The back layer is a disc: its depth and normal tiles hold edges between
+  // present and absent nodes, which filling makes cheaper (here by 2-3%, the
+  // codes being smooth; 5-7% on reconstructions).
+  for (const char* kind : {".depth.webp", ".normal.webp"})
+    EXPECT_LT(BytesOfKind(filled, kind), BytesOfKind(zeros, kind) * 99 / 100) << kind;
+  EXPECT_EQ(BytesOfKind(filled, ".graph.webp"), BytesOfKind(zeros, ".graph.webp"));
+  // Every absent back node of the filled depth tile of level 0, row 0, column
+  // 1 (beside the centre, holding part of the disc) carries a code.
+  const std::vector<uint8_t>* depth_tile = nullptr;
+  for (const auto& [path, bytes] : filled)
+    if (path == "l0/0-1.depth.webp") depth_tile = &bytes;
+  ASSERT_NE(depth_tile, nullptr);
+  StatusOr<Image8> image = DecodeWebp(depth_tile->data(), depth_tile->size());
+  ASSERT_TRUE(image.ok()) << image.status().ToString();
+  int absent = 0, absent_with_code = 0;
+  for (int y = 0; y < options_.tile_size; ++y)
+    for (int x = 0; x < options_.tile_size; ++x) {
+      if (pano_.present(kBack, options_.tile_size + x, y)) continue;
+      ++absent;
+      const uint8_t* px = &image->at(x, options_.tile_size + y);
+      absent_with_code += (px[0] | px[1]) != 0;
+    }
+  ASSERT_GT(absent, 0);
+  EXPECT_EQ(absent_with_code, absent);
+  // Every level decodes to exactly what the zero-filled package gives.
+  MemoryFileSource zero_source, filled_source;
+  for (const auto& [path, bytes] : zeros) zero_source.Add(path, bytes);
+  for (const auto& [path, bytes] : filled) filled_source.Add(path, bytes);
+  for (int level = 0; level < 3; ++level) {
+    ReadOptions read;
+    read.level = level;
+    StatusOr<TwoLayerPanorama> a = ReadPackage(zero_source, decoder_, read);
+    StatusOr<TwoLayerPanorama> b = ReadPackage(filled_source, decoder_, read);
+    ASSERT_TRUE(a.ok() && b.ok());
+    for (int l = 0; l < kNumLayers; ++l) {
+      EXPECT_EQ(a->layer(l).present, b->layer(l).present);
+      EXPECT_EQ(a->layer(l).links, b->layer(l).links);
+      EXPECT_EQ(a->layer(l).depth_m, b->layer(l).depth_m);
+      EXPECT_EQ(a->layer(l).normal, b->layer(l).normal);
+      EXPECT_EQ(a->layer(l).rgb, b->layer(l).rgb);
+    }
   }
 }
 
