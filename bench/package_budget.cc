@@ -9,9 +9,13 @@
 // side-by-side Lambert shading of the front layer's normals (reference |
 // candidate), the effect the viewer's lights have.
 //
+// Also prints the candidate as a row of docs/PERFORMANCE.md's table, and can
+// write the candidate package as a folder (for `casual3d evaluate`).
+//
 //   build/bench/package_budget MASTER.exr [--normal-bits B] [--depth-bits B]
-//       [--lossless-effort F] [--lossless-method M] [--reference-only]
-//       [--shading out.png]
+//       [--lossless-effort F] [--lossless-method M] [--tile-size T]
+//       [--color-quality Q] [--color-method M] [--no-fill-absent]
+//       [--reference-only] [--shading out.png] [--write-package DIR]
 
 #include <algorithm>
 #include <chrono>
@@ -91,6 +95,24 @@ void PrintSizes(const char* name, const Encoded& e) {
   }
 }
 
+// The row of docs/PERFORMANCE.md, "Package size of reconstructions": level 0
+// by kind, level 0, the other levels, the whole package (KB).
+void PrintTableRow(const Encoded& e) {
+  std::printf("table row: | ");
+  const char* sep = "";
+  for (const char* kind : {"color", "depth", "normal", "graph"}) {
+    std::printf("%s%.0f", sep, KindBytes(e.files, 0, kind) / 1024.0);
+    sep = " / ";
+  }
+  std::printf(" | %.0f | ", e.stats.level_bytes[0] / 1024.0);
+  sep = "";
+  for (size_t l = 1; l < e.stats.level_bytes.size(); ++l) {
+    std::printf("%s%.0f", sep, e.stats.level_bytes[l] / 1024.0);
+    sep = " / ";
+  }
+  std::printf(" | **%.0f** |\n", e.stats.total_bytes / 1024.0);
+}
+
 double Percentile(std::vector<float>* values, double p) {
   if (values->empty()) return 0;
   const size_t k = std::min(values->size() - 1, static_cast<size_t>(p * values->size()));
@@ -156,12 +178,13 @@ void Shade(const TwoLayerPanorama& pano, int x0, Image8* out) {
 int Main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: package_budget MASTER.exr [--normal-bits B] [--depth-bits B] "
-                         "[--lossless-effort F] "
-                         "[--lossless-method M] [--reference-only] [--shading out.png]\n");
+                         "[--lossless-effort F] [--lossless-method M] [--tile-size T] "
+                         "[--color-quality Q] [--color-method M] [--no-fill-absent] "
+                         "[--reference-only] [--shading out.png] [--write-package DIR]\n");
     return 2;
   }
   encoder::PackageOptions candidate = encoder::DeliveryPackageOptions();
-  std::string shading;
+  std::string shading, package_dir;
   bool reference_only = false;
   for (int a = 2; a < argc; ++a) {
     const std::string arg = argv[a];
@@ -171,7 +194,12 @@ int Main(int argc, char** argv) {
     else if (arg == "--depth-bits" && has_value) candidate.depth_bits = std::atoi(argv[++a]);
     else if (arg == "--lossless-effort" && has_value) candidate.lossless_effort = static_cast<float>(std::atof(argv[++a]));
     else if (arg == "--lossless-method" && has_value) candidate.lossless_method = std::atoi(argv[++a]);
+    else if (arg == "--tile-size" && has_value) candidate.tile_size = std::atoi(argv[++a]);
+    else if (arg == "--color-quality" && has_value) candidate.color_quality = static_cast<float>(std::atof(argv[++a]));
+    else if (arg == "--color-method" && has_value) candidate.color_method = std::atoi(argv[++a]);
+    else if (arg == "--no-fill-absent") candidate.fill_absent = false;
     else if (arg == "--shading" && has_value) shading = argv[++a];
+    else if (arg == "--write-package" && has_value) package_dir = argv[++a];
     else {
       std::fprintf(stderr, "package_budget: unknown or incomplete option %s\n", arg.c_str());
       return 2;
@@ -193,10 +221,20 @@ int Main(int argc, char** argv) {
   }
   PrintSizes("reference", reference);
   const Encoded encoded = EncodeAndDecode(*master, candidate);
-  std::printf("candidate: normal bits %d, depth bits %d, lossless effort %g method %d\n",
+  std::printf("candidate: normal bits %d, depth bits %d, lossless effort %g method %d, "
+              "tile size %d, colour quality %g method %d, absent nodes %s\n",
               candidate.normal_bits, candidate.depth_bits, candidate.lossless_effort,
-              candidate.lossless_method);
+              candidate.lossless_method, candidate.tile_size, candidate.color_quality,
+              candidate.color_method, candidate.fill_absent ? "filled" : "zero");
   PrintSizes("candidate", encoded);
+  PrintTableRow(encoded);
+  if (!package_dir.empty()) {
+    if (Status s = encoder::WritePackageFolder(encoded.files, package_dir); !s.ok()) {
+      std::fprintf(stderr, "package_budget: %s\n", s.ToString().c_str());
+      return 1;
+    }
+    std::printf("wrote %s\n", package_dir.c_str());
+  }
   for (size_t l = 0; l < encoded.levels.size(); ++l)
     PrintErrors(static_cast<int>(l), reference.levels[l], encoded.levels[l],
                 l == 0 ? &*master : nullptr);
