@@ -37,7 +37,7 @@ struct PackageOptions {
   int normal_bits = 8;
   // Fill the depth and normal codes of absent nodes with codes of nearby
   // present nodes (absent_fill.h) instead of zeros: the decoded panorama is
-  // the same, the lossless tiles smaller (4-7% on reconstructions). Off by
+  // the same, the lossless tiles smaller (4-9% on reconstructions). Off by
   // default so that archives and the spec's vectors keep their bytes.
   bool fill_absent = false;
   // Threads encoding tiles; 0 = all cores.
