@@ -70,14 +70,6 @@ float WindowCost(const Context& ctx, const Neighbor& nb, int x, int y, float inv
 
 }  // namespace
 
-Status ContinuousRefineOptions::Check() const {
-  if (!(search_labels > 0 && search_labels <= 4)) return InvalidArgument("refine search_labels outside (0, 4]");
-  if (!(coarse_step > 0 && coarse_step <= search_labels))
-    return InvalidArgument("refine coarse_step outside (0, search_labels]");
-  if (!(min_weight >= 0 && min_weight <= 1)) return InvalidArgument("refine min_weight outside [0, 1]");
-  return Status::Ok();
-}
-
 std::vector<float> RefineContinuous(const DenseView& ref, const std::vector<const DenseView*>& neighbors,
                                     const CostVolume& volume, const std::vector<int>& labels,
                                     const std::vector<float>& start, const SweepOptions& sweep,

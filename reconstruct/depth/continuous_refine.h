@@ -29,6 +29,7 @@
 #include "format/status.h"
 #include "reconstruct/depth/plane_sweep.h"
 #include "reconstruct/depth/view.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -41,7 +42,16 @@ struct ContinuousRefineOptions {
   double coarse_step = 0.25;   // Grid step of the first search, labels. (0, search_labels].
   double min_weight = 0.1;     // Pixels with lower w_photo keep their value. [0, 1].
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("enabled", o.enabled, R::Any(), "Continuous depth search around each MRF label");
+    v.Field("search_labels", o.search_labels, R::OpenClosed(0, 4), "Half-width of the search around the MRF label, labels");
+    v.Field("coarse_step", o.coarse_step, R::Above(0), "Grid step of the first search, labels");
+    v.Field("min_weight", o.min_weight, R::Closed(0, 1), "Pixels with a lower w_photo keep their value");
+    v.Require(o.coarse_step <= o.search_labels, "coarse_step", "must not exceed search_labels");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // `start` holds per pixel the fractional label to refine (for example

@@ -1,6 +1,7 @@
 #include "reconstruct/depth/dense_report.h"
 
 #include "reconstruct/io/file_util.h"
+#include "reconstruct/util/options_json.h"
 
 namespace casual3d::depth {
 
@@ -55,6 +56,7 @@ void WriteDenseJson(const std::string& path, const DenseReport& report, const De
   j["working_scale"] = options.working_scale;
   j["continuous_refine"] = options.refine.enabled;
   j["cross_view_consistency"] = report.cross_view_consistency;
+  j["options"] = util::FieldsJson(options);  // Every option (dense_stage.h).
   if (report.evaluated) {
     j["accuracy"] = {{"median_rel_error", report.median_rel_error},
                      {"within_3pct", report.within_3pct},

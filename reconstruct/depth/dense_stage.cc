@@ -12,36 +12,6 @@
 namespace casual3d::depth {
 namespace fs = std::filesystem;
 
-Status MrfTermOptions::Check() const {
-  if (!(lambda_smooth >= 0 && lambda_smooth <= 100)) return InvalidArgument("lambda_smooth outside [0, 100]");
-  if (!(lambda_near >= 0 && lambda_near <= 100)) return InvalidArgument("lambda_near outside [0, 100]");
-  if (!(sigma_color > 0 && sigma_color <= 10)) return InvalidArgument("mrf sigma_color outside (0, 10]");
-  if (!(color_floor >= 0 && color_floor <= 1)) return InvalidArgument("mrf color_floor outside [0, 1]");
-  if (!(far_bias >= 0 && far_bias <= 1)) return InvalidArgument("mrf far_bias outside [0, 1]");
-  if (truncation_labels < 1 || truncation_labels > 4096)
-    return InvalidArgument("truncation_labels outside [1, 4096]");
-  if (max_iterations < 1 || max_iterations > 1000) return InvalidArgument("mrf max_iterations outside [1, 1000]");
-  if (!(lambda_flat >= 0 && lambda_flat <= 100)) return InvalidArgument("lambda_flat outside [0, 100]");
-  if (!(flat_truncation_labels >= 1 && flat_truncation_labels <= 100))
-    return InvalidArgument("flat_truncation_labels outside [1, 100]");
-  return Status::Ok();
-}
-
-Status DenseOptions::Check() const {
-  if (!(working_scale > 0 && working_scale <= 1)) return InvalidArgument("working_scale outside (0, 1]");
-  if (num_neighbors < 1 || num_neighbors > 16)
-    return InvalidArgument("num_neighbors " + std::to_string(num_neighbors) + " outside [1, 16]");
-  if (!(reference_diagonal > 0)) return InvalidArgument("reference_diagonal must be > 0");
-  if (!(min_far_over_near >= 1 && min_far_over_near <= 1e6))
-    return InvalidArgument("min_far_over_near outside [1, 1e6]");
-  if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
-  for (const Status& s : {neighbors.Check(), sweep.Check(), gc.Check(), prune.Check(), envelope.Check(),
-                          mrf.Check(), edge_median.Check(), sublabel.Check(), refine.Check(), upsample.Check(),
-                          fullres.Check(), relabel.Check(), flat.Check(), visibility.Check()})
-    if (!s.ok()) return s;
-  return Status::Ok();
-}
-
 DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& out_dir,
                           const DenseOptions& options) {
   const Status st = options.Check();

@@ -46,6 +46,7 @@
 #include "reconstruct/depth/sublabel_refine.h"
 #include "reconstruct/depth/upsample.h"
 #include "reconstruct/depth/visibility_filter.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -74,7 +75,21 @@ struct MrfTermOptions {
   double lambda_flat = 0.3;
   double flat_truncation_labels = 4.0;
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("lambda_smooth", o.lambda_smooth, R::Closed(0, 100), "Smoothness weight (Eq. 1, Sec. 4.3.1)");
+    v.Field("lambda_near", o.lambda_near, R::Closed(0, 100), "Near envelope penalty (Eq. 4, Sec. 4.3.2)");
+    v.Field("sigma_color", o.sigma_color, R::OpenClosed(0, 10), "w_color colour sigma, colour in [0, 1]");
+    v.Field("color_floor", o.color_floor, R::Closed(0, 1), "Lower bound of w_color");
+    v.Field("far_bias", o.far_bias, R::Closed(0, 1), "Cost leaning textureless pixels away from the camera (MRF data term)");
+    v.Field("truncation_labels", o.truncation_labels, R::Closed(1, 4096), "Smoothness truncation T, labels");
+    v.Field("max_iterations", o.max_iterations, R::Closed(1, 1000),
+            "Most TRW-S passes (each forward and backward); fewer is faster, at a higher energy");
+    v.Field("lambda_flat", o.lambda_flat, R::Closed(0, 100), "Weight of the textureless-region prior in the MRF data term");
+    v.Field("flat_truncation_labels", o.flat_truncation_labels, R::Closed(1, 100), "Truncation T_flat of that prior, labels");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct DenseOptions {
@@ -120,7 +135,40 @@ struct DenseOptions {
   // to evaluate against (reported in dense.json).
   std::string ground_truth_dir;
 
-  Status Check() const;
+  // Every field of this struct and of the structs nested in it is described
+  // here (reconstruct/util/options_fields.h): the checks, the pipeline's cache
+  // key, dense.json's "options" and the dense command's help come from it.
+  // dense_options_test fails when a field is missing.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("working_scale", o.working_scale, R::OpenClosed(0, 1), "Sweep/MRF resolution relative to the photos");
+    v.Field("num_neighbors", o.num_neighbors, R::Closed(1, 16), "Neighbour photos per sweep");
+    v.Field("reference_diagonal", o.reference_diagonal, R::Above(0), "Image diagonal the filter sizes are given for, pixels");
+    v.Field("min_far_over_near", o.min_far_over_near, R::Closed(1, 1e6),
+            "The sweep's far plane is at least this many times farther than its near plane");
+    v.Struct("neighbors", o.neighbors);
+    v.Struct("sweep", o.sweep);
+    v.Struct("gc", o.gc);
+    v.Struct("prune", o.prune);
+    v.Struct("envelope", o.envelope);
+    v.Struct("mrf", o.mrf);
+    v.Struct("edge_median", o.edge_median);
+    v.Struct("sublabel", o.sublabel);
+    v.Struct("refine", o.refine);
+    v.Struct("upsample", o.upsample);
+    v.Struct("relabel", o.relabel);
+    v.Struct("fullres", o.fullres);
+    v.Struct("flat", o.flat);
+    v.Struct("visibility", o.visibility);
+    v.Field("use_near_envelope", o.use_near_envelope, R::Any(), "MRF with the near envelope term (Eq. 4)");
+    v.Field("use_gc_filter", o.use_gc_filter, R::Any(), "Build anchors with the GC filter");
+    v.Field("debug", o.debug, R::Any(), "Also write colour-mapped PNGs of every step to OUT/debug/");
+    v.Field("num_threads", o.num_threads, R::AtLeast(0), "Worker threads; 0 = all cores", util::Keyed::kNo);
+    v.Field("ground_truth_dir", o.ground_truth_dir, R::Any(),
+            "Folder of ground-truth depth <stem>.exr to evaluate against; results go to dense.json");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct StageQuality {

@@ -11,15 +11,6 @@
 
 namespace casual3d::depth {
 
-Status EdgeMedianOptions::Check() const {
-  if (radius < 0 || radius > 32) return InvalidArgument("edge median radius outside [0, 32]");
-  if (!(sigma_spatial > 0 && sigma_spatial <= 64))
-    return InvalidArgument("edge median sigma_spatial outside (0, 64]");
-  if (!(sigma_color > 0 && sigma_color <= 10))
-    return InvalidArgument("edge median sigma_color outside (0, 10]");
-  return Status::Ok();
-}
-
 namespace {
 
 // Filters row y of `labels` into `out`. hist (num_labels zeros, left zeroed)

@@ -20,6 +20,7 @@
 
 #include "format/image.h"
 #include "format/status.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -31,7 +32,14 @@ struct EdgeMedianOptions {
   double sigma_spatial = 8.0;  // Spatial Gaussian sigma, working pixels. (0, 64].
   double sigma_color = 0.05;   // Colour affinity sigma, colour in [0, 1]. (0, 10].
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("radius", o.radius, R::Closed(0, 32), "Edge-aware median window radius, working pixels; 0 = off");
+    v.Field("sigma_spatial", o.sigma_spatial, R::OpenClosed(0, 64), "Edge-aware median spatial sigma, working pixels");
+    v.Field("sigma_color", o.sigma_color, R::OpenClosed(0, 10), "Edge-aware median colour sigma, colour in [0, 1]");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // `labels` (width * height, row-major, values in [0, num_labels)) and `color`

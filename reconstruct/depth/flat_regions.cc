@@ -412,34 +412,6 @@ PlaneFit FitPlane(const std::vector<EdgePoint>& pts, const GroupShape& shape, co
 
 }  // namespace
 
-Status FlatRegionOptions::Check() const {
-  if (!(max_photo_weight >= 0 && max_photo_weight <= 1)) return InvalidArgument("flat max_photo_weight outside [0, 1]");
-  if (!(color_step > 0 && color_step <= 1)) return InvalidArgument("flat color_step outside (0, 1]");
-  if (!(color_spread > 0 && color_spread <= 1)) return InvalidArgument("flat color_spread outside (0, 1]");
-  if (!(min_area_fraction >= 0 && min_area_fraction <= 1))
-    return InvalidArgument("flat min_area_fraction outside [0, 1]");
-  if (!(extend_max_photo_weight >= 0 && extend_max_photo_weight <= 1))
-    return InvalidArgument("flat extend_max_photo_weight outside [0, 1]");
-  if (min_region_pixels < 1 || min_region_pixels > 1000000)
-    return InvalidArgument("flat min_region_pixels outside [1, 1e6]");
-  if (merge_gap < 0 || merge_gap > 256) return InvalidArgument("flat merge_gap outside [0, 256]");
-  if (!(merge_color >= 0 && merge_color <= 1)) return InvalidArgument("flat merge_color outside [0, 1]");
-  if (!(edge_contrast >= 0 && edge_contrast <= 3)) return InvalidArgument("flat edge_contrast outside [0, 3]");
-  if (!(edge_tau > 0 && edge_tau <= 3)) return InvalidArgument("flat edge_tau outside (0, 3]");
-  if (max_edge_points < 10 || max_edge_points > 1000000)
-    return InvalidArgument("flat max_edge_points outside [10, 1e6]");
-  if (!(touch_labels > 0 && touch_labels <= 100)) return InvalidArgument("flat touch_labels outside (0, 100]");
-  if (!(behind_fraction >= 0 && behind_fraction <= 1)) return InvalidArgument("flat behind_fraction outside [0, 1]");
-  if (min_touching < 3 || min_touching > 1000000) return InvalidArgument("flat min_touching outside [3, 1e6]");
-  if (min_side_points < 1 || min_side_points > 1000000) return InvalidArgument("flat min_side_points outside [1, 1e6]");
-  if (adopt_distance < 0 || adopt_distance > 1000000) return InvalidArgument("flat adopt_distance outside [0, 1e6]");
-  if (min_owned < 1 || min_owned > 1000000) return InvalidArgument("flat min_owned outside [1, 1e6]");
-  if (!(owned_margin >= 0 && owned_margin <= 1000)) return InvalidArgument("flat owned_margin outside [0, 1000]");
-  if (!(min_touching_fraction >= 0 && min_touching_fraction <= 1))
-    return InvalidArgument("flat min_touching_fraction outside [0, 1]");
-  return Status::Ok();
-}
-
 std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_weight,
                                     const PinholeCamera& camera, const ImageF& anchors,
                                     const std::vector<FlatRegionNeighbor>& neighbors,

@@ -42,6 +42,7 @@
 #include "format/status.h"
 #include "reconstruct/depth/plane_sweep.h"
 #include "reconstruct/depth/view.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -69,7 +70,32 @@ struct FlatRegionOptions {
   int min_side_points = 5;        // Touching points on a side that counts as holding the region. [1, 1e6].
   int adopt_distance = 48;        // Pixels between the boxes of groups that share a plane. [0, 1e6].
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("enabled", o.enabled, R::Any(), "Depth priors for textureless regions from their silhouettes");
+    v.Field("max_photo_weight", o.max_photo_weight, R::Closed(0, 1), "Flat pixels have a w_photo below this");
+    v.Field("color_step", o.color_step, R::OpenClosed(0, 1), "Region growing: RGB distance between 4-neighbours");
+    v.Field("color_spread", o.color_spread, R::OpenClosed(0, 1), "Region growing: RGB distance to the region's mean");
+    v.Field("min_area_fraction", o.min_area_fraction, R::Closed(0, 1), "Smallest group, fraction of the image's pixels");
+    v.Field("extend_max_photo_weight", o.extend_max_photo_weight, R::Closed(0, 1),
+            "A fitted plane also covers connected pixels of its colour with w_photo below this");
+    v.Field("min_region_pixels", o.min_region_pixels, R::Closed(1, 1e6), "Smaller regions are not segmented, pixels");
+    v.Field("merge_gap", o.merge_gap, R::Closed(0, 256), "Regions this close (pixels) with similar colour join");
+    v.Field("merge_color", o.merge_color, R::Closed(0, 1), "Similar colour for merging: RGB distance of the means");
+    v.Field("edge_contrast", o.edge_contrast, R::Closed(0, 3), "A boundary point's outside differs this much (RGB L1)");
+    v.Field("edge_tau", o.edge_tau, R::OpenClosed(0, 3), "Colour difference (RGB L1) counting fully in the edge test");
+    v.Field("max_edge_points", o.max_edge_points, R::Closed(10, 1e6), "Boundary points tested per group");
+    v.Field("touch_labels", o.touch_labels, R::OpenClosed(0, 100), "A point touches the plane within this many labels");
+    v.Field("behind_fraction", o.behind_fraction, R::Closed(0, 1), "The plane lies behind at least this fraction of the points");
+    v.Field("min_touching", o.min_touching, R::Closed(3, 1e6), "Touching points a fit needs (owned ones count twice)");
+    v.Field("min_owned", o.min_owned, R::Closed(1, 1e6), "Owned (silhouette) points among them");
+    v.Field("owned_margin", o.owned_margin, R::Closed(0, 1000), "The surface beyond a silhouette is this many labels farther");
+    v.Field("min_touching_fraction", o.min_touching_fraction, R::Closed(0, 1), "Touching points, fraction of the group's points");
+    v.Field("min_side_points", o.min_side_points, R::Closed(1, 1e6), "Touching points on a side that holds the region");
+    v.Field("adopt_distance", o.adopt_distance, R::Closed(0, 1e6), "Pixels between the boxes of groups that share a plane");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct FlatRegionStats {

@@ -18,19 +18,6 @@
 
 namespace casual3d::depth {
 
-Status FullResRefineOptions::Check() const {
-  if (window_radius < 1 || window_radius > 15) return InvalidArgument("refine window_radius outside [1, 15]");
-  if (!(search_labels > 0 && search_labels <= 8)) return InvalidArgument("refine search_labels outside (0, 8]");
-  if (steps < 3 || steps > 65 || steps % 2 == 0) return InvalidArgument("refine steps must be odd, in [3, 65]");
-  if (best_k < 1 || best_k > 16) return InvalidArgument("refine best_k outside [1, 16]");
-  if (!(occlusion_truncation >= 0 && occlusion_truncation <= 1))
-    return InvalidArgument("refine occlusion_truncation outside [0, 1]");
-  if (!(ncc_epsilon >= 0 && ncc_epsilon <= 1)) return InvalidArgument("refine ncc_epsilon outside [0, 1]");
-  if (!(texture_sigma > 0 && texture_sigma <= 1)) return InvalidArgument("refine texture_sigma outside (0, 1]");
-  if (!(min_texture >= 0 && min_texture <= 1)) return InvalidArgument("refine min_texture outside [0, 1]");
-  return Status::Ok();
-}
-
 ImageF RefineFullResolution(const ImageF& gray, const PinholeCamera& camera, const ImageF& depth,
                             const std::vector<RefineNeighbor>& neighbors, double inv_step,
                             const FullResRefineOptions& options, int num_threads, FullResRefineStats* stats) {
@@ -141,24 +128,6 @@ ImageF RefineFullResolution(const ImageF& gray, const PinholeCamera& camera, con
 }  // namespace casual3d::depth
 
 namespace casual3d::depth {
-
-Status BoundaryRelabelOptions::Check() const {
-  if (radius < 1 || radius > 32) return InvalidArgument("relabel radius outside [1, 32]");
-  if (window_radius < 1 || window_radius > 15) return InvalidArgument("relabel window_radius outside [1, 15]");
-  if (!(min_jump_labels >= 0 && min_jump_labels <= 1000)) return InvalidArgument("relabel min_jump_labels outside [0, 1000]");
-  if (!(sigma_color > 0 && sigma_color <= 10)) return InvalidArgument("relabel sigma_color outside (0, 10]");
-  if (!(min_gain >= 0 && min_gain <= 1)) return InvalidArgument("relabel min_gain outside [0, 1]");
-  if (best_k < 1 || best_k > 16) return InvalidArgument("relabel best_k outside [1, 16]");
-  if (!(occlusion_truncation >= 0 && occlusion_truncation <= 1))
-    return InvalidArgument("relabel occlusion_truncation outside [0, 1]");
-  if (!(ncc_epsilon >= 0 && ncc_epsilon <= 1)) return InvalidArgument("relabel ncc_epsilon outside [0, 1]");
-  if (!(texture_sigma > 0 && texture_sigma <= 1)) return InvalidArgument("relabel texture_sigma outside (0, 1]");
-  if (!(min_texture >= 0 && min_texture <= 1)) return InvalidArgument("relabel min_texture outside [0, 1]");
-  if (max_neighbors < 1 || max_neighbors > 16) return InvalidArgument("relabel max_neighbors outside [1, 16]");
-  if (window_step < 1 || window_step > window_radius)
-    return InvalidArgument("relabel window_step outside [1, window_radius]");
-  return Status::Ok();
-}
 
 
 namespace {

@@ -32,6 +32,7 @@
 #include "format/image.h"
 #include "format/status.h"
 #include "reconstruct/depth/view.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -49,7 +50,21 @@ struct FullResRefineOptions {
   double texture_sigma = 0.02;       // Texture weight var / (var + sigma^2). (0, 1].
   double min_texture = 0.3;          // Pixels with a lower texture weight keep their depth. [0, 1].
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("enabled", o.enabled, R::Any(), "Full-resolution depth search after upsampling");
+    v.Field("window_radius", o.window_radius, R::Closed(1, 15), "ZNCC window radius, full-resolution pixels");
+    v.Field("search_labels", o.search_labels, R::OpenClosed(0, 8), "Half-width of the search, sweep label steps");
+    v.Field("steps", o.steps, R::Closed(3, 65), "Depths tried over +-search_labels (odd)");
+    v.Field("best_k", o.best_k, R::Closed(1, 16), "Neighbours averaged per pixel");
+    v.Field("occlusion_truncation", o.occlusion_truncation, R::Closed(0, 1), "As the sweep's occlusion_truncation");
+    v.Field("ncc_epsilon", o.ncc_epsilon, R::Closed(0, 1), "Variance added to both windows");
+    v.Field("texture_sigma", o.texture_sigma, R::OpenClosed(0, 1), "Texture weight var / (var + sigma^2)");
+    v.Field("min_texture", o.min_texture, R::Closed(0, 1), "Pixels with a lower texture weight keep their depth");
+    v.Require(o.steps % 2 == 1, "steps", "must be odd");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // Boundary relabelling (before the search above): near depth edges the
@@ -98,7 +113,26 @@ struct BoundaryRelabelOptions {
   double min_texture = 0.1;       // [0, 1].
   bool test_nearer = false;
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("enabled", o.enabled, R::Any(), "Full-resolution relabelling of fattened depth edges");
+    v.Field("radius", o.radius, R::Closed(1, 32), "Reach from a depth edge, full-resolution pixels");
+    v.Field("window_radius", o.window_radius, R::Closed(1, 15), "Window radius, full-resolution pixels");
+    v.Field("window_step", o.window_step, R::AtLeast(1), "Window sample spacing, pixels");
+    v.Field("min_jump_labels", o.min_jump_labels, R::Closed(0, 1000), "Depth jump that makes an edge, labels");
+    v.Field("sigma_color", o.sigma_color, R::OpenClosed(0, 10), "Colour sigma of the window weights, RGB distance");
+    v.Field("min_gain", o.min_gain, R::Closed(0, 1), "Cost improvement needed to switch");
+    v.Field("best_k", o.best_k, R::Closed(1, 16), "Neighbours averaged per pixel");
+    v.Field("max_neighbors", o.max_neighbors, R::Closed(1, 16), "Neighbours the boundary relabelling tests (the sweep's first ones)");
+    v.Field("occlusion_truncation", o.occlusion_truncation, R::Closed(0, 1), "As the sweep's occlusion_truncation");
+    v.Field("ncc_epsilon", o.ncc_epsilon, R::Closed(0, 1), "Variance added to both windows");
+    v.Field("texture_sigma", o.texture_sigma, R::OpenClosed(0, 1), "Texture weight var / (var + sigma^2)");
+    v.Field("min_texture", o.min_texture, R::Closed(0, 1), "Pixels with a lower texture weight keep their depth");
+    v.Field("test_nearer", o.test_nearer, R::Any(), "Also try the nearer side's depth");
+    v.Require(o.window_step <= o.window_radius, "window_step", "must not exceed window_radius");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // One neighbour: its full-resolution grey image and camera.

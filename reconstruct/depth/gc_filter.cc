@@ -8,19 +8,6 @@
 
 namespace casual3d::depth {
 
-Status GcFilterOptions::Check() const {
-  if (!(tolerance_labels >= 0.5 && tolerance_labels <= 50))
-    return InvalidArgument("gc tolerance_labels " + std::to_string(tolerance_labels) +
-                           " outside [0.5, 50]");
-  if (min_support < 1 || min_support > 64)
-    return InvalidArgument("gc min_support " + std::to_string(min_support) + " outside [1, 64]");
-  if (!(max_violation_ratio >= 0 && max_violation_ratio <= 64))
-    return InvalidArgument("gc max_violation_ratio outside [0, 64]");
-  if (max_views < 1 || max_views > 256)
-    return InvalidArgument("gc max_views " + std::to_string(max_views) + " outside [1, 256]");
-  return Status::Ok();
-}
-
 ImageF GeometricConsistencyFilter(int ref, const std::vector<const DenseView*>& views,
                                   const std::vector<const ImageF*>& depth_maps,
                                   const std::vector<int>& others, double inv_step,

@@ -17,6 +17,7 @@
 #include "format/image.h"
 #include "format/status.h"
 #include "reconstruct/depth/view.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -26,7 +27,15 @@ struct GcFilterOptions {
   double max_violation_ratio = 1.0;  // Allowed violations per supporting view. [0, 64].
   int max_views = 8;                 // Other views checked (best neighbours first). [1, 256].
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("tolerance_labels", o.tolerance_labels, R::Closed(0.5, 50), "Agreement band, label steps of inverse depth");
+    v.Field("min_support", o.min_support, R::Closed(1, 64), "Views that must agree");
+    v.Field("max_violation_ratio", o.max_violation_ratio, R::Closed(0, 64), "Allowed violations per supporting view");
+    v.Field("max_views", o.max_views, R::Closed(1, 256), "Other views checked (best neighbours first)");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // `depth_maps[i]` is view i's WTA depth (metres, 0 = invalid) at the size of

@@ -24,21 +24,6 @@ bool WithinBand(double depth, double label, double median_label, const LabelGrid
 
 }  // namespace
 
-Status MedianPruneOptions::Check() const {
-  if (small_radius < 1 || small_radius > 64)
-    return InvalidArgument("small median radius " + std::to_string(small_radius) +
-                           " outside [1, 64]");
-  if (large_radius < 1 || large_radius > 256)
-    return InvalidArgument("large median radius " + std::to_string(large_radius) +
-                           " outside [1, 256]");
-  if (!(small_min_valid >= 0 && small_min_valid <= 1))
-    return InvalidArgument("small_min_valid outside [0, 1]");
-  if (!(sigma_color > 0 && sigma_color <= 10)) return InvalidArgument("sigma_color outside (0, 10]");
-  if (!(band_low > 0 && band_low <= 1 && band_high >= 1))
-    return InvalidArgument("median band must satisfy 0 < band_low <= 1 <= band_high");
-  return Status::Ok();
-}
-
 ImageF MedianPrune(const ImageF& depth, const LabelGrid& grid, const MedianPruneOptions& options,
                    int num_threads) {
   const Status st = options.Check();

@@ -18,6 +18,7 @@
 
 #include "format/image.h"
 #include "format/status.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -45,7 +46,17 @@ struct MedianPruneOptions {
   double band_low = 0.9;             // Sec. 4.3.2: keep if depth / median in [0.9, 1.11].
   double band_high = 1.11;
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("small_radius", o.small_radius, R::Closed(1, 64), "Small median radius at 900x1350 (Sec. 4.3.2: 5x5)");
+    v.Field("small_min_valid", o.small_min_valid, R::Closed(0, 1), "Fraction of the small window that must be valid");
+    v.Field("large_radius", o.large_radius, R::Closed(1, 256), "Bilateral median radius at 900x1350 (Sec. 4.3.2: 51x51)");
+    v.Field("sigma_color", o.sigma_color, R::OpenClosed(0, 10), "Bilateral median colour sigma, colour in [0, 1] (Sec. 4.3.2)");
+    v.Field("band_low", o.band_low, R::OpenClosed(0, 1), "Keep if depth / median is at least this (Sec. 4.3.2)");
+    v.Field("band_high", o.band_high, R::AtLeast(1), "... and at most this");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // Small-window median pruning. Returns the pruned copy of `depth`.

@@ -202,22 +202,6 @@ Eigen::VectorXd SolveLevel(const Level& lv, const EnvelopeOptions& options, int 
 
 }  // namespace
 
-Status EnvelopeOptions::Check() const {
-  if (!(sigma_env > 0 && sigma_env <= 10)) return InvalidArgument("sigma_env outside (0, 10]");
-  if (!(unary_scale > 0 && unary_scale <= 1e6)) return InvalidArgument("unary_scale outside (0, 1e6]");
-  if (!(unary_floor >= 0 && unary_floor <= 1e3)) return InvalidArgument("unary_floor outside [0, 1e3]");
-  if (variance_radius < 1 || variance_radius > 256)
-    return InvalidArgument("variance_radius " + std::to_string(variance_radius) + " outside [1, 256]");
-  if (!(scale > 0 && scale <= 1)) return InvalidArgument("envelope scale outside (0, 1]");
-  if (!(min_filter_fraction >= 0 && min_filter_fraction <= 0.5))
-    return InvalidArgument("min_filter_fraction outside [0, 0.5]");
-  if (!(cg_tolerance > 0 && cg_tolerance <= 0.1)) return InvalidArgument("cg_tolerance outside (0, 0.1]");
-  if (cg_max_iterations < 1 || cg_max_iterations > 100000)
-    return InvalidArgument("cg_max_iterations outside [1, 100000]");
-  if (coarse_levels < 0 || coarse_levels > 16) return InvalidArgument("coarse_levels outside [0, 16]");
-  return Status::Ok();
-}
-
 ImageF PropagateAnchors(const ImageF& anchors_depth, const ImageF& color,
                         const EnvelopeOptions& options, PropagationStats* stats) {
   const Status st = options.Check();

@@ -22,6 +22,7 @@
 
 #include "format/image.h"
 #include "format/status.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -39,7 +40,20 @@ struct EnvelopeOptions {
   // next finer level's initial guess. 0 = single level. [0, 16].
   int coarse_levels = 4;
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("sigma_env", o.sigma_env, R::OpenClosed(0, 10), "Propagation colour affinity sigma, colour in [0, 1] (Sec. 4.3.2)");
+    v.Field("unary_scale", o.unary_scale, R::OpenClosed(0, 1e6), "Anchor weight w_i = unary_scale sigma_i^2 (Sec. 4.3.2)");
+    v.Field("unary_floor", o.unary_floor, R::Closed(0, 1e3), "Added to w_i so flat anchors still count");
+    v.Field("variance_radius", o.variance_radius, R::Closed(1, 256), "Anchor variance patch radius at 900x1350");
+    v.Field("scale", o.scale, R::OpenClosed(0, 1), "Envelope = scale * propagated depth (Sec. 4.3.2)");
+    v.Field("min_filter_fraction", o.min_filter_fraction, R::Closed(0, 0.5), "Min-filter diameter / image diagonal");
+    v.Field("cg_tolerance", o.cg_tolerance, R::OpenClosed(0, 0.1), "Relative residual of the conjugate gradient");
+    v.Field("cg_max_iterations", o.cg_max_iterations, R::Closed(1, 100000), "Most conjugate gradient iterations");
+    v.Field("coarse_levels", o.coarse_levels, R::Closed(0, 16), "Coarser grids solved first; 0 = single level");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct PropagationStats {

@@ -8,19 +8,6 @@
 
 namespace casual3d::depth {
 
-Status NeighborOptions::Check() const {
-  if (!(theta_good_deg > 0 && theta_good_deg <= 90))
-    return InvalidArgument("theta_good_deg outside (0, 90]");
-  if (!(min_angle_deg >= 0 && min_angle_deg < 90)) return InvalidArgument("min_angle_deg outside [0, 90)");
-  if (!(max_angle_deg > min_angle_deg && max_angle_deg <= 180))
-    return InvalidArgument("max_angle_deg must lie in (min_angle_deg, 180]");
-  if (min_shared_points < 1 || min_shared_points > 1000000)
-    return InvalidArgument("min_shared_points outside [1, 1e6]");
-  if (coverage_k < 0 || coverage_k > 16) return InvalidArgument("coverage_k outside [0, 16]");
-  if (coverage_picks < 1 || coverage_picks > 64) return InvalidArgument("coverage_picks outside [1, 64]");
-  return Status::Ok();
-}
-
 namespace {
 
 // Angle at x between the rays to the two camera centres, degrees.

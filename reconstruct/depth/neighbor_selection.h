@@ -29,6 +29,7 @@
 #include <Eigen/Core>
 
 #include "format/status.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -45,7 +46,19 @@ struct NeighborOptions {
   // Picks made greedily for coverage; later ranks go by score. [1, 64].
   int coverage_picks = 16;
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("theta_good_deg", o.theta_good_deg, R::OpenClosed(0, 90), "Triangulation angle with full score, degrees");
+    v.Field("min_angle_deg", o.min_angle_deg, R::ClosedOpen(0, 90), "Median angle below which a pair has no parallax, degrees");
+    v.Field("max_angle_deg", o.max_angle_deg, R::OpenClosed(0, 180), "Median angle above which patches differ too much, degrees");
+    v.Field("min_shared_points", o.min_shared_points, R::Closed(1, 1e6), "Shared sparse points for a ranked pair");
+    v.Field("coverage_k", o.coverage_k, R::Closed(0, 16),
+            "Neighbours are picked so that each part of the photo has this many partners (0: by score alone)");
+    v.Field("coverage_picks", o.coverage_picks, R::Closed(1, 64), "Picks made greedily for coverage");
+    v.Require(o.max_angle_deg > o.min_angle_deg, "max_angle_deg", "must exceed min_angle_deg");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // What neighbour selection needs to know about one view.

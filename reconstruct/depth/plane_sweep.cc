@@ -23,25 +23,6 @@ struct NeighborWarp {
 
 }  // namespace
 
-Status SweepOptions::Check() const {
-  if (num_depths < 2 || num_depths > 4096)
-    return InvalidArgument("num_depths " + std::to_string(num_depths) + " outside [2, 4096]");
-  if (window_radius < 1 || window_radius > 15)
-    return InvalidArgument("window_radius " + std::to_string(window_radius) + " outside [1, 15]");
-  if (best_k < 1 || best_k > 16)
-    return InvalidArgument("best_k " + std::to_string(best_k) + " outside [1, 16]");
-  if (!(ncc_epsilon >= 0.0 && ncc_epsilon <= 1.0))
-    return InvalidArgument("ncc_epsilon " + std::to_string(ncc_epsilon) + " outside [0, 1]");
-  if (!(texture_sigma > 0.0 && texture_sigma <= 1.0))
-    return InvalidArgument("texture_sigma " + std::to_string(texture_sigma) + " outside (0, 1]");
-  if (!(texture_color_sigma >= 0.0 && texture_color_sigma <= 10.0))
-    return InvalidArgument("texture_color_sigma outside [0, 10]");
-  if (!(occlusion_truncation >= 0.0 && occlusion_truncation <= 1.0))
-    return InvalidArgument("occlusion_truncation outside [0, 1]");
-  if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
-  return Status::Ok();
-}
-
 PlaneHomography ComputePlaneHomography(const PinholeCamera& ref, const PinholeCamera& neighbor) {
   const Eigen::Matrix3d r_rel = neighbor.R * ref.R.transpose();
   const Eigen::Vector3d t_rel = neighbor.t - r_rel * ref.t;

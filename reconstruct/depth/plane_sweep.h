@@ -33,6 +33,7 @@
 #include "format/status.h"
 #include "reconstruct/depth/sweep_kernels.h"
 #include "reconstruct/depth/view.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -64,7 +65,21 @@ struct SweepOptions {
   double texture_color_sigma = 0.1;
   int num_threads = 0;          // 0 = all cores.
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("num_depths", o.num_depths, R::Closed(2, 4096), "Depth hypotheses over the sparse range (Sec. 4.3.1: 220)");
+    v.Field("window_radius", o.window_radius, R::Closed(1, 15), "ZNCC window radius at working resolution (3: 7x7)");
+    v.Field("best_k", o.best_k, R::Closed(1, 16), "Neighbours averaged per pixel (best costs first)");
+    v.Field("occlusion_truncation", o.occlusion_truncation, R::Closed(0, 1),
+            "Each of the best neighbours' matching costs is capped at the best one's plus this (1: plain mean)");
+    v.Field("ncc_epsilon", o.ncc_epsilon, R::Closed(0, 1), "Variance added to both ZNCC windows, intensity^2");
+    v.Field("texture_sigma", o.texture_sigma, R::OpenClosed(0, 1), "w_photo = var / (var + texture_sigma^2), intensity");
+    v.Field("texture_color_sigma", o.texture_color_sigma, R::Closed(0, 10),
+            "Colour sigma of the texture measure w_photo; 0 = plain window variance");
+    v.Field("num_threads", o.num_threads, R::AtLeast(0), "Worker threads; 0 = all cores", util::Keyed::kNo);
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // Costs for every pixel and depth label, pixel-major so that one pixel's

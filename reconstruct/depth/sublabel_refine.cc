@@ -8,20 +8,6 @@
 
 namespace casual3d::depth {
 
-Status SubLabelOptions::Check() const {
-  if (smooth_radius < 0 || smooth_radius > 8)
-    return InvalidArgument("sublabel smooth_radius outside [0, 8]");
-  if (smooth_iterations < 0 || smooth_iterations > 16)
-    return InvalidArgument("sublabel smooth_iterations outside [0, 16]");
-  if (!(sigma_color > 0 && sigma_color <= 10))
-    return InvalidArgument("sublabel sigma_color outside (0, 10]");
-  if (!(max_label_gap > 0 && max_label_gap <= 16))
-    return InvalidArgument("sublabel max_label_gap outside (0, 16]");
-  if (!(confidence_floor > 0 && confidence_floor <= 1))
-    return InvalidArgument("sublabel confidence_floor outside (0, 1]");
-  return Status::Ok();
-}
-
 namespace {
 
 void CheckSizes(const CostVolume& volume, size_t labels, const ImageF* color) {

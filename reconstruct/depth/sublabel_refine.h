@@ -22,6 +22,7 @@
 #include "format/image.h"
 #include "format/status.h"
 #include "reconstruct/depth/plane_sweep.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -33,7 +34,17 @@ struct SubLabelOptions {
   double max_label_gap = 1.5;      // Neighbours farther than this (labels) are ignored. (0, 16].
   double confidence_floor = 0.05;  // Added to w_photo so textureless areas still average. (0, 1].
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("parabola", o.parabola, R::Any(), "Step 1: parabola fit around each label");
+    v.Field("smooth_radius", o.smooth_radius, R::Closed(0, 8), "Step 2 window radius, working pixels; 0 = off");
+    v.Field("smooth_iterations", o.smooth_iterations, R::Closed(0, 16), "Step 2 passes");
+    v.Field("sigma_color", o.sigma_color, R::OpenClosed(0, 10), "Colour affinity sigma, colour in [0, 1]");
+    v.Field("max_label_gap", o.max_label_gap, R::OpenClosed(0, 16), "Neighbours farther than this (labels) are ignored");
+    v.Field("confidence_floor", o.confidence_floor, R::OpenClosed(0, 1), "Added to w_photo so textureless areas still average");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // `volume` holds E_photo and w_photo, `labels` the MRF labels (width * height,

@@ -11,16 +11,6 @@
 
 namespace casual3d::depth {
 
-Status UpsampleOptions::Check() const {
-  if (radius < 1 || radius > 8) return InvalidArgument("upsample radius outside [1, 8]");
-  if (!(sigma_spatial > 0 && sigma_spatial <= 16))
-    return InvalidArgument("upsample sigma_spatial outside (0, 16]");
-  if (!(sigma_color > 0 && sigma_color <= 10))
-    return InvalidArgument("upsample sigma_color outside (0, 10]");
-  if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
-  return Status::Ok();
-}
-
 ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
                                     const ImageF& high_color, const UpsampleOptions& options) {
   const Status st = options.Check();

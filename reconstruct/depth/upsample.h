@@ -7,6 +7,7 @@
 
 #include "format/image.h"
 #include "format/status.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -16,7 +17,15 @@ struct UpsampleOptions {
   double sigma_color = 0.06;   // Gaussian colour sigma, colour in [0, 1]. (0, 10].
   int num_threads = 0;
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("radius", o.radius, R::Closed(1, 8), "Low-resolution neighbourhood radius, pixels");
+    v.Field("sigma_spatial", o.sigma_spatial, R::OpenClosed(0, 16), "Spatial sigma, low-resolution pixels");
+    v.Field("sigma_color", o.sigma_color, R::OpenClosed(0, 10), "Colour sigma, colour in [0, 1]");
+    v.Field("num_threads", o.num_threads, R::AtLeast(0), "Worker threads; 0 = all cores", util::Keyed::kNo);
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // `low` is a single-channel map (values <= 0 are invalid and ignored; a pixel

@@ -122,25 +122,6 @@ void PhotoCosts(const Window& window, int x, int y, double z, const std::vector<
 
 }  // namespace
 
-Status VisibilityFilterOptions::Check() const {
-  if (!(tolerance > 0 && tolerance <= 1))
-    return InvalidArgument("visibility tolerance outside (0, 1]");
-  if (!(tolerance_labels >= 0 && tolerance_labels <= 100))
-    return InvalidArgument("visibility tolerance_labels outside [0, 100]");
-  if (min_violations < 1 || min_violations > 255)
-    return InvalidArgument("visibility min_violations outside [1, 255]");
-  if (max_views < 1 || max_views > 255)
-    return InvalidArgument("visibility max_views outside [1, 255]");
-  if (rounds < 1 || rounds > 10) return InvalidArgument("visibility rounds outside [1, 10]");
-  if (!(photo_margin >= 0 && photo_margin <= 1))
-    return InvalidArgument("visibility photo_margin outside [0, 1]");
-  if (photo_radius < 0 || photo_radius > 10)
-    return InvalidArgument("visibility photo_radius outside [0, 10]");
-  if (photo_stride < 1 || photo_stride > 10)
-    return InvalidArgument("visibility photo_stride outside [1, 10]");
-  return Status::Ok();
-}
-
 std::vector<DepthReplacement> CheckFreeSpace(int ref,
                                              const std::vector<const PinholeCamera*>& cameras,
                                              const std::vector<const ImageF*>& depths,

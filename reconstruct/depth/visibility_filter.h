@@ -39,6 +39,7 @@
 #include "format/image.h"
 #include "format/status.h"
 #include "reconstruct/depth/view.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::depth {
 
@@ -57,7 +58,23 @@ struct VisibilityFilterOptions {
   int photo_radius = 2;        // The compared window's half-size, pixels. [0, 10].
   int photo_stride = 2;        // ... sampled every this many pixels. [1, 10].
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("enabled", o.enabled, R::Any(), "Free-space check of the depth maps against each other");
+    v.Field("tolerance", o.tolerance, R::OpenClosed(0, 1),
+            "Relative depth band within which another photo's depth agrees (free-space check)");
+    v.Field("tolerance_labels", o.tolerance_labels, R::Closed(0, 100),
+            "... or this many label steps of inverse depth, whichever is larger");
+    v.Field("min_violations", o.min_violations, R::Closed(1, 255), "Views that must see through a point");
+    v.Field("max_views", o.max_views, R::Closed(1, 255), "Other photos each depth map is checked against (best neighbours first)");
+    v.Field("rounds", o.rounds, R::Closed(1, 10), "Rounds of the free-space check over all photos");
+    v.Field("photo_gate", o.photo_gate, R::Any(), "Move only where the photos agree");
+    v.Field("photo_margin", o.photo_margin, R::Closed(0, 1), "Photo agreement margin, grey levels in [0, 1]");
+    v.Field("photo_radius", o.photo_radius, R::Closed(0, 10), "The compared window's half-size, pixels");
+    v.Field("photo_stride", o.photo_stride, R::Closed(1, 10), "The compared window's sample spacing, pixels");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // One replaced pixel of a depth map.

@@ -124,26 +124,9 @@ bool ValidDepth(float d) { return d > 0 && std::isfinite(d); }
 
 }  // namespace
 
-std::string FuseOptions::Check() const {
-  if (!(tau_dratio > 0 && tau_dratio < 1)) {
-    return "tau_dratio " + std::to_string(tau_dratio) + ": must be in (0, 1)";
-  }
-  if (!(tau_grazing > 0 && tau_grazing <= tau_dratio)) {
-    return "tau_grazing " + std::to_string(tau_grazing) + ": must be in (0, tau_dratio]";
-  }
-  if (!(smooth_tolerance >= 0)) return "smooth_tolerance: must be >= 0";
-  if (!(expansion_fraction >= 0 && expansion_fraction <= 0.25)) {
-    return "expansion_fraction: must be in [0, 0.25]";
-  }
-  if (!(fringe_fraction >= 0 && fringe_fraction <= 0.05)) {
-    return "fringe_fraction: must be in [0, 0.05]";
-  }
-  return "";
-}
-
 TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options, FuseStats* stats_out) {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("fuse options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("fuse options: " + st.message());
   if (!input.front_rgb || !input.front_depth_m || !input.back_rgb || !input.back_depth_m) {
     throw std::invalid_argument("fuse: front and back colour and depth are required");
   }

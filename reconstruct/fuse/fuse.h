@@ -28,6 +28,7 @@
 #include "format/equirect.h"
 #include "format/image.h"
 #include "format/two_layer.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::fuse {
 
@@ -55,7 +56,17 @@ struct FuseOptions {
   // Rings of B-label propagation onto front nodes, fraction of the width (0.001 at 4096: 4); >= 0.
   double fringe_fraction = 0.001;
 
-  std::string Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("tau_dratio", o.tau_dratio, R::Open(0, 1), "Depth ratio min / max above which two nodes are one surface");
+    v.Field("tau_grazing", o.tau_grazing, R::Above(0), "Lower depth ratio linked where the surface continues smoothly");
+    v.Field("smooth_tolerance", o.smooth_tolerance, R::AtLeast(0), "Log-depth step difference of a smooth surface");
+    v.Field("expansion_fraction", o.expansion_fraction, R::Closed(0, 0.25), "Rings of back-layer growth, fraction of the width");
+    v.Field("fringe_fraction", o.fringe_fraction, R::Closed(0, 0.05), "Rings of B-label propagation, fraction of the width");
+    v.Require(o.tau_grazing <= o.tau_dratio, "tau_grazing", "must not exceed tau_dratio");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // Inputs: both layers at the same size (width = 2 * height), depth 0 where a

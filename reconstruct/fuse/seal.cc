@@ -349,15 +349,6 @@ class Sealer {
 
 }  // namespace
 
-std::string SealOptions::Check() const {
-  if (!(min_link_ratio > 0 && min_link_ratio < 1)) return "min_link_ratio: must be in (0, 1)";
-  if (!(tau_dratio > min_link_ratio && tau_dratio < 1))
-    return "tau_dratio: must be in (min_link_ratio, 1)";
-  if (max_passes < 1 || max_passes > 32) return "max_passes: must be in [1, 32]";
-  if (!(continuous_ratio > 0 && continuous_ratio < 1)) return "continuous_ratio: must be in (0, 1)";
-  return "";
-}
-
 int64_t CountOpenQuads(const TwoLayerPanorama& pano) {
   int64_t open = 0;
   for (int y = 0; y + 1 < pano.height(); ++y)
@@ -397,8 +388,8 @@ std::pair<int64_t, int64_t> SealPasses(Sealer* sealer, int width, int height, in
 }  // namespace
 
 SealStats SealTears(TwoLayerPanorama* pano, const SealOptions& options) {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("seal options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("seal options: " + st.message());
   SealStats stats;
   Sealer sealer(pano, options);
   const int W = pano->width(), H = pano->height();

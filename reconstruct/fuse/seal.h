@@ -40,6 +40,7 @@
 #include <string>
 
 #include "format/two_layer.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::fuse {
 
@@ -56,7 +57,16 @@ struct SealOptions {
   // triangles should close; (0, 1). The warp's min_edge_depth_ratio.
   double continuous_ratio = 0.9;
 
-  std::string Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("min_link_ratio", o.min_link_ratio, R::Open(0, 1), "Depth ratio above which nodes may be linked to close a quad");
+    v.Field("tau_dratio", o.tau_dratio, R::ClosedOpen(0, 1), "Depth ratio above which a back-layer extension links");
+    v.Field("max_passes", o.max_passes, R::Closed(1, 32), "Sealing passes");
+    v.Field("continuous_ratio", o.continuous_ratio, R::Open(0, 1), "Front nodes within this depth ratio are one surface");
+    v.Require(o.tau_dratio > o.min_link_ratio, "tau_dratio", "must exceed min_link_ratio");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct SealStats {

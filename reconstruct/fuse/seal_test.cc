@@ -180,12 +180,12 @@ TEST(SealTears, QuadCoverageQuarters) {
 
 TEST(SealOptions, Check) {
   SealOptions o;
-  EXPECT_EQ(o.Check(), "");
+  EXPECT_TRUE(o.Check().ok());
   o.tau_dratio = 0.5;
-  EXPECT_NE(o.Check(), "");
+  EXPECT_FALSE(o.Check().ok());
   o = SealOptions();
   o.max_passes = 0;
-  EXPECT_NE(o.Check(), "");
+  EXPECT_FALSE(o.Check().ok());
   EXPECT_THROW(SealTears(nullptr, o), std::invalid_argument);
 }
 

@@ -104,21 +104,9 @@ Eigen::Matrix3f MinimalRotation(const Vec3& a, const Vec3& b) {
 
 }  // namespace
 
-std::string NormalOptions::Check() const {
-  if (!(smoothness > 0)) return "smoothness: must be > 0";
-  if (iterations < 0 || iterations > 10000) return "iterations: must be in [0, 10000]";
-  if (!(detail_strength >= 0)) return "detail_strength: must be >= 0";
-  if (detail_radius < 1 || detail_radius > 64) return "detail_radius: must be in [1, 64]";
-  if (!(sky_depth_fraction > 0 && sky_depth_fraction <= 1)) {
-    return "sky_depth_fraction: must be in (0, 1]";
-  }
-  if (!(sky_max_texture >= 0)) return "sky_max_texture: must be >= 0";
-  return "";
-}
-
 NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options) {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("normal options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("normal options: " + st.message());
   const NodeGraph g = BuildGraph(*pano);
   const size_t num_nodes = 2 * g.n;
   NormalStats stats;

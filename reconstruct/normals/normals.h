@@ -18,6 +18,7 @@
 #include <string>
 
 #include "format/two_layer.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::normals {
 
@@ -37,7 +38,18 @@ struct NormalOptions {
   double sky_max_texture = 0.03;
   bool detect_sky = true;
 
-  std::string Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("smoothness", o.smoothness, R::Above(0), "Smoothness weight relative to the data weight (Eq. 5)");
+    v.Field("iterations", o.iterations, R::Closed(0, 10000), "Jacobi iterations of the smoothing system");
+    v.Field("detail_strength", o.detail_strength, R::AtLeast(0), "Strength of the hallucinated detail; 0 disables");
+    v.Field("detail_radius", o.detail_radius, R::Closed(1, 64), "Radius of the low-pass that separates detail, pixels");
+    v.Field("sky_depth_fraction", o.sky_depth_fraction, R::OpenClosed(0, 1), "Sky: depth from this fraction of the 99th percentile");
+    v.Field("sky_max_texture", o.sky_max_texture, R::AtLeast(0), "Sky: luminance deviation below this");
+    v.Field("detect_sky", o.detect_sky, R::Any(), "Give sky nodes the normal facing the centre");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct NormalStats {

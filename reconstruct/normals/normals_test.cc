@@ -144,9 +144,9 @@ TEST(NormalsTest, SkyIsUnlitAndDetailTiltsNormals) {
 
 TEST(NormalsTest, RejectsBadOptions) {
   NormalOptions options;
-  EXPECT_EQ(options.Check(), "");
+  EXPECT_TRUE(options.Check().ok());
   options.smoothness = 0;
-  EXPECT_NE(options.Check(), "");
+  EXPECT_FALSE(options.Check().ok());
 }
 
 }  // namespace

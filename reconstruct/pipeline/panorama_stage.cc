@@ -103,31 +103,6 @@ void WriteHolesPreview(const Image8& fov, const Image8& holes, const std::string
 
 }  // namespace
 
-std::string PanoramaStageOptions::Check() const {
-  if (pano_width != 0 && (pano_width < 64 || pano_width > 16384 || pano_width % 2 != 0)) {
-    return "pano_width " + std::to_string(pano_width) +
-           ": must be 0 (automatic) or even and in [64, 16384]";
-  }
-  if (max_auto_width < 2048 || max_auto_width > 16384 || max_auto_width % 1024 != 0) {
-    return "max_auto_width " + std::to_string(max_auto_width) +
-           ": must be a multiple of 1024 in [2048, 16384]";
-  }
-  if (pano_width != 0 && stitch.solve_width > pano_width) {
-    return "stitch.solve_width " + std::to_string(stitch.solve_width) +
-           ": must not exceed pano_width " + std::to_string(pano_width);
-  }
-  if (!(sky_depth_m >= 0)) return "sky_depth_m: must be >= 0";
-  if (num_threads < 0) return "num_threads: must be >= 0";
-  warp::WarpOptions w = warp;
-  w.pano_width = pano_width != 0 ? pano_width : max_auto_width;
-  w.pano_height = w.pano_width / 2;
-  for (const std::string& why :
-       {w.Check(), stitch.Check(), fuse.Check(), seal.Check(), normals.Check(), view.Check()}) {
-    if (!why.empty()) return why;
-  }
-  return "";
-}
-
 int AutoPanoramaWidth(const std::vector<geometry::Camera>& cameras, int max_width) {
   std::vector<double> focal;
   for (const geometry::Camera& c : cameras) {
@@ -165,8 +140,8 @@ PanoramaFrame LoadOrComputeFrame(const std::string& sparse_dir) {
 TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::string& depth_dir,
                                   const std::string& out_dir, const PanoramaStageOptions& options,
                                   PanoramaStageReport* report_out) {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("panorama options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("panorama options: " + st.message());
   const auto start = Clock::now();
   PanoramaStageReport report;
 

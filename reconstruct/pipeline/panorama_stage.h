@@ -29,6 +29,7 @@
 #include "reconstruct/pipeline/view_volume.h"
 #include "reconstruct/stitch/stitch.h"
 #include "reconstruct/warp/warp.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::pipeline {
 
@@ -60,7 +61,32 @@ struct PanoramaStageOptions {
   bool write_previews = true;
   int num_threads = 0;  // 0 = all cores.
 
-  std::string Check() const;  // Empty if valid, else "field: reason".
+  // Every field of this struct and of the structs nested in it is described
+  // here (reconstruct/util/options_fields.h): the checks, the pipeline's cache
+  // key and report come from it; panorama_options_test fails when one is missing.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("pano_width", o.pano_width, R::ZeroOr(R::Closed(64, 16384)),
+            "Panorama width (even); 0 = from the photos' angular resolution");
+    v.Field("max_auto_width", o.max_auto_width, R::Closed(2048, 16384), "Largest automatic width (a multiple of 1024)");
+    v.Struct("warp", o.warp);
+    v.Struct("stitch", o.stitch);
+    v.Struct("fuse", o.fuse);
+    v.Field("seal_tears", o.seal_tears, R::Any(), "Close the quads fusion leaves open");
+    v.Struct("seal", o.seal);
+    v.Struct("normals", o.normals);
+    v.Struct("view", o.view);
+    v.Field("back_layer", o.back_layer, R::Any(), "Build the back layer (false: front only, Fig. 15's ablation)");
+    v.Field("fill_front_gaps", o.fill_front_gaps, R::Any(), "Fill the front layer's gaps inside the photos' field of view");
+    v.Field("sky_depth_m", o.sky_depth_m, R::AtLeast(0), "Depth of sky pixels, metres; 0 = 1.5 x the largest finite depth");
+    v.Field("write_previews", o.write_previews, R::Any(), "Write preview images");
+    v.Field("num_threads", o.num_threads, R::AtLeast(0), "Worker threads; 0 = all cores", util::Keyed::kNo);
+    v.Require(o.pano_width % 2 == 0, "pano_width", "must be even");
+    v.Require(o.max_auto_width % 1024 == 0, "max_auto_width", "must be a multiple of 1024");
+    v.Require(o.pano_width == 0 || o.stitch.solve_width <= o.pano_width, "stitch.solve_width", "must not exceed pano_width");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct PanoramaStageReport {

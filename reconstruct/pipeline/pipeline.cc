@@ -16,6 +16,7 @@
 #include "reconstruct/pipeline/capture_shape.h"
 #include "reconstruct/pipeline/holdout.h"
 #include "reconstruct/util/log.h"
+#include "reconstruct/util/options_json.h"
 
 namespace casual3d::pipeline {
 namespace {
@@ -25,7 +26,11 @@ using Clock = std::chrono::steady_clock;
 
 // Bump when a stage's output format or algorithm changes, so old caches are stale.
 // sparse-3: the import skips bad and duplicate files, reads HEIF, TIFF and video.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-3", "dense-4", "panorama-3",
+// sparse-4, dense-5, panorama-7: the key lists every field of the stage's
+// options from their description (util::FieldsKeyText; pipeline.h, "Cache
+// key"); panorama-7 also takes over the version (panorama-6) the panorama key
+// text used to carry.
+constexpr const char* kStageVersions[kNumStages] = {"sparse-4", "dense-5", "panorama-7",
                                                     "encode-2"};
 
 std::string HashHex(const std::string& text) {
@@ -54,56 +59,6 @@ std::string InputFingerprint(const std::string& input) {
   std::string out;
   for (const std::string& r : rows) out += r + "\n";
   return out;
-}
-
-std::string SparseOptionsText(const sfm::SparseStageOptions& o) {
-  std::ostringstream s;
-  s << "input_type=" << static_cast<int>(o.input_type)
-    << " working_megapixels=" << o.import.working_megapixels
-    << " skip_unreadable=" << o.import.skip_unreadable
-    << " allow_mixed_devices=" << o.import.allow_mixed_devices << " focal_px=" << o.import.focal_px
-    << " video_max_frames=" << o.video.max_frames << " video_min_step=" << o.video.min_step_fraction
-    << " video_blur_ratio=" << o.video.blur_ratio << " video_blur_window=" << o.video.blur_window
-    << " video_analysis=" << o.video.analysis_long_side
-    << " camera_model=" << o.camera_model << " shared_camera=" << o.shared_camera
-    << " matcher=" << static_cast<int>(o.matcher) << " max_features=" << o.max_features
-    << " sift_first_octave=" << o.sift_first_octave << " native_matching=" << o.native_matching
-    << " min_registered_fraction=" << o.min_registered_fraction;
-  return s.str();
-}
-
-std::string DenseOptionsText(const depth::DenseOptions& o) {
-  std::ostringstream s;
-  s << "working_scale=" << o.working_scale << " num_neighbors=" << o.num_neighbors
-    << " num_depths=" << o.sweep.num_depths << " window_radius=" << o.sweep.window_radius
-    << " lambda_smooth=" << o.mrf.lambda_smooth << " lambda_near=" << o.mrf.lambda_near
-    << " use_near_envelope=" << o.use_near_envelope << " use_gc_filter=" << o.use_gc_filter
-    << " envelope_scale=" << o.envelope.scale << " continuous_refine=" << o.refine.enabled
-    << " min_far_over_near=" << o.min_far_over_near
-    << " texture_color_sigma=" << o.sweep.texture_color_sigma << " far_bias=" << o.mrf.far_bias
-    << " neighbor_coverage=" << o.neighbors.coverage_k
-    << " occlusion_truncation=" << o.sweep.occlusion_truncation
-    << " flat_regions=" << o.flat.enabled << " lambda_flat=" << o.mrf.lambda_flat
-    << " relabel=" << o.relabel.enabled << " relabel_radius=" << o.relabel.radius
-    << " relabel_neighbors=" << o.relabel.max_neighbors << " fullres_refine=" << o.fullres.enabled
-    << " free_space=" << o.visibility.enabled << " free_space_tolerance=" << o.visibility.tolerance
-    << " free_space_labels=" << o.visibility.tolerance_labels
-    << " free_space_views=" << o.visibility.max_views << " free_space_rounds=" << o.visibility.rounds;
-  return s.str();
-}
-
-std::string PanoramaOptionsText(const PanoramaStageOptions& o) {
-  std::ostringstream s;
-  // The stage's version (spec/stage-panorama.md): its output changed.
-  s << "version=panorama-6 pano_width=" << o.pano_width << " max_auto_width=" << o.max_auto_width << " solve=" << o.stitch.solve_width
-    << " back_layer=" << o.back_layer << " fill_front_gaps=" << o.fill_front_gaps
-    << " tau_stretch=" << o.warp.tau_stretch_deg
-    << " lambda_gc=" << o.stitch.lambda_gc << " tau_dratio=" << o.fuse.tau_dratio
-    << " expansion=" << o.fuse.expansion_fraction << " sky_depth=" << o.sky_depth_m
-    << " min_edge_depth_ratio=" << o.warp.min_edge_depth_ratio << " seal=" << o.seal_tears << " seal_min_link_ratio=" << o.seal.min_link_ratio
-    << " view_hints=1 near_percentile=" << o.view.near_percentile
-    << " radius_over_near=" << o.view.min_radius_over_near << "," << o.view.max_radius_over_near;
-  return s.str();
 }
 
 std::string ReadKey(const fs::path& path) {
@@ -160,24 +115,21 @@ bool StageFromName(const std::string& name, Stage* stage) {
   return false;
 }
 
-std::string PipelineOptions::Check() const {
+Status PipelineOptions::Check() const {
   if (static_cast<int>(from) > static_cast<int>(to)) {
-    return std::string("--from ") + StageName(from) + " comes after --to " + StageName(to);
+    return InvalidArgument(std::string("--from ") + StageName(from) + " comes after --to " + StageName(to));
   }
-  if (!(color_quality >= 0 && color_quality <= 100)) return "color_quality: must be in [0, 100]";
-  if (num_threads < 0) return "num_threads: must be >= 0";
-  if (holdout_every < 0 || holdout_every > 1000) return "holdout_every: must be in [0, 1000]";
-  Status s = sparse.Check();
-  if (!s.ok()) return s.message();
-  s = dense.Check();
-  if (!s.ok()) return s.message();
-  return panorama.Check();
+  if (!(color_quality >= 0 && color_quality <= 100)) return InvalidArgument("color_quality: must be in [0, 100]");
+  if (num_threads < 0) return InvalidArgument("num_threads: must be >= 0");
+  if (holdout_every < 0 || holdout_every > 1000) return InvalidArgument("holdout_every: must be in [0, 1000]");
+  for (const Status& s : {sparse.Check(), dense.Check(), panorama.Check()})
+    if (!s.ok()) return s;
+  return Status::Ok();
 }
 
 PipelineReport RunPipeline(const std::string& input, const std::string& out,
                            const PipelineOptions& options_in) {
-  const std::string why = options_in.Check();
-  if (!why.empty()) throw std::invalid_argument(why);
+  if (const Status st = options_in.Check(); !st.ok()) throw std::invalid_argument(st.message());
   PipelineOptions options = options_in;
   options.sparse.num_threads = options.num_threads;
   options.dense.num_threads = options.num_threads;
@@ -204,9 +156,9 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
   // The canonical path, so that "a/../b" and "b" share the cache.
   keys[0] = HashHex(std::string(kStageVersions[0]) + "\n" +
                     fs::weakly_canonical(fs::absolute(input)).string() + "\n" +
-                    InputFingerprint(input) + SparseOptionsText(options.sparse));
+                    InputFingerprint(input) + util::FieldsKeyText(options.sparse));
   keys[1] = HashHex(
-      std::string(kStageVersions[1]) + "\n" + keys[0] + "\n" + DenseOptionsText(options.dense) +
+      std::string(kStageVersions[1]) + "\n" + keys[0] + "\n" + util::FieldsKeyText(options.dense) +
       (options.holdout_every > 0 ? "\nholdout " + std::to_string(options.holdout_every) : ""));
   // The dense and panorama stages read the training workspace (holdout.h)
   // when photos are held out, written once the sparse output exists.
@@ -225,7 +177,7 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
     return train_dir;
   };
   keys[2] = HashHex(std::string(kStageVersions[2]) + "\n" + keys[1] + "\n" +
-                    PanoramaOptionsText(options.panorama));
+                    util::FieldsKeyText(options.panorama));
   keys[3] =
       HashHex(std::string(kStageVersions[3]) + "\n" + keys[2] + "\n" +
               std::to_string(options.color_quality) + " " + std::to_string(options.tile_size));
@@ -424,6 +376,10 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
       stage_json[name] = previous["results"][name];
   }
   j["results"] = stage_json;
+  // Every option of the stages, as their descriptions give them.
+  j["options"] = {{"sparse", util::FieldsJson(options.sparse)},
+                  {"dense", util::FieldsJson(options.dense)},
+                  {"panorama", util::FieldsJson(options.panorama)}};
   if (!capture_json.is_null()) j["capture"] = capture_json;
   // Files of the input the import left out (bad or duplicate), at the top level.
   if (stage_json.contains("sparse") && stage_json["sparse"].contains("skipped"))

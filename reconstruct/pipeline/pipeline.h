@@ -15,8 +15,22 @@
 //   OUT/report.json     timings and statistics of every stage, with the key of
 //                       its cache; a cached stage keeps the figures of the run
 //                       that computed it; "capture": the capture's shape and
-//                       advice (capture_shape.h)
+//                       advice (capture_shape.h); "options": every option of
+//                       the sparse, dense and panorama stages
 //   OUT/work/{sparse,dense,panorama}/ and OUT/work/<stage>.key   stage caches
+//
+// Cache key: a stage's key is the SHA-256 (hex) of its version (kStageVersions
+// in pipeline.cc), the previous stage's key (the sparse stage: the input's
+// canonical path and the names, sizes and times of its files) and the text
+// util::FieldsKeyText makes of the stage's options: one "path=value" line per
+// field of the options struct and the structs nested in it, in the order of
+// its description (reconstruct/util/options_fields.h), for example
+// "mrf.max_iterations=6" or "sweep.texture_color_sigma=0.1"; numbers in the
+// shortest form that reads back to the same value, booleans as true/false,
+// strings quoted. Thread counts (and the sparse stage's overwrite) are left
+// out: they do not change what a stage writes. The dense key adds
+// "holdout N" when photos are held out; the encode key the colour quality
+// and tile size.
 
 #include <functional>
 #include <string>
@@ -58,7 +72,7 @@ struct PipelineOptions {
   std::function<void(const std::string& web_dir, const std::vector<std::string>& capture_advice)>
       finish_web_package;
 
-  std::string Check() const;  // Empty if valid.
+  Status Check() const;
 };
 
 struct StageRun {

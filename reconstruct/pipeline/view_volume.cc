@@ -45,15 +45,6 @@ double VerticalFromHorizontal(double horizontal_deg, double aspect) {
 
 }  // namespace
 
-std::string ViewVolumeOptions::Check() const {
-  if (!(near_percentile >= 0 && near_percentile <= 0.5)) return "near_percentile: must be in [0, 0.5]";
-  if (!(min_radius_over_near > 0 && min_radius_over_near <= max_radius_over_near &&
-        max_radius_over_near <= 1))
-    return "min_radius_over_near, max_radius_over_near: need 0 < min <= max <= 1";
-  if (!(frame_aspect >= 0.25 && frame_aspect <= 4)) return "frame_aspect: must be in [0.25, 4]";
-  return "";
-}
-
 // Largest share of the content box (solid angle) left without content.
 constexpr double kMaxEmptyFraction = 0.005;
 
@@ -148,8 +139,8 @@ void FitContentBox(const Image8& fov_mask, double max_empty_fraction, ViewHints*
 ViewHints ComputeViewHints(const TwoLayerPanorama& pano, const Image8& fov_mask,
                            const std::vector<CoverageView>& views, const PanoramaFrame& frame,
                            bool metric, const ViewVolumeOptions& options) {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("view volume options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("view volume options: " + st.message());
   if (fov_mask.width() != pano.width() || fov_mask.height() != pano.height())
     throw std::invalid_argument("view volume: the field-of-view mask is not the panorama's size");
   ViewHints hints;

@@ -28,6 +28,7 @@
 #include "format/two_layer.h"
 #include "format/view_hints.h"
 #include "reconstruct/pipeline/coverage.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::pipeline {
 
@@ -43,7 +44,16 @@ struct ViewVolumeOptions {
   // fit; [0.25, 4].
   double frame_aspect = 16.0 / 9.0;
 
-  std::string Check() const;  // Empty if valid, else "field: reason".
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("near_percentile", o.near_percentile, R::Closed(0, 0.5), "Percentile of the front depths taken as the near depth");
+    v.Field("min_radius_over_near", o.min_radius_over_near, R::OpenClosed(0, 1), "Smallest volume radius, fraction of the near depth");
+    v.Field("max_radius_over_near", o.max_radius_over_near, R::OpenClosed(0, 1), "Largest volume radius, fraction of the near depth");
+    v.Field("frame_aspect", o.frame_aspect, R::Closed(0.25, 4), "Aspect ratio of the view the opening field of view fits");
+    v.Require(o.min_radius_over_near <= o.max_radius_over_near, "min_radius_over_near", "must not exceed max_radius_over_near");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // Content extent of a field-of-view mask (width x height x 1, non-zero

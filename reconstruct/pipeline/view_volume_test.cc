@@ -141,12 +141,12 @@ TEST(ComputeViewHints, NarrowContentNarrowsAndCentresTheView) {
 
 TEST(ViewVolumeOptions, Check) {
   ViewVolumeOptions o;
-  EXPECT_EQ(o.Check(), "");
+  EXPECT_TRUE(o.Check().ok());
   o.max_radius_over_near = 0.01;
-  EXPECT_NE(o.Check(), "");
+  EXPECT_FALSE(o.Check().ok());
   o = ViewVolumeOptions();
   o.frame_aspect = 10;
-  EXPECT_NE(o.Check(), "");
+  EXPECT_FALSE(o.Check().ok());
 }
 
 }  // namespace

@@ -50,23 +50,6 @@ std::string JoinList(const std::vector<std::string>& items, size_t max_items) {
 
 }  // namespace
 
-Status PhotoImportOptions::Check() const {
-  if (!(working_megapixels >= 0.05 && working_megapixels <= 100)) {
-    return InvalidArgument("working_megapixels " + std::to_string(working_megapixels) +
-                           " is outside [0.05, 100]");
-  }
-  if (!(focal_px == 0 || (focal_px >= 1 && focal_px <= 1e6))) {
-    return InvalidArgument("focal_px " + std::to_string(focal_px) + " must be 0 or in [1, 1e6]");
-  }
-  if (jpeg_quality < 50 || jpeg_quality > 100) {
-    return InvalidArgument("jpeg_quality " + std::to_string(jpeg_quality) + " is outside [50, 100]");
-  }
-  if (min_photos < 2 || min_photos > 1000000) {
-    return InvalidArgument("min_photos " + std::to_string(min_photos) + " is outside [2, 1e6]");
-  }
-  return Status::Ok();
-}
-
 bool IsPhotoFileName(const std::string& name) {
   const std::string l = Lower(name);
   return !name.empty() && name[0] != '.' &&

@@ -19,6 +19,7 @@
 
 #include "format/status.h"
 #include "reconstruct/sfm/exif.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::sfm {
 
@@ -38,7 +39,18 @@ struct PhotoImportOptions {
   int jpeg_quality = 95;  // Range [50, 100]; quality of the re-encoded photos.
   int min_photos = 3;     // Range [2, 1e6]; fewer photos is an error.
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("working_megapixels", o.working_megapixels, R::Closed(0.05, 100), "Working resolution, megapixels (Sec. 4.1: ~900x1350)");
+    v.Field("skip_unreadable", o.skip_unreadable, R::Any(), "Skip unreadable photos with a warning rather than stop");
+    v.Field("allow_mixed_devices", o.allow_mixed_devices, R::Any(), "Allow photos from several devices, one calibration each");
+    v.Field("focal_px", o.focal_px, R::ZeroOr(R::Closed(1, 1e6)),
+            "Focal length prior at the photos' original size, pixels; 0 = from EXIF");
+    v.Field("jpeg_quality", o.jpeg_quality, R::Closed(50, 100), "Quality of the re-encoded photos");
+    v.Field("min_photos", o.min_photos, R::Closed(2, 1e6), "Fewer usable photos is an error");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct ImportedPhoto {

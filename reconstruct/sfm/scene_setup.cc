@@ -54,17 +54,6 @@ DepthRange RangeFromDepths(std::vector<double> depths, const DepthRangeOptions& 
   return r;
 }
 
-Status CheckRange(const char* name, double value, double lo, double hi, bool lo_open,
-                  bool hi_open) {
-  const bool ok = std::isfinite(value) && (lo_open ? value > lo : value >= lo) &&
-                  (hi_open ? value < hi : value <= hi);
-  if (ok) return Status::Ok();
-  std::ostringstream ss;
-  ss << name << " " << value << " is outside " << (lo_open ? "(" : "[") << lo << ", " << hi
-     << (hi_open ? ")" : "]");
-  return InvalidArgument(ss.str());
-}
-
 int ParseMajor(const Json& j, const std::string& path, const char* expected_format) {
   if (!j.is_object()) throw std::runtime_error(path + ": not a JSON object");
   if (!j.contains("format") || !j["format"].is_string() ||
@@ -107,17 +96,6 @@ Json ParseJsonFile(const std::string& path) {
 }
 
 }  // namespace
-
-Status DepthRangeOptions::Check() const {
-  CASUAL3D_RETURN_IF_ERROR(CheckRange("near_percentile", near_percentile, 0, 0.5, false, true));
-  CASUAL3D_RETURN_IF_ERROR(CheckRange("far_percentile", far_percentile, 0.5, 1, true, false));
-  CASUAL3D_RETURN_IF_ERROR(CheckRange("near_margin", near_margin, 0, 1, true, false));
-  CASUAL3D_RETURN_IF_ERROR(CheckRange("far_margin", far_margin, 1, 100, false, false));
-  CASUAL3D_RETURN_IF_ERROR(CheckRange("min_points", min_points, 1, 1e6, false, false));
-  CASUAL3D_RETURN_IF_ERROR(
-      CheckRange("min_near_over_far", min_near_over_far, 0, 1, true, true));
-  return Status::Ok();
-}
 
 std::map<int, DepthRange> ComputeDepthRanges(const geometry::SparseModel& model,
                                              const DepthRangeOptions& options) {
@@ -193,10 +171,6 @@ std::map<int, DepthRange> ComputeDepthRanges(const geometry::SparseModel& model,
     }
   }
   return ranges;
-}
-
-Status PanoramaFrameOptions::Check() const {
-  return CheckRange("min_partial_resultant", min_partial_resultant, 0, 1, false, false);
 }
 
 PanoramaFrame ComputePanoramaFrame(const geometry::SparseModel& model,

@@ -20,6 +20,7 @@
 #include "format/equirect.h"
 #include "format/status.h"
 #include "reconstruct/geometry/colmap_model.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::sfm {
 
@@ -43,7 +44,17 @@ struct DepthRangeOptions {
   double min_near_over_far = 1e-3;  // Range (0, 1).
 
   // Names the first field out of range.
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("near_percentile", o.near_percentile, R::ClosedOpen(0, 0.5), "Percentile of point depths taken as the raw near bound");
+    v.Field("far_percentile", o.far_percentile, R::OpenClosed(0.5, 1), "Percentile of point depths taken as the raw far bound");
+    v.Field("near_margin", o.near_margin, R::OpenClosed(0, 1), "Near bound factor");
+    v.Field("far_margin", o.far_margin, R::Closed(1, 100), "Far bound factor");
+    v.Field("min_points", o.min_points, R::Closed(1, 1e6), "Observed points a photo needs for its own range");
+    v.Field("min_near_over_far", o.min_near_over_far, R::Open(0, 1), "Near bounds are at least this fraction of the far bound");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct DepthRange {
@@ -77,7 +88,14 @@ struct PanoramaFrameOptions {
   // horizontal viewing direction, which is stable from run to run.
   double min_partial_resultant = 0.3;  // Range [0, 1].
 
-  Status Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("robust_centre", o.robust_centre, R::Any(), "Centre at the geometric median of the cameras, not their mean");
+    v.Field("min_partial_resultant", o.min_partial_resultant, R::Closed(0, 1),
+            "Mean viewing direction length from which a capture counts as partial");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // What ComputePanoramaFrame decided, for logs and frame.json.

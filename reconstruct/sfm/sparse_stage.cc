@@ -32,9 +32,6 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-const char* const kCameraModels[] = {"SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL",
-                                     "OPENCV"};
-
 std::string FormatNumber(double v) {
   std::ostringstream ss;
   ss.precision(10);
@@ -314,46 +311,6 @@ Json OptionsJson(const SparseStageOptions& o) {
 }
 
 }  // namespace
-
-Status SparseStageOptions::Check() const {
-  CASUAL3D_RETURN_IF_ERROR(import.Check());
-  CASUAL3D_RETURN_IF_ERROR(video.Check());
-  CASUAL3D_RETURN_IF_ERROR(depth_ranges.Check());
-  CASUAL3D_RETURN_IF_ERROR(frame.Check());
-  if (std::find(std::begin(kCameraModels), std::end(kCameraModels), camera_model) ==
-      std::end(kCameraModels)) {
-    return InvalidArgument("camera_model " + camera_model +
-                           " is not one of SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV");
-  }
-  if (exhaustive_max_photos < 3 || exhaustive_max_photos > 100000) {
-    return InvalidArgument("exhaustive_max_photos " + std::to_string(exhaustive_max_photos) +
-                           " is outside [3, 100000]");
-  }
-  if (sequential_overlap < 1 || sequential_overlap > 1000) {
-    return InvalidArgument("sequential_overlap " + std::to_string(sequential_overlap) +
-                           " is outside [1, 1000]");
-  }
-  if (max_features < 500 || max_features > 100000) {
-    return InvalidArgument("max_features " + std::to_string(max_features) +
-                           " is outside [500, 100000]");
-  }
-  if (sift_first_octave < -1 || sift_first_octave > 2) {
-    return InvalidArgument("sift_first_octave " + std::to_string(sift_first_octave) +
-                           " is outside [-1, 2]");
-  }
-  if (num_threads < 0 || num_threads > 1024) {
-    return InvalidArgument("num_threads " + std::to_string(num_threads) + " is outside [0, 1024]");
-  }
-  if (!(init_min_tri_angle_deg >= 0.5 && init_min_tri_angle_deg <= 60)) {
-    return InvalidArgument("init_min_tri_angle_deg " + std::to_string(init_min_tri_angle_deg) +
-                           " is outside [0.5, 60]");
-  }
-  if (!(min_registered_fraction >= 0 && min_registered_fraction <= 1)) {
-    return InvalidArgument("min_registered_fraction " + std::to_string(min_registered_fraction) +
-                           " is outside [0, 1]");
-  }
-  return Status::Ok();
-}
 
 SparseStageResult RunSparseStage(const std::string& input, const std::string& output,
                                  const SparseStageOptions& options) {

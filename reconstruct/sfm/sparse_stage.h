@@ -30,6 +30,7 @@
 #include "reconstruct/sfm/photo_import.h"
 #include "reconstruct/sfm/scene_setup.h"
 #include "reconstruct/sfm/video_import.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::sfm {
 
@@ -89,7 +90,36 @@ struct SparseStageOptions {
   DepthRangeOptions depth_ranges;
   PanoramaFrameOptions frame;
 
-  Status Check() const;
+  // Every field of this struct and of the structs nested in it is described
+  // here (reconstruct/util/options_fields.h): the checks, the pipeline's cache
+  // key and report come from it; sparse_options_test fails when one is missing.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("input_type", o.input_type, R::Closed(0, 2), "Input: 0 auto, 1 photos or a video, 2 a COLMAP workspace");
+    v.Struct("import", o.import);
+    v.Struct("video", o.video);
+    v.Field("camera_model", o.camera_model, R::OneOf({"SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV"}),
+            "COLMAP camera model of the photos");
+    v.Field("shared_camera", o.shared_camera, R::Any(), "One calibration per camera group rather than per photo");
+    v.Field("matcher", o.matcher, R::Closed(0, 2), "Matcher: 0 auto, 1 exhaustive, 2 sequential");
+    v.Field("exhaustive_max_photos", o.exhaustive_max_photos, R::Closed(3, 100000), "The automatic matcher's switch-over, photos");
+    v.Field("sequential_overlap", o.sequential_overlap, R::Closed(1, 1000), "Neighbours matched by the sequential matcher");
+    v.Field("max_features", o.max_features, R::Closed(500, 100000), "SIFT features per photo");
+    v.Field("sift_first_octave", o.sift_first_octave, R::Closed(-1, 2), "First octave of the SIFT pyramid (-1: upsampled)");
+    v.Field("native_matching", o.native_matching, R::Any(), "Match descriptors with casual3d's matcher, not COLMAP's");
+    v.Field("num_threads", o.num_threads, R::Closed(0, 1024), "Worker threads; 0 = all cores", util::Keyed::kNo);
+    v.Field("init_min_tri_angle_deg", o.init_min_tri_angle_deg, R::Closed(0.5, 60),
+            "Smallest triangulation angle of the mapper's initial pair, degrees");
+    v.Field("min_registered_fraction", o.min_registered_fraction, R::Closed(0, 1),
+            "Fewer registered photos than this fraction is an error");
+    v.Field("overwrite", o.overwrite, R::Any(), "Replace an existing output folder", util::Keyed::kNo);
+    v.Field("keep_work", o.keep_work, R::Any(), "Keep COLMAP's database and raw models in OUT/work");
+    v.Field("colmap_path", o.colmap_path, R::Any(), "COLMAP program; empty: colmap on PATH");
+    v.Struct("depth_ranges", o.depth_ranges);
+    v.Struct("frame", o.frame);
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 struct SparseStageResult {

@@ -75,30 +75,6 @@ double Motion(const cv::Mat& a, const cv::Mat& b) {
 
 }  // namespace
 
-Status VideoFrameOptions::Check() const {
-  if (max_frames < 3 || max_frames > 2000) {
-    return InvalidArgument("max_frames " + std::to_string(max_frames) + " is outside [3, 2000]");
-  }
-  if (!(min_step_fraction >= 0 && min_step_fraction <= 1)) {
-    return InvalidArgument("min_step_fraction " + std::to_string(min_step_fraction) +
-                           " is outside [0, 1]");
-  }
-  if (!(blur_ratio >= 0 && blur_ratio <= 1)) {
-    return InvalidArgument("blur_ratio " + std::to_string(blur_ratio) + " is outside [0, 1]");
-  }
-  if (blur_window < 1 || blur_window > 100) {
-    return InvalidArgument("blur_window " + std::to_string(blur_window) + " is outside [1, 100]");
-  }
-  if (analysis_long_side < 64 || analysis_long_side > 4096) {
-    return InvalidArgument("analysis_long_side " + std::to_string(analysis_long_side) +
-                           " is outside [64, 4096]");
-  }
-  if (jpeg_quality < 50 || jpeg_quality > 100) {
-    return InvalidArgument("jpeg_quality " + std::to_string(jpeg_quality) + " is outside [50, 100]");
-  }
-  return Status::Ok();
-}
-
 bool IsVideoFileName(const std::string& name) {
   const std::string l = Lower(name);
   if (name.empty() || name[0] == '.') return false;

@@ -9,12 +9,6 @@
 
 namespace casual3d::stitch {
 
-std::string AlphaExpansionOptions::Check() const {
-  if (max_cycles < 1) return "max_cycles " + std::to_string(max_cycles) + ": must be >= 1";
-  if (!(min_relative_decrease >= 0)) return "min_relative_decrease: must be >= 0";
-  return "";
-}
-
 GridMrf::GridMrf(int width, int height, int num_labels, bool wrap_x)
     : width_(width), height_(height), num_labels_(num_labels), wrap_x_(wrap_x) {
   if (width <= 0 || height <= 0 || num_labels <= 0) {
@@ -52,8 +46,8 @@ std::vector<int> GridMrf::Solve(const Pairwise& pairwise,
 
 std::vector<int> GridMrf::Solve(std::vector<int> labels, const Pairwise& pairwise,
                                 const AlphaExpansionOptions& options) const {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("alpha expansion options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("alpha expansion options: " + st.message());
   const int n = width_ * height_;
   if (static_cast<int>(labels.size()) != n) {
     throw std::invalid_argument("GridMrf::Solve: initial labelling has the wrong size");

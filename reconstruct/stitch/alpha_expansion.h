@@ -16,6 +16,7 @@
 #include <functional>
 #include <string>
 #include <vector>
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::stitch {
 
@@ -25,7 +26,14 @@ struct AlphaExpansionOptions {
   int max_cycles = 4;  // Full sweeps over all labels; >= 1.
   // Stop when a whole cycle lowers the energy by less than this fraction.
   double min_relative_decrease = 1e-4;
-  std::string Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("max_cycles", o.max_cycles, R::AtLeast(1), "Full sweeps over all labels");
+    v.Field("min_relative_decrease", o.min_relative_decrease, R::AtLeast(0),
+            "Stop when a cycle lowers the energy by less than this fraction");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 class GridMrf {

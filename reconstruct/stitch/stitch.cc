@@ -80,8 +80,8 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
                           const std::vector<warp::WarpedView>& coarse,
                           const std::vector<ViewGeometry>& views, int pano_width,
                           const StitchedLayer* front, const StitchOptions& options) {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("stitch options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("stitch options: " + st.message());
   if (full.size() != coarse.size() || full.size() != views.size() || full.empty()) {
     throw std::invalid_argument("stitch: full, coarse warps and views must be equally many (>0)");
   }
@@ -257,26 +257,6 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
 }
 
 }  // namespace
-
-std::string StitchOptions::Check() const {
-  if (solve_width <= 0 || solve_height <= 0 || solve_width != 2 * solve_height) {
-    return "solve_width x solve_height: must be positive with width = 2 * height";
-  }
-  if (!(lambda_stretch >= 0 && lambda_parallax >= 0 && lambda_gc >= 0 &&
-        lambda_seam_color >= 0 && lambda_seam_depth >= 0 && lambda_seam_invalid >= 0)) {
-    return "lambda_*: must be >= 0";
-  }
-  if (!(parallax_scale_deg > 0)) return "parallax_scale_deg: must be > 0";
-  if (!(gc_depth_tolerance > 0 && gc_depth_tolerance < 1)) {
-    return "gc_depth_tolerance: must be in (0, 1)";
-  }
-  if (gc_min_support < 1) return "gc_min_support: must be >= 1";
-  if (!(seam_depth_scale > 0)) return "seam_depth_scale: must be > 0";
-  if (!(back_tolerance >= 0 && back_tolerance < 1)) return "back_tolerance: must be in [0, 1)";
-  if (upsample_radius < 0 || upsample_radius > 4) return "upsample_radius: must be in [0, 4]";
-  if (!(upsample_sigma_color > 0)) return "upsample_sigma_color: must be > 0";
-  return solver.Check();
-}
 
 StitchedLayer StitchFront(const std::vector<warp::WarpedView>& full,
                           const std::vector<warp::WarpedView>& coarse,

@@ -33,6 +33,7 @@
 #include "format/image.h"
 #include "reconstruct/stitch/alpha_expansion.h"
 #include "reconstruct/warp/warp.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::stitch {
 
@@ -60,7 +61,28 @@ struct StitchOptions {
 
   AlphaExpansionOptions solver;
 
-  std::string Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("solve_width", o.solve_width, R::AtLeast(2), "Width the labelling is solved at, pixels (Sec. 4.4.2)");
+    v.Field("solve_height", o.solve_height, R::AtLeast(1), "Height the labelling is solved at: width / 2");
+    v.Field("lambda_stretch", o.lambda_stretch, R::AtLeast(0), "Cost per unit stretch penalty");
+    v.Field("lambda_parallax", o.lambda_parallax, R::AtLeast(0), "Cost at parallax_scale_deg and beyond");
+    v.Field("parallax_scale_deg", o.parallax_scale_deg, R::Above(0), "Parallax that costs lambda_parallax, degrees");
+    v.Field("lambda_gc", o.lambda_gc, R::AtLeast(0), "Cost of a pixel with no support; 0 disables GC");
+    v.Field("gc_depth_tolerance", o.gc_depth_tolerance, R::Open(0, 1), "Relative depth agreement for support");
+    v.Field("gc_min_support", o.gc_min_support, R::AtLeast(1), "Supporting photos for zero GC cost");
+    v.Field("lambda_seam_color", o.lambda_seam_color, R::AtLeast(0), "Seam cost per unit mean absolute colour difference");
+    v.Field("lambda_seam_depth", o.lambda_seam_depth, R::AtLeast(0), "Seam cost of a depth step of seam_depth_scale or more");
+    v.Field("seam_depth_scale", o.seam_depth_scale, R::Above(0), "Relative depth step that costs lambda_seam_depth");
+    v.Field("lambda_seam_invalid", o.lambda_seam_invalid, R::AtLeast(0), "Seam cost next to a pixel one label cannot show");
+    v.Field("back_tolerance", o.back_tolerance, R::ClosedOpen(0, 1), "Back may be this much (relative) in front of the front");
+    v.Field("upsample_radius", o.upsample_radius, R::Closed(0, 4), "Label upsampling radius, solve-resolution pixels");
+    v.Field("upsample_sigma_color", o.upsample_sigma_color, R::Above(0), "Label upsampling colour sigma, 8-bit units");
+    v.Struct("solver", o.solver);
+    v.Require(o.solve_width == 2 * o.solve_height, "solve_width", "must be 2 * solve_height");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // One stitched layer at full resolution.

@@ -101,12 +101,12 @@ TEST(StitchTest, FrontAndBackLayersMatchTheScene) {
 
 TEST(StitchTest, OptionsAreChecked) {
   StitchOptions options;
-  EXPECT_EQ(options.Check(), "");
+  EXPECT_TRUE(options.Check().ok());
   options.solve_width = 300;
-  EXPECT_NE(options.Check(), "");
+  EXPECT_FALSE(options.Check().ok());
   options = StitchOptions();
   options.gc_depth_tolerance = 0;
-  EXPECT_NE(options.Check(), "");
+  EXPECT_FALSE(options.Check().ok());
 }
 
 }  // namespace

@@ -151,25 +151,6 @@ bool DirectionInView(const Eigen::Vector3d& dir_pano, const Eigen::Matrix3d& R_c
 
 }  // namespace
 
-std::string WarpOptions::Check() const {
-  if (pano_width <= 0 || pano_height <= 0 || pano_width != 2 * pano_height) {
-    return "pano_width x pano_height " + std::to_string(pano_width) + "x" +
-           std::to_string(pano_height) + ": must be positive with width = 2 * height";
-  }
-  if (pano_width > 65536) return "pano_width " + std::to_string(pano_width) + ": at most 65536";
-  if (!(tau_stretch_deg > 0 && tau_stretch_deg < 90)) {
-    return "tau_stretch_deg " + std::to_string(tau_stretch_deg) + ": must be in (0, 90)";
-  }
-  if (!(near_m > 0)) return "near_m " + std::to_string(near_m) + ": must be positive";
-  if (!(max_triangle_width_fraction > 0 && max_triangle_width_fraction <= 0.5)) {
-    return "max_triangle_width_fraction: must be in (0, 0.5]";
-  }
-  if (!(min_edge_depth_ratio >= 0 && min_edge_depth_ratio < 1)) {
-    return "min_edge_depth_ratio: must be in [0, 1)";
-  }
-  return "";
-}
-
 bool WarpedLayer::ToCrop(int x, int y, int pano_width, int* cx, int* cy) const {
   *cy = y - y0;
   if (*cy < 0 || *cy >= height()) return false;
@@ -182,8 +163,8 @@ bool WarpedLayer::ToCrop(int x, int y, int pano_width, int* cx, int* cy) const {
 
 WarpedView WarpView(const SourceView& view, const PanoramaFrame& frame,
                     const WarpOptions& options) {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("warp options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("warp options: " + st.message());
   if (view.rgb == nullptr || view.depth_m == nullptr || view.rgb->channels() != 3 ||
       view.depth_m->channels() != 1 || view.rgb->empty() || view.depth_m->empty()) {
     throw std::invalid_argument("warp: a view needs an RGB image and a 1-channel depth map");
@@ -309,8 +290,8 @@ WarpedView WarpView(const SourceView& view, const PanoramaFrame& frame,
 
 std::vector<WarpedView> WarpViews(const std::vector<SourceView>& views, const PanoramaFrame& frame,
                                   const WarpOptions& options, int num_threads) {
-  const std::string why = options.Check();
-  if (!why.empty()) throw std::invalid_argument("warp options: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("warp options: " + st.message());
   std::vector<WarpedView> out(views.size());
   if (num_threads <= 0) num_threads = std::max(1u, std::thread::hardware_concurrency());
   num_threads = std::min<int>(num_threads, static_cast<int>(views.size()));

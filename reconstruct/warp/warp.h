@@ -25,6 +25,7 @@
 #include "format/image.h"
 #include "reconstruct/geometry/camera.h"
 #include "reconstruct/geometry/pose.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::warp {
 
@@ -50,7 +51,20 @@ struct WarpOptions {
   double min_edge_depth_ratio = 0.9;
 
   // Returns an empty string if valid, else "field value: reason".
-  std::string Check() const;
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("pano_width", o.pano_width, R::Closed(1, 65536), "Panorama width, pixels (the panorama stage sets it)");
+    v.Field("pano_height", o.pano_height, R::AtLeast(1), "Panorama height, pixels: width / 2");
+    v.Field("tau_stretch_deg", o.tau_stretch_deg, R::Open(0, 90), "Grazing angle below which a triangle is stretched, degrees (Sec. 4.4.1)");
+    v.Field("near_m", o.near_m, R::Above(0), "Depth normalisation z = 1 - near_m / r, metres");
+    v.Field("max_triangle_width_fraction", o.max_triangle_width_fraction, R::OpenClosed(0, 0.5),
+            "Triangles wider than this fraction of the panorama are dropped");
+    v.Field("min_edge_depth_ratio", o.min_edge_depth_ratio, R::ClosedOpen(0, 1),
+            "Triangles whose depth ratio min / max is below this are not drawn; 0 draws all");
+    v.Require(o.pano_width == 2 * o.pano_height, "pano_width", "must be 2 * pano_height");
+  }
+  Status Check() const { return util::CheckFields(*this); }
 };
 
 // One photo with its depth map. The camera must be undistorted (pinhole part

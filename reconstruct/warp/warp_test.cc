@@ -148,11 +148,11 @@ TEST(WarpTest, RejectsBadOptions) {
   WarpOptions options;
   options.pano_width = 1000;
   options.pano_height = 400;
-  EXPECT_NE(options.Check(), "");
+  EXPECT_FALSE(options.Check().ok());
   options = WarpOptions();
   options.tau_stretch_deg = 0;
-  EXPECT_NE(options.Check(), "");
-  EXPECT_EQ(WarpOptions().Check(), "");
+  EXPECT_FALSE(options.Check().ok());
+  EXPECT_TRUE(WarpOptions().Check().ok());
 }
 
 }  // namespace
