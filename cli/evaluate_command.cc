@@ -107,8 +107,8 @@ void AddEvaluateCommand(CLI::App& app) {
   cmd->callback([args] {
     args->options.viewer_views = !args->no_viewer_views;
     args->options.backdrop = !args->no_backdrop;
-    if (const std::string why = args->options.Check(); !why.empty())
-      throw std::invalid_argument("evaluate: --" + why);
+    if (const Status st = args->options.Check(); !st.ok())
+      throw std::invalid_argument("evaluate: --" + st.message());
     if (!args->labels.empty() && args->labels.size() != args->photo3d.size())
       throw std::invalid_argument("--labels: " + std::to_string(args->labels.size()) +
                                   " names for " + std::to_string(args->photo3d.size()) +
@@ -129,8 +129,8 @@ void AddEvaluateCommand(CLI::App& app) {
       }
       args->report.references.push_back(ref);
     }
-    if (const std::string why = args->report.Check(); !why.empty())
-      throw std::invalid_argument("evaluate: --" + why);
+    if (const Status st = args->report.Check(); !st.ok())
+      throw std::invalid_argument("evaluate: --" + st.message());
     if (!args->write_cameras.empty() && args->photo3d.size() != 1)
       throw std::invalid_argument("--write-cameras: give exactly one 3D photo (got " +
                                   std::to_string(args->photo3d.size()) + ")");

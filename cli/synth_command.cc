@@ -42,7 +42,7 @@ void AddSynthCommand(CLI::App& app) {
     if (!synth::RigKindFromName(*rig_name, &options->rig)) {
       throw std::invalid_argument("--rig '" + *rig_name + "' is not partial, sphere or walk-around");
     }
-    if (std::string why = options->Check(); !why.empty()) throw std::invalid_argument(why);
+    if (const Status st = options->Check(); !st.ok()) throw std::invalid_argument(st.message());
     const synth::CaptureSummary s = synth::GenerateCapture(*options, *out_dir);
     std::printf(
         "synth: wrote %s: %d photos of %dx%d (%s rig), %zu points (mean track %.1f), "

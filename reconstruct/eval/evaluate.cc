@@ -31,18 +31,18 @@ namespace casual3d::eval {
 
 namespace fs = std::filesystem;
 
-std::string EvaluateOptions::Check() const {
+Status EvaluateOptions::Check() const {
   if (width != 0 && (width < 16 || width > 8192))
-    return "width: " + std::to_string(width) + " is outside [16, 8192] (or 0 for the photos' size)";
+    return InvalidArgument("width: " + std::to_string(width) + " is outside [16, 8192] (or 0 for the photos' size)");
   if (holdout_every < 0 || holdout_every > 1000)
-    return "holdout_every: " + std::to_string(holdout_every) + " is outside [0, 1000]";
+    return InvalidArgument("holdout_every: " + std::to_string(holdout_every) + " is outside [0, 1000]");
   if (!(depth_tolerance > 0 && depth_tolerance <= 1))
-    return "depth_tolerance: " + std::to_string(depth_tolerance) + " is outside (0, 1]";
+    return InvalidArgument("depth_tolerance: " + std::to_string(depth_tolerance) + " is outside (0, 1]");
   if (num_threads < 0 || num_threads > 256)
-    return "num_threads: " + std::to_string(num_threads) + " is outside [0, 256]";
-  if (const std::string why = metrics.Check(); !why.empty()) return "metrics." + why;
-  if (const std::string why = viewer.Check(); !why.empty()) return "viewer." + why;
-  return {};
+    return InvalidArgument("num_threads: " + std::to_string(num_threads) + " is outside [0, 256]");
+  if (const Status s = metrics.Check(); !s.ok()) return InvalidArgument("metrics." + s.message());
+  if (const Status s = viewer.Check(); !s.ok()) return InvalidArgument("viewer." + s.message());
+  return Status::Ok();
 }
 
 std::vector<int> SelectPhotos(const std::vector<std::string>& names,
@@ -280,8 +280,8 @@ DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r,
 PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
                                      const std::string& photo3d_path,
                                      const EvaluateOptions& options) {
-  if (const std::string why = options.Check(); !why.empty())
-    throw std::invalid_argument("evaluate: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("evaluate: " + st.message());
   const fs::path capture(capture_dir);
   std::error_code ec;
   if (!fs::is_directory(capture, ec))

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "format/status.h"
 #include "format/image.h"
 #include "reconstruct/eval/rephoto_metrics.h"
 #include "reconstruct/eval/viewer_views.h"
@@ -75,7 +76,7 @@ struct EvaluateOptions {
   // Needs cameras without lens distortion (the undistorted workspace).
   std::string rendered_dir;
 
-  std::string Check() const;  // Empty if valid, else "field: reason".
+  Status Check() const;  // Names the field and its range.
 };
 
 // Depth of the rephotograph against a synthetic capture's ground truth

@@ -42,12 +42,12 @@ TEST(SelectPhotosTest, HeldOutListOrAll) {
 
 TEST(EvaluateOptionsTest, CheckNamesTheField) {
   EvaluateOptions options;
-  EXPECT_EQ(options.Check(), "");
+  EXPECT_TRUE(options.Check().ok());
   options.width = 5;
-  EXPECT_NE(options.Check().find("width"), std::string::npos);
+  EXPECT_NE(options.Check().message().find("width"), std::string::npos);
   options.width = 900;
   options.metrics.psnr_cap_db = -1;
-  EXPECT_NE(options.Check().find("metrics.psnr_cap_db"), std::string::npos);
+  EXPECT_NE(options.Check().message().find("metrics.psnr_cap_db"), std::string::npos);
 }
 
 // End to end on a tiny synthetic capture: the 3D photo is built by the

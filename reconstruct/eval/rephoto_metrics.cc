@@ -10,14 +10,14 @@
 
 namespace casual3d::eval {
 
-std::string RephotoMetricOptions::Check() const {
+Status RephotoMetricOptions::Check() const {
   if (shift_radius_px < 0 || shift_radius_px > 8)
-    return "shift_radius_px: " + std::to_string(shift_radius_px) + " is outside [0, 8]";
+    return InvalidArgument("shift_radius_px: " + std::to_string(shift_radius_px) + " is outside [0, 8]");
   if (!(psnr_cap_db > 0.0 && psnr_cap_db <= 1000.0))
-    return "psnr_cap_db: " + std::to_string(psnr_cap_db) + " is outside (0, 1000]";
+    return InvalidArgument("psnr_cap_db: " + std::to_string(psnr_cap_db) + " is outside (0, 1000]");
   if (histogram_bins < 8 || histogram_bins > 4096)
-    return "histogram_bins: " + std::to_string(histogram_bins) + " is outside [8, 4096]";
-  return {};
+    return InvalidArgument("histogram_bins: " + std::to_string(histogram_bins) + " is outside [8, 4096]");
+  return Status::Ok();
 }
 
 namespace {
@@ -52,8 +52,8 @@ RephotoMetrics ComputeRephotoMetrics(ImageView<const uint8_t> photo,
                                      ImageView<const uint8_t> render, ImageView<const uint8_t> mask,
                                      const RephotoMetricOptions& options, ImageF* error_map,
                                      Image8* filled_out) {
-  if (const std::string why = options.Check(); !why.empty())
-    throw std::invalid_argument("rephotography metrics: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("rephotography metrics: " + st.message());
   if (photo.channels() != 3 || render.channels() != 3 || mask.channels() != 1)
     throw std::invalid_argument(
         "rephotography metrics: photo and render must be RGB, mask 1 channel");

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "format/status.h"
 #include "format/image.h"
 
 namespace casual3d::eval {
@@ -42,7 +43,7 @@ struct RephotoMetricOptions {
   int histogram_bins = 256;
 
   // Empty if valid, else "field: reason".
-  std::string Check() const;
+  Status Check() const;  // Names the field and its range.
 };
 
 struct RephotoMetrics {

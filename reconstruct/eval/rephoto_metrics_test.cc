@@ -119,7 +119,7 @@ TEST(RephotoMetricsTest, RejectsMismatchedInputsAndBadOptions) {
                std::invalid_argument);
   RephotoMetricOptions bad;
   bad.shift_radius_px = 9;
-  EXPECT_NE(bad.Check().find("shift_radius_px"), std::string::npos);
+  EXPECT_NE(bad.Check().message().find("shift_radius_px"), std::string::npos);
   EXPECT_THROW(ComputeRephotoMetrics(a.view(), a.view(), std::as_const(mask).view(), bad),
                std::invalid_argument);
 }

@@ -16,16 +16,16 @@
 
 namespace casual3d::eval {
 
-std::string ReportOptions::Check() const {
+Status ReportOptions::Check() const {
   if (thumbnail_width < 32 || thumbnail_width > 2048)
-    return "thumbnail_width: " + std::to_string(thumbnail_width) + " is outside [32, 2048]";
+    return InvalidArgument("thumbnail_width: " + std::to_string(thumbnail_width) + " is outside [32, 2048]");
   if (!(heatmap_max_error > 0 && heatmap_max_error <= 1))
-    return "heatmap_max_error: " + std::to_string(heatmap_max_error) + " is outside (0, 1]";
+    return InvalidArgument("heatmap_max_error: " + std::to_string(heatmap_max_error) + " is outside (0, 1]");
   for (const ReferenceResult& r : references)
     if (r.label.empty() || !(r.psnr_db > 0 && r.psnr_db < 1000) || !(r.ssim >= -1 && r.ssim <= 1))
-      return "references: '" + r.label +
-             "' needs a name, a PSNR in (0, 1000) dB and an SSIM in [-1, 1]";
-  return {};
+      return InvalidArgument("references: '" + r.label +
+             "' needs a name, a PSNR in (0, 1000) dB and an SSIM in [-1, 1]");
+  return Status::Ok();
 }
 
 std::string Base64(const std::string& bytes) {
@@ -144,8 +144,8 @@ std::string ErrorCompletenessSvg(const std::vector<PhotoModelEvaluation>& evals)
 std::string RenderHtmlReport(const std::string& capture,
                              const std::vector<PhotoModelEvaluation>& evals,
                              const ReportOptions& options) {
-  if (const std::string why = options.Check(); !why.empty())
-    throw std::invalid_argument("report: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("report: " + st.message());
   std::ostringstream s;
   s << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>"
     << util::HtmlEscape(options.title)

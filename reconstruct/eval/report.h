@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "format/status.h"
 #include "reconstruct/eval/evaluate.h"
 
 namespace casual3d::eval {
@@ -37,7 +38,7 @@ struct ReportOptions {
   std::string title = "casual3d rephotography report";
   std::vector<ReferenceResult> references;  // Shown under the 3D photos' rows.
 
-  std::string Check() const;  // Empty if valid, else "field: reason".
+  Status Check() const;  // Names the field and its range.
 };
 
 // The HTML document for `capture` and the evaluations of one or more 3D photos.

@@ -48,18 +48,18 @@ double TriangleScreenSize(const Mesh& mesh, size_t t, const Eigen::Vector3d& eye
 
 }  // namespace
 
-std::string ViewerViewsOptions::Check() const {
+Status ViewerViewsOptions::Check() const {
   if (width < 16 || width > 4096)
-    return "width: " + std::to_string(width) + " is outside [16, 4096]";
+    return InvalidArgument("width: " + std::to_string(width) + " is outside [16, 4096]");
   if (height < 16 || height > 4096)
-    return "height: " + std::to_string(height) + " is outside [16, 4096]";
+    return InvalidArgument("height: " + std::to_string(height) + " is outside [16, 4096]");
   if (!(stretch_factor >= 1 && stretch_factor <= 1000))
-    return "stretch_factor: " + std::to_string(stretch_factor) + " is outside [1, 1000]";
+    return InvalidArgument("stretch_factor: " + std::to_string(stretch_factor) + " is outside [1, 1000]");
   if (!(closing_deg >= 0 && closing_deg <= 45))
-    return "closing_deg: " + std::to_string(closing_deg) + " is outside [0, 45]";
+    return InvalidArgument("closing_deg: " + std::to_string(closing_deg) + " is outside [0, 45]");
   if (num_threads < 0 || num_threads > 256)
-    return "num_threads: " + std::to_string(num_threads) + " is outside [0, 256]";
-  return {};
+    return InvalidArgument("num_threads: " + std::to_string(num_threads) + " is outside [0, 256]");
+  return Status::Ok();
 }
 
 std::vector<render::GlCamera> ViewerCameras(const ViewHints& hints) {
@@ -146,8 +146,8 @@ ViewerViewsEvaluation EvaluateViewerViews(const TwoLayerPanorama& pano, const Me
                                           ImageView<const uint8_t> atlas,
                                           const std::optional<ViewHints>& hints,
                                           const ViewerViewsOptions& options) {
-  if (const std::string why = options.Check(); !why.empty())
-    throw std::invalid_argument("viewer views: " + why);
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("viewer views: " + st.message());
   ViewerViewsEvaluation eval;
   eval.hints = render::ResolveViewHints(pano, options.derive_hints ? std::nullopt : hints,
                                         &eval.hints_derived);

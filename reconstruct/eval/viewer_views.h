@@ -44,6 +44,7 @@
 #include <string>
 #include <vector>
 
+#include "format/status.h"
 #include "format/image.h"
 #include "format/mesh.h"
 #include "format/two_layer.h"
@@ -71,7 +72,7 @@ struct ViewerViewsOptions {
   // vertex colours (render::RenderOptions::vertex_colors_from_triangle).
   uint64_t vertex_colors_from_triangle = UINT64_MAX;
 
-  std::string Check() const;  // Empty if valid, else "field: reason".
+  Status Check() const;  // Names the field and its range.
 };
 
 // The 17 viewer cameras of `hints` (index 0 the centre), and their names

@@ -44,6 +44,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "format/status.h"
 #include "format/equirect.h"
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/pipeline/coverage.h"
@@ -72,7 +73,7 @@ struct CaptureShapeOptions {
   // Directions sampled on the sphere for the coverage, [64, 1e6].
   int sphere_samples = 8192;
 
-  std::string Check() const;  // Empty if valid, else "field: reason".
+  Status Check() const;  // Names the field and its range.
 };
 
 struct CaptureShape {

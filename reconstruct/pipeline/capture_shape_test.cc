@@ -301,9 +301,9 @@ TEST(NameRuns, ConsecutiveNamesBecomeRanges) {
 
 TEST(CaptureShapeOptions, CheckNamesTheField) {
   CaptureShapeOptions o;
-  EXPECT_EQ(o.Check(), "");
+  EXPECT_TRUE(o.Check().ok());
   o.min_sweep = 0.5;
-  EXPECT_EQ(o.Check().rfind("min_sweep", 0), 0u);
+  EXPECT_EQ(o.Check().message().rfind("min_sweep", 0), 0u);
   EXPECT_THROW(MeasureCaptureShape(geometry::SparseModel(), PanoramaFrame(), {}, true, o),
                std::invalid_argument);
 }

@@ -17,6 +17,7 @@
 //     (a front-to-back link and a back-to-front one between the same pixels);
 //     links are mutual; right/left wrap around the 180 degree seam.
 
+#include "format/status.h"
 #include "format/two_layer.h"
 #include "reconstruct/synth/ground_truth_panorama.h"
 
@@ -26,10 +27,10 @@ struct TwoLayerOptions {
   double tau_dratio = 0.75;   // Sec. 4.4.3: back nodes with d(f)/d(b) above this are dropped, (0, 1].
   double link_ratio = 0.9;    // Neighbours link when their depth ratio is above this, (0, 1).
   double sky_depth_m = 1000.0;  // Depth given to the sky, metres, > 0.
-  std::string Check() const;  // Empty if valid, else names the field and its range.
+  Status Check() const;  // Names the field and its range.
 };
 
-// Precondition: options.Check() is empty and the panorama has kNumPanoramaChannels channels.
+// Precondition: options.Check() is ok and the panorama has kNumPanoramaChannels channels.
 TwoLayerPanorama GroundTruthToTwoLayer(const GroundTruthPanorama& gt, const TwoLayerOptions& options);
 
 }  // namespace casual3d::synth

@@ -40,7 +40,7 @@ TEST(GroundTruthTwoLayerTest, DropsRedundantBacksAndLinksSimilarDepths) {
   SetSurface(&gt, 3, 1, 0, kInf);
 
   TwoLayerOptions options;
-  ASSERT_EQ(options.Check(), "");
+  ASSERT_TRUE(options.Check().ok());
   const TwoLayerPanorama pano = GroundTruthToTwoLayer(gt, options);
   ASSERT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
   EXPECT_TRUE(pano.present(kBack, 1, 0));

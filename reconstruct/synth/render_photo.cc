@@ -44,12 +44,12 @@ Eigen::Vector3d Sample(const Scene& scene, const CameraRays& rays, double u, dou
 
 }  // namespace
 
-std::string RenderOptions::Check() const {
+Status RenderOptions::Check() const {
   if (edge_samples < 1 || edge_samples > 8) {
-    return "edge_samples " + std::to_string(edge_samples) + " is outside 1..8";
+    return InvalidArgument("edge_samples " + std::to_string(edge_samples) + " is outside 1..8");
   }
-  if (num_threads < 0) return "num_threads must be >= 0";
-  return "";
+  if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
+  return Status::Ok();
 }
 
 PhotoRender RenderPhoto(const Scene& scene, const geometry::Camera& camera,

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <string>
 
+#include "format/status.h"
 #include "format/image.h"
 #include "reconstruct/geometry/camera.h"
 #include "reconstruct/geometry/pose.h"
@@ -20,7 +21,7 @@ namespace casual3d::synth {
 struct RenderOptions {
   int edge_samples = 3;  // Rays per axis at edge pixels (n x n), 1..8; 1 disables anti-aliasing.
   int num_threads = 0;   // 0: all hardware threads. Results do not depend on it.
-  std::string Check() const;  // Empty if valid, else names the field and its range.
+  Status Check() const;  // Names the field and its range.
 };
 
 struct PhotoRender {

@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include "format/status.h"
 #include "reconstruct/geometry/camera.h"
 #include "reconstruct/geometry/pose.h"
 
@@ -51,7 +52,7 @@ struct RigOptions {
   // The defaults of a rig kind (size, photo count, field of view).
   static RigOptions Defaults(RigKind kind);
   // Empty if valid; otherwise names the field and its valid range.
-  std::string Check() const;
+  Status Check() const;  // Names the field and its range.
 };
 
 struct Rig {
@@ -60,7 +61,7 @@ struct Rig {
 };
 
 // Lays out the rig around `centre` (world, metres); world +Y is up and the rig
-// faces world -Z. Precondition: options.Check() is empty.
+// faces world -Z. Precondition: options.Check() is ok.
 Rig MakeRig(const RigOptions& options, const Eigen::Vector3d& centre);
 
 }  // namespace casual3d::synth

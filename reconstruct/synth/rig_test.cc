@@ -11,7 +11,7 @@ constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 TEST(RigTest, PartialRigIsAForwardGridOnASphere) {
   RigOptions o = RigOptions::Defaults(RigKind::kPartial);
-  ASSERT_EQ(o.Check(), "");
+  ASSERT_TRUE(o.Check().ok());
   const Eigen::Vector3d centre(0, 1.5, 0);
   const Rig rig = MakeRig(o, centre);
   ASSERT_EQ(rig.poses.size(), 16u);
@@ -90,10 +90,10 @@ TEST(RigTest, JitterIsSeededAndOptionsAreChecked) {
   EXPECT_EQ(a.poses[3].translation, b.poses[3].translation);
   EXPECT_NE(a.poses[3].translation, c.poses[3].translation);
   o.width = 4;
-  EXPECT_NE(o.Check().find("width"), std::string::npos);
+  EXPECT_NE(o.Check().message().find("width"), std::string::npos);
   o = RigOptions::Defaults(RigKind::kPartial);
   o.num_photos = 1;
-  EXPECT_NE(o.Check().find("photos"), std::string::npos);
+  EXPECT_NE(o.Check().message().find("photos"), std::string::npos);
   RigKind kind;
   EXPECT_TRUE(RigKindFromName("sphere", &kind));
   EXPECT_EQ(kind, RigKind::kSphere);

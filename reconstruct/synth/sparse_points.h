@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "format/status.h"
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/synth/rig.h"
 #include "reconstruct/synth/scene.h"
@@ -23,7 +24,7 @@ struct SparsePointOptions {
   int min_track = 2;    // Minimum number of observing photos, >= 1.
   uint64_t seed = 1;    // Jitter of the seed pixels.
   int num_threads = 0;  // 0: all cores. Results do not depend on it.
-  std::string Check() const;  // Empty if valid, else names the field and its range.
+  Status Check() const;  // Names the field and its range.
 };
 
 // `scenes[i]` is the scene as photo i saw it (the moving object displaced);

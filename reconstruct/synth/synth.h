@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <string>
 
+#include "format/status.h"
 #include "reconstruct/synth/rig.h"
 
 namespace casual3d::synth {
@@ -36,7 +37,7 @@ struct SynthOptions {
   int num_threads = 0;            // 0: all cores.
 
   // Empty if valid; otherwise one line naming the option and its valid range.
-  std::string Check() const;
+  Status Check() const;  // Names the field and its range.
   // The rig these options describe (defaults filled in).
   RigOptions ResolvedRig() const;
 };

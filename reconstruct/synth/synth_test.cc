@@ -86,16 +86,16 @@ TEST_F(SynthTest, DifferentSeedGivesDifferentPhotos) {
 TEST_F(SynthTest, OptionsAreChecked) {
   SynthOptions o = Small();
   o.panorama_width = 1001;
-  EXPECT_NE(o.Check().find("--panorama-width"), std::string::npos);
+  EXPECT_NE(o.Check().message().find("--panorama-width"), std::string::npos);
   EXPECT_THROW(GenerateCapture(o, Path("bad")), std::invalid_argument);
   EXPECT_FALSE(fs::exists(Path("bad")));
   o = Small();
   o.noise_sigma = -1;
-  EXPECT_NE(o.Check().find("--noise"), std::string::npos);
+  EXPECT_NE(o.Check().message().find("--noise"), std::string::npos);
   o = Small();
   o.num_photos = 1;
-  EXPECT_NE(o.Check().find("--photos"), std::string::npos);
-  EXPECT_EQ(Small().Check(), "");
+  EXPECT_NE(o.Check().message().find("--photos"), std::string::npos);
+  EXPECT_TRUE(Small().Check().ok());
 }
 
 double Median(std::vector<double> v) {
