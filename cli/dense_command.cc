@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/described_option.h"
 #include "reconstruct/depth/dense_stage.h"
 #include "reconstruct/depth/dense_units.h"
 #include "reconstruct/util/log.h"
@@ -115,71 +116,34 @@ void AddDenseCommand(CLI::App& app) {
                 "Ablation: no full-resolution depth search after upsampling");
   cmd->add_flag("--no-free-space-check", opts->no_free_space_check,
                 "Ablation: keep depths that other photos' depth maps see through");
-  cmd->add_option("--free-space-tolerance", opts->dense.visibility.tolerance,
-                  "Relative depth band within which another photo's depth agrees (free-space check)")
-      ->capture_default_str();
-  cmd->add_option("--free-space-labels", opts->dense.visibility.tolerance_labels,
-                  "... or this many label steps of inverse depth, whichever is larger")
-      ->capture_default_str();
-  cmd->add_option("--free-space-views", opts->dense.visibility.max_views,
-                  "Other photos each depth map is checked against (best neighbours first)")
-      ->capture_default_str();
-  cmd->add_option("--free-space-rounds", opts->dense.visibility.rounds,
-                  "Rounds of the free-space check over all photos")
-      ->capture_default_str();
-  cmd->add_option("--lambda-flat", opts->dense.mrf.lambda_flat,
-                  "Weight of the textureless-region prior in the MRF data term")
-      ->capture_default_str();
-  cmd->add_option("--relabel-neighbors", opts->dense.relabel.max_neighbors,
-                  "Neighbours the boundary relabelling tests (the sweep's first ones)")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--free-space-tolerance", opts->dense, opts->dense.visibility.tolerance);
+  AddDescribedOption(cmd, "--free-space-labels", opts->dense, opts->dense.visibility.tolerance_labels);
+  AddDescribedOption(cmd, "--free-space-views", opts->dense, opts->dense.visibility.max_views);
+  AddDescribedOption(cmd, "--free-space-rounds", opts->dense, opts->dense.visibility.rounds);
+  AddDescribedOption(cmd, "--lambda-flat", opts->dense, opts->dense.mrf.lambda_flat);
+  AddDescribedOption(cmd, "--relabel-neighbors", opts->dense, opts->dense.relabel.max_neighbors);
   cmd->add_flag("--refine", opts->refine,
                 "Continuous depth search within one label of the MRF's (slower; helps wide baselines)");
-  cmd->add_option("--threads", opts->dense.num_threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, 1024));
-  cmd->add_option("--scale", opts->dense.working_scale,
-                  "Sweep/MRF resolution relative to the photos, in (0, 1]")
-      ->capture_default_str();
-  cmd->add_option("--depths", opts->dense.sweep.num_depths, "Depth hypotheses (Sec. 4.3.1: 220)")
-      ->capture_default_str();
-  cmd->add_option("--neighbors", opts->dense.num_neighbors, "Neighbour photos per sweep")
-      ->capture_default_str();
-  cmd->add_option("--lambda-smooth", opts->dense.mrf.lambda_smooth, "Smoothness weight (Eq. 1)")
-      ->capture_default_str();
-  cmd->add_option("--lambda-near", opts->dense.mrf.lambda_near, "Near envelope penalty (Eq. 4)")
-      ->capture_default_str();
-  cmd->add_option("--mrf-passes", opts->dense.mrf.max_iterations,
-                  "Most TRW-S passes (each forward and backward); fewer is faster, at a higher energy")
-      ->capture_default_str();
-  cmd->add_option("--window-radius", opts->dense.sweep.window_radius,
-                  "ZNCC window radius at working resolution (2: 5x5)")
-      ->capture_default_str();
-  cmd->add_option("--texture-color-sigma", opts->dense.sweep.texture_color_sigma,
-                  "Colour sigma of the texture measure w_photo; 0 = plain window variance")
-      ->capture_default_str();
-  cmd->add_option("--min-far-over-near", opts->dense.min_far_over_near,
-                  "The sweep's far plane is at least this many times farther than its near plane")
-      ->capture_default_str();
-  cmd->add_option("--far-bias", opts->dense.mrf.far_bias,
-                  "Cost leaning textureless pixels away from the camera (MRF data term)")
-      ->capture_default_str();
-  cmd->add_option("--occlusion-truncation", opts->dense.sweep.occlusion_truncation,
-                  "Each of the best neighbours' matching costs is capped at the best one's plus "
-                  "this (1: plain mean)")
-      ->capture_default_str();
-  cmd->add_option("--neighbor-coverage", opts->dense.neighbors.coverage_k,
-                  "Neighbours are picked so that each part of the photo has this many partners "
-                  "(0: by score alone)")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--threads", opts->dense, opts->dense.num_threads);
+  AddDescribedOption(cmd, "--scale", opts->dense, opts->dense.working_scale);
+  AddDescribedOption(cmd, "--depths", opts->dense, opts->dense.sweep.num_depths);
+  AddDescribedOption(cmd, "--neighbors", opts->dense, opts->dense.num_neighbors);
+  AddDescribedOption(cmd, "--lambda-smooth", opts->dense, opts->dense.mrf.lambda_smooth);
+  AddDescribedOption(cmd, "--lambda-near", opts->dense, opts->dense.mrf.lambda_near);
+  AddDescribedOption(cmd, "--mrf-passes", opts->dense, opts->dense.mrf.max_iterations);
+  AddDescribedOption(cmd, "--window-radius", opts->dense, opts->dense.sweep.window_radius);
+  AddDescribedOption(cmd, "--texture-color-sigma", opts->dense, opts->dense.sweep.texture_color_sigma);
+  AddDescribedOption(cmd, "--min-far-over-near", opts->dense, opts->dense.min_far_over_near);
+  AddDescribedOption(cmd, "--far-bias", opts->dense, opts->dense.mrf.far_bias);
+  AddDescribedOption(cmd, "--occlusion-truncation", opts->dense, opts->dense.sweep.occlusion_truncation);
+  AddDescribedOption(cmd, "--neighbor-coverage", opts->dense, opts->dense.neighbors.coverage_k);
   cmd->add_option("--pass", opts->pass,
                   "Run one unit of the stage over a shared OUT, for several processes or machines: "
                   "plan (list the photos), sweep, depth (per photo, see --photos), finish (all "
                   "photos); all units give the same files as one run without --pass");
   cmd->add_option("--photos", opts->photos,
                   "With --pass sweep or depth: the photos, by index in the plan, e.g. 0,3,5-9 (default: all)");
-  cmd->add_option("--ground-truth", opts->dense.ground_truth_dir,
-                  "Folder of ground-truth depth <stem>.exr (e.g. a synthetic capture's depth/) "
-                  "to evaluate against; results go to dense.json");
+  AddDescribedOption(cmd, "--ground-truth", opts->dense, opts->dense.ground_truth_dir);
   cmd->callback([opts]() { RunDense(*opts); });
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/described_option.h"
 #include "reconstruct/io/image_io.h"
 #include "reconstruct/pipeline/ground_truth_eval.h"
 #include "reconstruct/pipeline/panorama_stage.h"
@@ -32,35 +33,22 @@ void AddPanoramaCommand(CLI::App& app) {
                   "Folder holding depth/<photo>.exr (dense stage output); default: the workspace "
                   "itself (ground-truth depth of a synthetic capture)");
   cmd->add_option("-o,--output", args->output, "Output folder")->required();
-  cmd->add_option("--pano-width", args->options.pano_width,
-                  "Panorama width in pixels (height = width / 2); 0 = from the photos' angular "
-                  "resolution, at most --max-pano-width")
-      ->capture_default_str();
-  cmd->add_option("--max-pano-width", args->options.max_auto_width,
-                  "Largest automatic panorama width, a multiple of 1024 in 2048..16384")
-      ->capture_default_str();
-  cmd->add_option("--solve-width", args->options.stitch.solve_width,
-                  "Width at which the stitching MRF is solved (height = width / 2)")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--pano-width", args->options, args->options.pano_width);
+  AddDescribedOption(cmd, "--max-pano-width", args->options, args->options.max_auto_width);
+  AddDescribedOption(cmd, "--solve-width", args->options, args->options.stitch.solve_width);
   cmd->add_flag("--no-gap-fill", "Leave the front layer's gaps inside the photos' field of view empty")
       ->each([args](const std::string&) { args->options.fill_front_gaps = false; });
   cmd->add_flag("--front-only", "Front layer only (no back layer)")
       ->each([args](const std::string&) { args->options.back_layer = false; });
-  cmd->add_option("--min-edge-depth-ratio", args->options.warp.min_edge_depth_ratio,
-                  "Photo triangles whose depths differ by more (ratio min/max below this) are "
-                  "not warped: no rubber sheets across depth edges; 0 warps all")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--min-edge-depth-ratio", args->options, args->options.warp.min_edge_depth_ratio);
   cmd->add_flag("--no-seal", "Leave the quads fusion leaves open (tears seen from the centre)")
       ->each([args](const std::string&) { args->options.seal_tears = false; });
   cmd->add_flag("--no-gc", "Stitch without the geometric-consistency cost")
       ->each([args](const std::string&) { args->options.stitch.lambda_gc = 0.0; });
-  cmd->add_option("--sky-depth", args->options.sky_depth_m,
-                  "Depth for pixels without depth (sky), metres; 0 = automatic")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--sky-depth", args->options, args->options.sky_depth_m);
   cmd->add_option("--ground-truth", args->ground_truth,
                   "A synthetic capture's ground_truth/panorama.exr (same size) to compare with");
-  cmd->add_option("--threads", args->options.num_threads, "Worker threads; 0 = all cores")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--threads", args->options, args->options.num_threads);
   cmd->callback([args] {
     pipeline::PanoramaStageOptions options = args->options;
     options.stitch.solve_height = options.stitch.solve_width / 2;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/described_option.h"
 #include "cli/viewer_assets.h"
 #include "reconstruct/pipeline/pipeline.h"
 #include "reconstruct/util/log.h"
@@ -47,15 +48,11 @@ void AddReconstructCommand(CLI::App& app) {
                   "Panorama width in pixels (height = width / 2), even, 64..16384; 0 = from the "
                   "photos' angular resolution, at most --max-pano-width")
       ->capture_default_str();
-  cmd->add_option("--max-pano-width", args->options.panorama.max_auto_width,
-                  "Largest automatic panorama width, a multiple of 1024 in 2048..16384")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--max-pano-width", args->options.panorama, args->options.panorama.max_auto_width);
   cmd->add_option("--working-megapixels", args->working_megapixels,
                   "Photos are downscaled to about this size before matching and depth")
       ->capture_default_str();
-  cmd->add_option("--focal-px", args->options.sparse.import.focal_px,
-                  "Focal length prior in pixels at the photos' (or video's) original size; default: "
-                  "EXIF (a video has none: give it when its frames do not register)");
+  AddDescribedOption(cmd, "--focal-px", args->options.sparse, args->options.sparse.import.focal_px);
   AddSiftOptions(cmd, &args->options.sparse);
   AddPhotoInputOptions(cmd, &args->options.sparse);
   cmd->add_flag("--no-gap-fill", "Leave the front layer's gaps inside the photos' field of view empty")

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/described_option.h"
 #include "reconstruct/sfm/sparse_stage.h"
 #include "reconstruct/util/log.h"
 
@@ -57,12 +58,8 @@ void RunSparse(SparseCommandOptions options) {
 }  // namespace
 
 void AddSiftOptions(CLI::App* cmd, sfm::SparseStageOptions* options) {
-  cmd->add_option("--max-features", options->max_features,
-                  "SIFT features per photo for structure from motion [500, 100000]")
-      ->capture_default_str();
-  cmd->add_option("--sift-first-octave", options->sift_first_octave,
-                  "First SIFT octave: 0 at the photo's size, -1 doubled (slower, finer features) [-1, 2]")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--max-features", *options, options->max_features);
+  AddDescribedOption(cmd, "--sift-first-octave", *options, options->sift_first_octave);
   cmd->add_flag_callback("--colmap-matching", [options] { options->native_matching = false; },
                          "Match descriptors with COLMAP's own CPU matcher (same criteria, slower)");
 }
@@ -72,9 +69,7 @@ void AddPhotoInputOptions(CLI::App* cmd, sfm::SparseStageOptions* options) {
                          "Stop at an unreadable, truncated or corrupt photo instead of skipping it");
   cmd->add_flag("--mixed-cameras", options->import.allow_mixed_devices,
                 "Accept photos from different cameras (one calibration per camera)");
-  cmd->add_option("--max-frames", options->video.max_frames,
-                  "Video input: at most this many frames become photos [3, 2000]")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--max-frames", *options, options->video.max_frames);
 }
 
 void AddSparseCommand(CLI::App& app) {
@@ -92,33 +87,22 @@ void AddSparseCommand(CLI::App& app) {
   cmd->add_option("--input-type", options->input_type, "auto, photos or workspace")
       ->check(CLI::IsMember({"auto", "photos", "workspace"}))
       ->capture_default_str();
-  cmd->add_option("--working-megapixels", s.import.working_megapixels,
-                  "Downsample photos to about this many megapixels before matching [0.05, 100]")
-      ->capture_default_str();
-  cmd->add_option("--focal-px", s.import.focal_px,
-                  "Focal length prior in pixels at the photos' original size (default: EXIF)");
+  AddDescribedOption(cmd, "--working-megapixels", s, s.import.working_megapixels);
+  AddDescribedOption(cmd, "--focal-px", s, s.import.focal_px);
   AddPhotoInputOptions(cmd, &s);
-  cmd->add_option("--camera-model", s.camera_model,
-                  "COLMAP camera model: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV")
-      ->check(CLI::IsMember({"SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV"}))
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--camera-model", s, s.camera_model);
   cmd->add_flag("--camera-per-photo", options->camera_per_photo,
                 "Calibrate every photo separately (zooming or unknown cameras)");
   cmd->add_option("--matcher", options->matcher, "auto, exhaustive or sequential")
       ->check(CLI::IsMember({"auto", "exhaustive", "sequential"}))
       ->capture_default_str();
   AddSiftOptions(cmd, &s);
-  cmd->add_option("--threads", s.num_threads, "Threads for COLMAP (0: all cores)")
-      ->capture_default_str();
-  cmd->add_option("--init-tri-angle", s.init_min_tri_angle_deg,
-                  "Smallest triangulation angle of COLMAP's initial pair, degrees [0.5, 60]")
-      ->capture_default_str();
-  cmd->add_option("--min-registered", s.min_registered_fraction,
-                  "Fail if fewer than this fraction of the photos register [0, 1]")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--threads", s, s.num_threads);
+  AddDescribedOption(cmd, "--init-tri-angle", s, s.init_min_tri_angle_deg);
+  AddDescribedOption(cmd, "--min-registered", s, s.min_registered_fraction);
   cmd->add_flag("--robust-centre", s.frame.robust_centre,
                 "Centre the 3D photo at the geometric median of the cameras, not their mean");
-  cmd->add_option("--colmap", s.colmap_path, "Path of the colmap program (default: PATH)");
+  AddDescribedOption(cmd, "--colmap", s, s.colmap_path);
   cmd->add_flag("--overwrite", s.overwrite, "Replace an existing output folder when done");
   cmd->add_flag("--keep-work", s.keep_work, "Keep COLMAP's database and raw models in OUT/work");
   cmd->callback([options] { RunSparse(*options); });
