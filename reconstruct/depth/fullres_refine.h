@@ -129,7 +129,8 @@ struct BoundaryRelabelOptions {
     v.Field("ncc_epsilon", o.ncc_epsilon, R::Closed(0, 1), "Variance added to both windows");
     v.Field("texture_sigma", o.texture_sigma, R::OpenClosed(0, 1), "Texture weight var / (var + sigma^2)");
     v.Field("min_texture", o.min_texture, R::Closed(0, 1), "Pixels with a lower texture weight keep their depth");
-    v.Field("test_nearer", o.test_nearer, R::Any(), "Also try the nearer side's depth");
+    v.Field("test_nearer", o.test_nearer, R::Any(),
+            "Also test the nearest depth within radius (by default only the farthest)");
     v.Require(o.window_step <= o.window_radius, "window_step", "must not exceed window_radius");
   }
   Status Check() const { return util::CheckFields(*this); }

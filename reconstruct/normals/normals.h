@@ -47,7 +47,7 @@ struct NormalOptions {
     v.Field("detail_radius", o.detail_radius, R::Closed(1, 64), "Radius of the low-pass that separates detail, pixels");
     v.Field("sky_depth_fraction", o.sky_depth_fraction, R::OpenClosed(0, 1), "Sky: depth from this fraction of the 99th percentile");
     v.Field("sky_max_texture", o.sky_max_texture, R::AtLeast(0), "Sky: luminance deviation below this");
-    v.Field("detect_sky", o.detect_sky, R::Any(), "Give sky nodes the normal facing the centre");
+    v.Field("detect_sky", o.detect_sky, R::Any(), "Find sky nodes and give them a zero normal (unlit)");
   }
   Status Check() const { return util::CheckFields(*this); }
 };

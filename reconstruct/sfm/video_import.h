@@ -39,7 +39,7 @@ struct VideoFrameOptions {
     v.Field("max_frames", o.max_frames, R::Closed(3, 2000), "Most frames picked from a video");
     v.Field("min_step_fraction", o.min_step_fraction, R::Closed(0, 1),
             "Smallest motion between picked frames, fraction of the frame diagonal");
-    v.Field("blur_ratio", o.blur_ratio, R::Closed(0, 1), "Frames less sharp than this times their neighbours' are skipped; 0 keeps all");
+    v.Field("blur_ratio", o.blur_ratio, R::Closed(0, 1), "Frames less sharp than this times their neighbours' median are skipped; 0 keeps all");
     v.Field("blur_window", o.blur_window, R::Closed(1, 100), "Neighbours on each side for the sharpness test");
     v.Field("analysis_long_side", o.analysis_long_side, R::Closed(64, 4096), "Long side of the analysis copy, pixels");
     v.Field("jpeg_quality", o.jpeg_quality, R::Closed(50, 100), "Quality of the written frames");
