@@ -26,11 +26,10 @@ const GlobalOptions& Globals() { return g_options; }
 namespace {
 
 // The reconstruction allocates and frees buffers of tens to hundreds of
-// megabytes per photo; faulting their pages in 4 KiB at a time took about a
-// third of the dense stage's time on a virtual machine, and glibc's
-// allocator asks for transparent huge pages (2 MiB) only when its
+// megabytes per photo, and faulting their pages in 4 KiB at a time is slow;
+// glibc's allocator asks for transparent huge pages (2 MiB) only when its
 // glibc.malloc.hugetlb tunable is set before the process starts
-// (docs/PERFORMANCE.md, the dense stage's huge-page figures). So the command
+// (docs/DECISIONS.md, "Dense: huge pages and reused buffers"). So the command
 // restarts itself once with the tunable added, unless the environment
 // already sets it (which also stops a second restart). Nothing changes when
 // the restart fails.

@@ -382,9 +382,9 @@ ImageF DepthPhoto(const DensePlan& plan, int i, const DenseOptions& options, int
   const ImageF env_full = !env.envelope.empty()
                               ? ResizeLinear(env.envelope, v.full_width, v.full_height)
                               : ImageF(v.full_width, v.full_height, 1, static_cast<float>(v.range.near_m));
-  // The confidence and the envelope without ZIP: it took 60-120 ms per map
-  // and saved a quarter (confidence) to a half (envelope) of 4 MB
-  // (docs/PERFORMANCE.md). The depth map is written after pass 3.
+  // The confidence and the envelope without ZIP (docs/DECISIONS.md, "Dense:
+  // confidence and envelope maps written without compression"). The depth
+  // map is written after pass 3.
   io::ExrWriteOptions plain;
   plain.compression = io::ExrCompression::kNone;
   io::WriteExr(StemPath(out_dir, "confidence", stem, ".exr"), conf.view(), {"Y"}, plain);

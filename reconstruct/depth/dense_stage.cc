@@ -47,17 +47,16 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   std::vector<CostVolume> shells(n);  // Sizes and depth grid; costs live in the cache.
 
   // Photos run `outer` at a time in both per-photo passes, `inner` threads
-  // each: a sweep splits its planes over threads with about 1.6x on 2
-  // cores, whole photos in parallel with about 2x (docs/PERFORMANCE.md,
-  // "Dense"); TRW-S is sequential. Results do not depend on the split.
+  // each: whole photos in parallel scale better than a sweep's planes split
+  // over threads, and TRW-S is sequential (docs/DECISIONS.md, "Dense: photos
+  // swept in parallel"). Results do not depend on the split.
   const int outer = std::min(threads, n);
   const int inner = std::max(1, threads / outer);
   // The big buffers (the cost volume, which the MRF's unary then takes
   // over, and TRW-S's two message arrays: 220 MB each at the default
   // resolution) pass from one photo to the next (huge_pages.h). Three idle
-  // buffers at most, one photo's set: on the synthetic capture at 4
-  // neighbours, 2 / 3 / 4 kept took 54.3 / 52.2 / 53.1 s with peaks of 1.56
-  // / 1.62 / 2.04 GB (docs/PERFORMANCE.md).
+  // buffers at most, one photo's set (docs/DECISIONS.md, "Dense: huge pages
+  // and reused buffers").
   BufferPool pool(3);
 
   // Pass 1: cost volumes and WTA maps of every photo (the GC filter needs

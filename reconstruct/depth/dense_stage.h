@@ -59,15 +59,12 @@ struct MrfTermOptions {
   // Our addition (spec/stage-dense.md): textureless pixels (sky, blank walls)
   // carry no photo-consistency evidence; a small cost far_bias * (1 - w_photo)
   // * (1 - k / (L - 1)) on label k leans them away from the camera rather than
-  // letting the smoothness term extend nearby near objects over them. On the
-  // default synthetic capture 0.02 / 0.04 / 0.06 gave near floaters 5.66 /
-  // 4.59 / 4.20% and within 3% 64.0 / 63.7 / 63.4%, but 0.06 lost 0.6 dB on
-  // fern's held-out views (docs/RESULTS.md). [0, 1].
+  // letting the smoothness term extend nearby near objects over them; 0 turns
+  // it off (docs/DECISIONS.md, "Dense: 7x7 ZNCC window, far bias 0.02,
+  // colour-weighted texture measure"). [0, 1].
   double far_bias = 0.02;
   int truncation_labels = 8;    // w_depth = min(|k_i - k_j|, T) / T, labels (inverse depth). [1, 4096].
-  // TRW-S passes. 6: on the synthetic capture the energy is within 0.15% of
-  // 8 passes' and the accuracy figures within 0.6% (docs/PERFORMANCE.md);
-  // 4-5 passes leave measurably more near floaters. [1, 1000].
+  // TRW-S passes (docs/DECISIONS.md, "Dense: 6 TRW-S passes"). [1, 1000].
   int max_iterations = 6;
   // Our addition: pixels with a flat-region prior (flat_regions.h) pay
   // lambda_flat * (1 - w_photo) * min(|k - prior|, T_flat) / T_flat, and the
@@ -110,8 +107,8 @@ struct DenseOptions {
   // facades and trees stand at tens. Labels are added beyond the sparse far
   // bound at the sparse range's spacing (sweep.num_depths over the sparse
   // range; at most 4 * num_depths in all), so near content keeps its
-  // precision: stretching 220 labels instead cost 0.45 dB on fern.
-  // [1, 1e6].
+  // precision (docs/DECISIONS.md, "Dense: far plane at least 100 times the
+  // near plane"). [1, 1e6].
   double min_far_over_near = 100.0;
   NeighborOptions neighbors;
   SweepOptions sweep;

@@ -59,17 +59,14 @@ struct SparseStageOptions {
   int exhaustive_max_photos = 60;  // Range [3, 1e5]; kAuto's switch-over.
   int sequential_overlap = 10;     // Range [1, 1000]; neighbours matched by kSequential.
   // SIFT features per photo (COLMAP keeps the coarsest ones when it caps;
-  // orientations add about half again). Matching time grows with the square.
-  // With sift_first_octave 0, 2048 registered every photo of fern,
-  // fountain-P11 and the default synthetic capture with poses as accurate as
-  // 4096 or COLMAP's 8192 (docs/PERFORMANCE.md, "Sparse stage"); raise it for
-  // weakly textured scenes.
+  // orientations add about half again). Matching time grows with the square
+  // (docs/DECISIONS.md, "Sparse: 2048 features from the photo's own size");
+  // raise it for weakly textured scenes.
   int max_features = 2048;  // Range [500, 1e5].
   // First octave of the SIFT pyramid. COLMAP's -1 doubles each photo before
-  // detection, for features finer than a pixel; at the working size of about
-  // 1.2 MP that triples extraction and doubles matching time for features the
-  // mapper hardly needs (docs/PERFORMANCE.md, "Sparse stage"). -1 for tiny
-  // photos or weak texture.
+  // detection, for features finer than a pixel, at several times the
+  // extraction and matching time (docs/DECISIONS.md, "Sparse: 2048 features
+  // from the photo's own size"). -1 for tiny photos or weak texture.
   int sift_first_octave = 0;  // Range [-1, 2].
   // Match descriptors with casual3d's CPU matcher (descriptor_matcher.h: the
   // same criteria, about 9 times faster on 2 cores) and let COLMAP only verify
