@@ -148,17 +148,12 @@ StatusOr<Mesh> BuildBackdrop(const TwoLayerPanorama& pano, const BackdropOptions
   // column 0, at pixel x = w), rows 0..rows-1 at pixel y = j * cell.
   const int rows = (h - 1) / cell + 1;
   const int cols = cells_x + 1;
-  auto far_at = [&](int cx, int cy) -> float {
-    if (cy < 0 || cy >= cells_y) return 0.0f;
-    cx = ((cx % cells_x) + cells_x) % cells_x;
-    return far[static_cast<size_t>(cy) * cells_x + cx];
-  };
   // Quads: cell (i, j) with a node, and a row of vertices below it.
   std::vector<uint32_t> vertex_of(static_cast<size_t>(cols) * rows, UINT32_MAX);
   std::vector<std::pair<int, int>> quads;
   for (int j = 0; j + 1 < rows; ++j) {
     for (int i = 0; i < cells_x; ++i) {
-      if (far_at(i, j) <= 0.0f) continue;
+      if (far[static_cast<size_t>(j) * cells_x + i] <= 0.0f) continue;
       quads.emplace_back(i, j);
       for (int dj = 0; dj < 2; ++dj) {
         for (int di = 0; di < 2; ++di) vertex_of[static_cast<size_t>(j + dj) * cols + i + di] = 0;
@@ -175,6 +170,12 @@ StatusOr<Mesh> BuildBackdrop(const TwoLayerPanorama& pano, const BackdropOptions
   mesh.normals.assign(3 * static_cast<size_t>(count), 0.0f);
   mesh.uvs.resize(2 * static_cast<size_t>(count));
   mesh.colors.resize(3 * static_cast<size_t>(count));
+  // Longitude of each vertex column (the seam copy's is column 0's).
+  std::vector<double> sin_lon(static_cast<size_t>(cols)), cos_lon(static_cast<size_t>(cols));
+  for (int i = 0; i < cols; ++i) {
+    const int px = std::min(i * cell, w) % w;
+    DeterministicSinCos(((px + 0.5) / w - 0.5) * 2.0 * kPi, &sin_lon[i], &cos_lon[i]);
+  }
   for (int j = 0; j < rows; ++j) {
     const int y = j * cell;
     double sin_lat, cos_lat;
@@ -183,16 +184,13 @@ StatusOr<Mesh> BuildBackdrop(const TwoLayerPanorama& pano, const BackdropOptions
       const uint32_t v = vertex_of[static_cast<size_t>(j) * cols + i];
       if (v == UINT32_MAX) continue;
       const int x = std::min(i * cell, w);  // w: the seam copy of column 0.
-      const int px = x % w;
       // Every vertex of a quad has a node in its window (the quad's cell).
       const size_t from = source[static_cast<size_t>(j) * cells_x + i % cells_x];
       const double d = far[from] * options.depth_factor;
-      double sin_lon, cos_lon;
-      DeterministicSinCos(((px + 0.5) / w - 0.5) * 2.0 * kPi, &sin_lon, &cos_lon);
       float* position = &mesh.positions[3 * static_cast<size_t>(v)];
-      position[0] = static_cast<float>(cos_lat * d * sin_lon);
+      position[0] = static_cast<float>(cos_lat * d * sin_lon[i]);
       position[1] = static_cast<float>(sin_lat * d);
-      position[2] = static_cast<float>(-(cos_lat * d * cos_lon));
+      position[2] = static_cast<float>(-(cos_lat * d * cos_lon[i]));
       float* uv = &mesh.uvs[2 * static_cast<size_t>(v)];
       uv[0] = static_cast<float>((x + 0.5) / w);
       uv[1] = static_cast<float>((y + 0.5 + h) / (2.0 * h));

@@ -331,8 +331,10 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
 
   // The mesh and its atlas, unless every rendering comes from elsewhere.
   const bool render_here = options.rendered_dir.empty();
-  Mesh mesh;         // spec/mesh.md's mesh: the rephotographs.
-  Mesh viewer_mesh;  // The mesh with the viewer's backdrop: the viewer views.
+  // spec/mesh.md's mesh; the viewer views append the backdrop to it and
+  // take it off again before the rephotographs.
+  Mesh mesh;
+  Mesh backdrop;
   Image8 atlas;
   if (render_here) {
     const auto mesh_start = std::chrono::steady_clock::now();
@@ -342,12 +344,11 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     atlas = encoder::BuildColourAtlas(photo3d.pano);
     eval.mesh_triangles = mesh.indices.size() / 3;
     if (options.backdrop && options.viewer_views) {
-      auto backdrop = BuildBackdrop(photo3d.pano);
-      if (!backdrop.ok())
-        throw std::runtime_error(photo3d.source + ": backdrop: " + backdrop.status().message());
-      eval.backdrop_triangles = backdrop->indices.size() / 3;
-      viewer_mesh = mesh;
-      AppendMesh(*backdrop, &viewer_mesh);
+      auto built_backdrop = BuildBackdrop(photo3d.pano);
+      if (!built_backdrop.ok())
+        throw std::runtime_error(photo3d.source + ": backdrop: " + built_backdrop.status().message());
+      backdrop = std::move(*built_backdrop);
+      eval.backdrop_triangles = backdrop.num_triangles();
     }
     util::LogInfo("evaluate: " + photo3d_path + ": mesh of " +
                   std::to_string(eval.mesh_triangles) + " triangles (and " +
@@ -361,10 +362,22 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     ViewerViewsOptions viewer = options.viewer;
     viewer.num_threads = options.num_threads;
     viewer.keep_images = viewer.keep_images && options.keep_images;
-    if (options.backdrop) viewer.vertex_colors_from_triangle = eval.mesh_triangles;
-    eval.viewer = EvaluateViewerViews(photo3d.pano, options.backdrop ? viewer_mesh : mesh,
-                                      std::as_const(atlas).view(), photo3d.pano.view_hints(), viewer);
-    viewer_mesh = Mesh();
+    // Array sizes of the mesh alone (colours may be absent).
+    const size_t sizes[5] = {mesh.positions.size(), mesh.normals.size(), mesh.uvs.size(),
+                             mesh.colors.size(), mesh.indices.size()};
+    if (options.backdrop) {
+      viewer.vertex_colors_from_triangle = eval.mesh_triangles;
+      AppendMesh(backdrop, &mesh);
+    }
+    eval.viewer = EvaluateViewerViews(photo3d.pano, mesh, std::as_const(atlas).view(),
+                                      photo3d.pano.view_hints(), viewer);
+    // The mesh alone again for the rephotographs.
+    mesh.positions.resize(sizes[0]);
+    mesh.normals.resize(sizes[1]);
+    mesh.uvs.resize(sizes[2]);
+    mesh.colors.resize(sizes[3]);
+    mesh.indices.resize(sizes[4]);
+    backdrop = Mesh();
     util::LogInfo("evaluate: " + photo3d_path + ": 17 viewer views in " +
                   std::to_string(SecondsSince(viewer_start)) + " s");
   }
