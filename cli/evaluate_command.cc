@@ -78,6 +78,11 @@ void AddEvaluateCommand(CLI::App& app) {
   cmd->add_flag("--no-backdrop", args->no_backdrop,
                  "Viewer views: the mesh alone, without the backdrop the viewer draws behind "
                  "it (format/backdrop.h); the photos are always rendered without it");
+  cmd->add_option("--sheet-stretch", args->options.viewer.sheet_stretch,
+                  "Viewer views with the backdrop: triangles that look more than this many "
+                  "times larger from the eye than from the centre (sheets across depth steps) "
+                  "are left out, as the viewer does (format/sheet_stretch.h); 0 draws them")
+      ->capture_default_str();
   cmd->add_flag("--no-viewer-views", args->no_viewer_views,
                 "Skip the viewer-side measure (tears and stretched fill seen from 17 eyes over "
                 "the viewing volume)");

@@ -290,7 +290,8 @@ std::string RenderJsonReport(const std::string& capture,
                   {"viewer_views", options.viewer_views},
                   {"viewer_width", options.viewer.width},
                   {"viewer_height", options.viewer.height},
-                  {"viewer_stretch_factor", options.viewer.stretch_factor}};
+                  {"viewer_stretch_factor", options.viewer.stretch_factor},
+                  {"viewer_sheet_stretch", options.backdrop ? options.viewer.sheet_stretch : 0.0}};
   j["photo3d"] = nlohmann::json::array();
   for (const auto& e : evals) {
     nlohmann::json m;

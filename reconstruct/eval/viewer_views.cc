@@ -55,6 +55,8 @@ Status ViewerViewsOptions::Check() const {
     return InvalidArgument("height: " + std::to_string(height) + " is outside [16, 4096]");
   if (!(stretch_factor >= 1 && stretch_factor <= 1000))
     return InvalidArgument("stretch_factor: " + std::to_string(stretch_factor) + " is outside [1, 1000]");
+  if (!(sheet_stretch >= 0 && sheet_stretch <= 1000))
+    return InvalidArgument("sheet_stretch: " + std::to_string(sheet_stretch) + " is outside [0, 1000]");
   if (!(closing_deg >= 0 && closing_deg <= 45))
     return InvalidArgument("closing_deg: " + std::to_string(closing_deg) + " is outside [0, 45]");
   if (num_threads < 0 || num_threads > 256)
@@ -154,12 +156,14 @@ ViewerViewsEvaluation EvaluateViewerViews(const TwoLayerPanorama& pano, const Me
   eval.width = options.width;
   eval.height = options.height;
   eval.stretch_factor = options.stretch_factor;
+  if (options.vertex_colors_from_triangle != UINT64_MAX) eval.sheet_stretch = options.sheet_stretch;
   const CapturedField field(pano, eval.hints, options.closing_deg);
 
   render::RenderOptions render_options;
   render_options.num_threads = options.num_threads;
   render_options.want_triangle_ids = true;
   render_options.vertex_colors_from_triangle = options.vertex_colors_from_triangle;
+  render_options.sheet_stretch = eval.sheet_stretch;
   // Clipping planes around the content whatever its unit (models from
   // structure from motion have arbitrary scale), as the viewer sets them.
   double near_m = 0, far_m = 0;

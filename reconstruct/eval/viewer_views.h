@@ -44,6 +44,7 @@
 #include <string>
 #include <vector>
 
+#include "format/sheet_stretch.h"
 #include "format/status.h"
 #include "format/image.h"
 #include "format/mesh.h"
@@ -71,6 +72,10 @@ struct ViewerViewsOptions {
   // Triangles of the mesh from this index on are a backdrop drawn in its
   // vertex colours (render::RenderOptions::vertex_colors_from_triangle).
   uint64_t vertex_colors_from_triangle = UINT64_MAX;
+  // With a backdrop (vertex_colors_from_triangle set): mesh triangles
+  // stretched beyond this seen from the eye are not drawn, as the viewer
+  // does (format/sheet_stretch.h); 0 draws them all. [0, 1000].
+  double sheet_stretch = kDefaultSheetStretch;
 
   Status Check() const;  // Names the field and its range.
 };
@@ -109,6 +114,8 @@ struct ViewerViewsEvaluation {
   bool hints_derived = false;  // Derived from the panorama (the 3D photo had none).
   int width = 0, height = 0;
   double stretch_factor = 0;
+  // The sheets left out (render::RenderOptions::sheet_stretch); 0: all drawn.
+  double sheet_stretch = 0;
   std::vector<ViewerViewResult> views;  // 17, the centre first.
   double centre_tears = 0, boundary_tears_mean = 0, boundary_tears_max = 0;
   double centre_stretched = 0, boundary_stretched_mean = 0, boundary_stretched_max = 0;

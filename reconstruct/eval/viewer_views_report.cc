@@ -113,6 +113,7 @@ std::string ViewerViewsJson(const ViewerViewsEvaluation& e) {
   nlohmann::json j = {{"width", e.width},
                       {"height", e.height},
                       {"stretch_factor", e.stretch_factor},
+                      {"sheet_stretch", e.sheet_stretch},
                       {"hints_derived", e.hints_derived},
                       {"hints",
                        {{"yaw_deg", h.yaw_deg},
@@ -159,7 +160,13 @@ std::string ViewerViewsHtml(const ViewerViewsEvaluation& e, int thumbnail_width)
        "of the captured content covers from the same eye) that show no surface. <b>Stretched "
        "fill</b>: covered pixels there drawn by a triangle whose longest edge spans more than "
     << Fmt("%g", e.stretch_factor)
-    << " times the view's median triangle.</p>\n"
+    << " times the view's median triangle."
+    << (e.sheet_stretch > 0
+            ? " With the backdrop, mesh triangles that look more than " + Fmt("%g", e.sheet_stretch) +
+                  " times larger from the eye than from the centre (sheets across depth steps) are "
+                  "left out, as the viewer does."
+            : std::string())
+    << "</p>\n"
        "<table><tr><th class=\"l\"></th><th>tears</th><th>stretched fill</th></tr>\n"
     << "<tr><td class=\"l\">centre</td><td>" << Percent(e.centre_tears) << "</td><td>"
     << Percent(e.centre_stretched) << "</td></tr>\n"

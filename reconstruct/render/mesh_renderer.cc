@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include "format/sheet_stretch.h"
+
 namespace casual3d::render {
 namespace {
 
@@ -88,6 +90,8 @@ class Rasterizer {
     num_threads_ = options.num_threads > 0
                        ? options.num_threads
                        : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    const Eigen::Vector3d eye = -view.rotation.transpose() * view.translation;
+    for (int k = 0; k < 3; ++k) eye_[k] = eye[k];
   }
 
   RenderResult Run() {
@@ -140,6 +144,16 @@ class Rasterizer {
         cam_[3 * i + 2] = c.z();
       }
     });
+  }
+
+  // A mesh triangle stretched beyond options_.sheet_stretch seen from the
+  // eye (format/sheet_stretch.h); the backdrop's triangles never are.
+  bool HiddenSheet(size_t triangle) const {
+    if (!(options_.sheet_stretch > 0) || triangle >= options_.vertex_colors_from_triangle) return false;
+    const float* p = mesh_.positions.data();
+    const uint32_t* i = &mesh_.indices[3 * triangle];
+    return SheetStretch(p + 3 * size_t{i[0]}, p + 3 * size_t{i[1]}, p + 3 * size_t{i[2]}, eye_) >
+           options_.sheet_stretch;
   }
 
   bool UsesAtlas(size_t triangle) const {
@@ -248,6 +262,7 @@ class Rasterizer {
       ScreenVertex poly[kMaxPolygon];
       const size_t end = std::min(num_triangles, static_cast<size_t>((chunk + 1) * kChunk));
       for (size_t t = static_cast<size_t>(chunk * kChunk); t < end; ++t) {
+        if (HiddenSheet(t)) continue;
         const int count = ClipAndProject(t, poly);
         int first, last;
         if (count < 3 || !RowRange(poly, count, &first, &last)) continue;
@@ -386,6 +401,7 @@ class Rasterizer {
   const RenderOptions& options_;
   Plane planes_[kNumPlanes];
   int num_threads_ = 1;
+  double eye_[3] = {0, 0, 0};  // The camera centre in the panorama frame.
   std::vector<double> cam_;
   int num_bands_ = 0;
   std::vector<std::vector<uint32_t>> bands_;
@@ -454,6 +470,10 @@ Status RenderOptions::Check() const {
   if (num_threads < 0 || num_threads > 256) {
     return InvalidArgument("num_threads " + std::to_string(num_threads) +
                            " is out of range [0, 256] (0 = all cores)");
+  }
+  if (!(sheet_stretch >= 0) || !std::isfinite(sheet_stretch)) {
+    return InvalidArgument("sheet_stretch " + std::to_string(sheet_stretch) +
+                           " must be finite and at least 0 (0 draws every triangle)");
   }
   return Status::Ok();
 }

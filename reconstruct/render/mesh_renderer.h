@@ -48,6 +48,11 @@ struct RenderOptions {
   // With kAtlas: triangles from this index on take Mesh::colors instead (a
   // backdrop appended to the mesh, format/backdrop.h, as the viewer draws it).
   uint64_t vertex_colors_from_triangle = UINT64_MAX;
+  // Triangles before vertex_colors_from_triangle that look more than this
+  // many times larger from the view's eye than from the panorama's centre
+  // (format/sheet_stretch.h: sheets across depth steps) are not drawn, as the
+  // viewer does where it draws the backdrop; 0 draws every triangle. >= 0.
+  double sheet_stretch = 0.0;
   // Clipping planes, metres along the optical axis; 0 < near_m < far_m. The
   // defaults are the WebGL viewer's (wasm-viewer/js/camera.js).
   double near_m = 0.05;

@@ -617,6 +617,41 @@ TEST(MeshRendererTest, TriangleIdsNameTheTriangleThatWonTheDepthTest) {
   EXPECT_GT(near_pixels, 1000);
 }
 
+TEST(MeshRendererTest, SheetsAreLeftOutSeenFromOffTheCentreOnly) {
+  // A sheet across a depth step: two corners on a surface 1 m away, one on a
+  // wall 4 m away, 0.6 degrees apart seen from the centre.
+  const double a = 0.01;
+  Mesh sheet;
+  const uint8_t grey[3] = {128, 128, 128};
+  AddVertex(&sheet, {0, 0, -1}, 0.5, 0.5, grey);
+  AddVertex(&sheet, {4 * std::sin(a), 0, -4 * std::cos(a)}, 0.5, 0.5, grey);
+  AddVertex(&sheet, {0, std::sin(a), -std::cos(a)}, 0.5, 0.5, grey);
+  AddTriangle(&sheet, 0, 1, 2);
+  const Image8 atlas = LinearAtlas(8, 8);
+  GlCamera camera;
+  camera.fov_y_deg = 40.0;
+  RenderOptions options;
+  options.sheet_stretch = 4.0;
+  // Seen from the centre it is drawn: nothing is stretched there.
+  const RenderResult centre = RenderMesh(sheet, atlas.view(), ViewFromGlCamera(camera, 640, 480), options);
+  EXPECT_GT(centre.covered_pixels, 0);
+  // From 0.2 m to the side it spans about 9 degrees: left out, unless the
+  // limit is 0 or the triangle belongs to the backdrop.
+  camera.position[0] = 0.2;
+  const PinholeView side = ViewFromGlCamera(camera, 640, 480);
+  EXPECT_EQ(RenderMesh(sheet, atlas.view(), side, options).covered_pixels, 0);
+  options.sheet_stretch = 0.0;
+  const int64_t drawn = RenderMesh(sheet, atlas.view(), side, options).covered_pixels;
+  EXPECT_GT(drawn, 200);
+  options.sheet_stretch = 4.0;
+  options.vertex_colors_from_triangle = 0;
+  EXPECT_EQ(RenderMesh(sheet, atlas.view(), side, options).covered_pixels, drawn);
+  // A limit above its stretch draws it.
+  options.vertex_colors_from_triangle = UINT64_MAX;
+  options.sheet_stretch = 1000.0;
+  EXPECT_EQ(RenderMesh(sheet, atlas.view(), side, options).covered_pixels, drawn);
+}
+
 TEST(MeshRendererTest, RejectsInconsistentInput) {
   Mesh mesh = Parallelogram({-1, 1, -2}, {2, 0, 0}, {0, -2, 0});
   const Image8 atlas = LinearAtlas(8, 8);
@@ -644,6 +679,10 @@ TEST(MeshRendererTest, RejectsInconsistentInput) {
   bad_near.near_m = 0.0;
   expect_error(mesh, atlas.view(), view, bad_near,
                "render options: near_m 0.000000 must be positive and finite");
+  RenderOptions bad_sheets;
+  bad_sheets.sheet_stretch = -1.0;
+  expect_error(mesh, atlas.view(), view, bad_sheets,
+               "render options: sheet_stretch -1.000000 must be finite and at least 0 (0 draws every triangle)");
   RenderOptions bad_threads;
   bad_threads.num_threads = -2;
   expect_error(mesh, atlas.view(), view, bad_threads,

@@ -1,5 +1,7 @@
 // Screenshots of a package from eyes on the boundary of its viewing volume,
-// with and without the backdrop (format/backdrop.h), in headless Chromium
+// with the backdrop (format/backdrop.h) and its sheets left out (the viewer's
+// default, "with"), with the backdrop and every sheet drawn ("sheets",
+// format/sheet_stretch.h) and without the backdrop ("without"), in headless Chromium
 // (SwiftShader). Each view looks along the package's view hints; eyes at the
 // centre and at the left, right, top and bottom of the volume. Prints one
 // JSON line: per view, the fraction of pixels no triangle covers.
@@ -24,13 +26,14 @@ const page = (options) => viewerCorePage(options, W, H);
 
 const server = await startServer({ '/viewer/': DIST_DIR, '/pkg/': pkg }, {
   '/with.html': page({ mouseParallax: false }), '/without.html': page({ mouseParallax: false, backdrop: false }),
+  '/sheets.html': page({ mouseParallax: false, sheetStretch: 0 }),
   '/favicon.ico': '',
 }, { isolated: true });
 const browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: chromiumArgs() });
 const result = {};
 try {
   const tab = await browser.newPage({ viewport: { width: W, height: H }, deviceScaleFactor: 1 });
-  for (const name of ['with', 'without']) {
+  for (const name of ['with', 'sheets', 'without']) {
     await tab.goto(`${server.url}/${name}.html`);
     await tab.waitForFunction(() => window.loaded, null, { timeout: 600000 });
     await tab.evaluate(() => window.loaded);

@@ -77,6 +77,8 @@ export interface ViewerOptions {
   softBackground?: boolean;
   /** Draw the backdrop behind the mesh (a coarse surface at the background's depth), so that tears show the background. Default true. */
   backdrop?: boolean;
+  /** With the backdrop: fragments of mesh triangles that look more than this many times larger from the eye than from the centre (sheets across depth steps) are left out, so that what lies behind shows. 0 draws them all. Default 4. */
+  sheetStretch?: number;
 }
 
 export interface ProgressDetail { loadedBytes: number; totalBytes: number; level: number; levels: number; }

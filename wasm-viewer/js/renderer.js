@@ -64,9 +64,27 @@ in vec3 vNormal;
 in vec2 vUv;
 in vec4 vColor;
 uniform sampler2D uAtlas;
+uniform float uSheetStretch;  // 0: every fragment of the mesh is drawn.
 ${LIGHTING}
 out vec4 fragColor;
+// Whether this fragment's triangle looks more than uSheetStretch times larger
+// from the eye than from the panorama's centre (format/sheet_stretch.h: a
+// sheet across a depth step): the smaller root l of det(Gu - l Ge) = 0, Gu
+// and Ge the Gram matrices of the screen derivatives of the directions from
+// the centre and from the eye, below 1 / uSheetStretch^2.
+bool hiddenSheet() {
+  vec3 u = normalize(vPosition), e = normalize(vPosition - uEye);
+  vec3 ux = dFdx(u), uy = dFdy(u), ex = dFdx(e), ey = dFdy(e);
+  float gu11 = dot(ux, ux), gu12 = dot(ux, uy), gu22 = dot(uy, uy);
+  float ge11 = dot(ex, ex), ge12 = dot(ex, ey), ge22 = dot(ey, ey);
+  float a = ge11 * ge22 - ge12 * ge12;
+  float b = gu11 * ge22 + gu22 * ge11 - 2.0 * gu12 * ge12;
+  float c = gu11 * gu22 - gu12 * gu12;
+  float big = b + sqrt(max(b * b - 4.0 * a * c, 0.0));  // 2 a times the larger root; l = 2 c / big.
+  return a > 0.0 && big > 2.0 * c * uSheetStretch * uSheetStretch;
+}
 void main() {
+  if (uSheetStretch > 0.0 && vColor.a < 0.5 && hiddenSheet()) discard;
   vec3 albedo = vColor.a > 0.5 ? vColor.rgb : texture(uAtlas, vUv).rgb;
   vec3 color = albedo;
   // Unlit where the node has no normal (sky): interpolated length drops below 0.5.
@@ -189,14 +207,20 @@ export const DEFAULT_EFFECTS = Object.freeze({
 });
 
 export class Renderer {
-  /** @param {HTMLCanvasElement|OffscreenCanvas} canvas */
-  constructor(canvas, { xrCompatible = false } = {}) {
+  /**
+   * @param {HTMLCanvasElement|OffscreenCanvas} canvas
+   * @param sheetStretch where a backdrop is drawn, fragments of mesh triangles
+   *   that look more than this many times larger from the eye than from the
+   *   centre are left out (format/sheet_stretch.h); 0 draws them all
+   */
+  constructor(canvas, { xrCompatible = false, sheetStretch = 4 } = {}) {
     const gl = canvas.getContext('webgl2', {
       antialias: false, depth: true, alpha: false, preserveDrawingBuffer: true, xrCompatible,
     });
     if (!gl) throw new Error('WebGL2 is not available in this browser');
     this.gl = gl;
     this.canvas = canvas;
+    this.sheetStretch = sheetStretch;
     this.scene = program(gl, SCENE_VS, SCENE_FS);
     this.object = program(gl, SCENE_VS, OBJECT_FS);
     this.water = program(gl, SCENE_VS, WATER_FS);
@@ -239,7 +263,7 @@ export class Renderer {
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
     buffers.push(ib);
     gl.bindVertexArray(null);
-    return { vao, buffers, count: indices.length };
+    return { vao, buffers, count: indices.length, hasBackdrop: Boolean(colors) };
   }
 
   _release(geometry) {
@@ -393,6 +417,8 @@ export class Renderer {
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, this.texture);
     gl.uniform1i(this.scene.uniforms.uAtlas, 0);
+    // Sheets are left out only where the backdrop stands behind them.
+    gl.uniform1f(this.scene.uniforms.uSheetStretch, this.mesh.hasBackdrop ? this.sheetStretch : 0);
     gl.bindVertexArray(this.mesh.vao);
     gl.drawElements(gl.TRIANGLES, this.mesh.count, gl.UNSIGNED_INT, 0);
 

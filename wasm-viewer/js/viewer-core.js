@@ -44,6 +44,7 @@ export const DEFAULT_OPTIONS = Object.freeze({
   keepInContent: true,       // Soft limits keep the view on the captured content.
   softBackground: true,      // A blurred continuation of the photo where no surface is (else black).
   backdrop: true,            // Draw the backdrop behind the mesh (format/backdrop.h): tears show the background.
+  sheetStretch: 4,           // With the backdrop: leave out sheets stretched more than this from the eye (format/sheet_stretch.h); 0 draws them.
 });
 
 /** Radius of the eye's ball before a package's volume is known (unit of the depths). */
@@ -63,7 +64,7 @@ export class Casual3dViewer extends EventTarget {
     this.canvas.tabIndex = 0;
     container.appendChild(this.canvas);
     this.camera = new Camera({ maxOffset: this.options.maxOffset ?? INITIAL_MAX_OFFSET });
-    this.renderer = new Renderer(this.canvas, { xrCompatible: true });
+    this.renderer = new Renderer(this.canvas, { xrCompatible: true, sheetStretch: this.options.sheetStretch });
     this.effects = { ...DEFAULT_EFFECTS };
     this.effectsTime = null;          // Fixed effects time (s) or null: real time.
     this.stats = {};

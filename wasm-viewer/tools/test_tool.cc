@@ -5,12 +5,17 @@
 //     Writes a web package of a procedural two-layer panorama (encoder/).
 //     room-partial: the room with nodes only at longitudes [-75, 45] and
 //     latitudes [-40, 50] degrees, like a capture of part of the sphere.
-//   viewer_test_tool render <package_dir> <level> <width> <height> <out_prefix>
+//     room-sheets: the room without a back layer, its sphere's outline linked
+//     to the wall behind (links down to a depth ratio of 0.2): sheets across a
+//     depth step, as the sealing makes where three surfaces meet.
+//   viewer_test_tool render [--viewer] <package_dir> <level> <width> <height> <out_prefix>
 //                           <yaw,pitch,fov,x,y,z>...
 //     Reads the package natively (libwebp), builds the mesh of `level` and
 //     renders it with the native software renderer (reconstruct/render/) from
 //     each WebGL-style camera (degrees, metres): <out_prefix>_<i>.ppm (binary
 //     RGB, for comparisons) and <out_prefix>_<i>.png (for looking at).
+//     --viewer: as the viewer draws by default, with the backdrop
+//     (format/backdrop.h) and the sheets it leaves out (format/sheet_stretch.h).
 //   viewer_test_tool single-file <package_dir> <out.c3d>
 //     Writes the package folder's files (manifest.json first, then the files
 //     in the manifest's order) as a single-file container (spec/package.md 8).
@@ -30,11 +35,13 @@
 
 #include "encoder/package_writer.h"
 #include "encoder/webp_codec.h"
+#include "format/backdrop.h"
 #include "format/colour_atlas.h"
 #include "format/file_source.h"
 #include "format/mesh_builder.h"
 #include "format/package_reader.h"
 #include "format/package_test_scene.h"
+#include "format/sheet_stretch.h"
 #include "format/testing/test_panoramas.h"
 #include "reconstruct/render/mesh_renderer.h"
 #include "wasm-viewer/src/panorama_blob.h"
@@ -94,6 +101,11 @@ bool MakePanorama(const std::string& kind, int w, int h, casual3d::TwoLayerPanor
     KeepLonLatBox(-75, 45, -40, 50, pano);
   } else if (kind == "room") {
     *pano = t::MakeRoomPanorama(w, h);
+  } else if (kind == "room-sheets") {
+    t::RoomOptions options;
+    options.with_back_layer = false;
+    *pano = t::MakeRoomPanorama(w, h, options);
+    t::LinkByDepthRatio(pano, 0.2f);
   } else if (kind == "room-nosphere") {
     t::RoomOptions options;
     options.with_sphere = false;
@@ -163,10 +175,16 @@ int DumpMesh(int argc, char** argv) {
 }
 
 int Render(int argc, char** argv) {
+  // --viewer: drawn as the viewer draws by default (backdrop, sheets left out).
+  const bool as_viewer = argc > 2 && std::string(argv[2]) == "--viewer";
+  if (as_viewer) {
+    for (int i = 2; i + 1 < argc; ++i) argv[i] = argv[i + 1];
+    --argc;
+  }
   if (argc < 8) {
     return Fail(
-        "usage: viewer_test_tool render <package_dir> <level> <width> <height> <out_prefix> "
-        "<yaw,pitch,fov,x,y,z>...");
+        "usage: viewer_test_tool render [--viewer] <package_dir> <level> <width> <height> "
+        "<out_prefix> <yaw,pitch,fov,x,y,z>...");
   }
   casual3d::ReadOptions read;
   read.level = std::atoi(argv[3]);
@@ -180,6 +198,14 @@ int Render(int argc, char** argv) {
   if (!mesh.ok()) return Fail(mesh.status().ToString());
   // The colour atlas the viewer uploads (format/colour_atlas.h).
   const casual3d::Image8 atlas = casual3d::BuildColourAtlas(*pano, 3);
+  casual3d::render::RenderOptions options;
+  if (as_viewer) {
+    auto backdrop = casual3d::BuildBackdrop(*pano);
+    if (!backdrop.ok()) return Fail(backdrop.status().ToString());
+    options.vertex_colors_from_triangle = mesh->num_triangles();
+    options.sheet_stretch = casual3d::kDefaultSheetStretch;
+    casual3d::AppendMesh(*backdrop, &*mesh);
+  }
   for (int i = 7; i < argc; ++i) {
     casual3d::render::GlCamera camera;
     char comma;
@@ -190,7 +216,7 @@ int Render(int argc, char** argv) {
     const casual3d::render::PinholeView view =
         casual3d::render::ViewFromGlCamera(camera, width, height);
     const casual3d::render::RenderResult result = casual3d::render::RenderMesh(
-        *mesh, atlas.view(), view);
+        *mesh, atlas.view(), view, options);
     const std::string base = prefix + "_" + std::to_string(i - 7);
     std::ofstream ppm(base + ".ppm", std::ios::binary);
     ppm << "P6\n" << width << " " << height << "\n255\n";
