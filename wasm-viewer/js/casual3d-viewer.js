@@ -15,6 +15,7 @@
 // viewer-core.js. Property `viewer` gives the Casual3dViewer (JS API).
 
 import { Casual3dViewer } from './viewer-core.js';
+import { EFFECT_BUTTONS } from './effects.js';
 
 export { Casual3dViewer } from './viewer-core.js';
 export { setAssetBase } from './assets.js';
@@ -56,9 +57,7 @@ export class Casual3dViewerElement extends HTMLElement {
       <div class="error" part="error" role="alert" hidden><button type="button" aria-label="Dismiss">×</button><span></span></div>
       <div class="info" part="info" role="note" hidden><button type="button" aria-label="Close">×</button><slot name="info"></slot></div>
       <div class="toolbar" part="toolbar" hidden>
-        <button type="button" data-effect="lighting" aria-pressed="false" title="Moving lights">Light</button>
-        <button type="button" data-effect="water" aria-pressed="false" title="Rising water">Water</button>
-        <button type="button" data-effect="object" aria-pressed="false" title="Inserted object">Object</button>
+        ${EFFECT_BUTTONS.map((e) => `<button type="button" data-effect="${e.name}" aria-pressed="false" title="${e.title}">${e.label}</button>`).join('\n        ')}
         <button type="button" data-action="motion" hidden title="Look around by moving the phone">Motion</button>
         <button type="button" data-action="vr" hidden title="Immersive VR">VR</button>
         <button type="button" data-action="info" hidden aria-pressed="false" title="About this capture">Info</button>
@@ -203,7 +202,7 @@ export class Casual3dViewerElement extends HTMLElement {
     this._applyCamera();
     if (this.hasAttribute('effects')) {
       const on = new Set((this.getAttribute('effects') || '').split(/\s+/));
-      v.setEffects({ lighting: on.has('lighting'), water: on.has('water'), object: on.has('object') });
+      v.setEffects(Object.fromEntries(EFFECT_BUTTONS.map((e) => [e.name, on.has(e.name)])));
     }
     this._syncToolbar();
   }

@@ -15,6 +15,7 @@
 // much of a view no surface covers.
 
 import { invert, multiply } from './camera.js';
+import { EFFECTS } from './effects.js';
 
 const SCENE_VS = `#version 300 es
 layout(location = 0) in vec3 aPosition;
@@ -92,35 +93,7 @@ void main() {
   fragColor = vec4(color, 1.0);
 }`;
 
-const OBJECT_FS = `#version 300 es
-precision highp float;
-in vec3 vPosition;
-in vec3 vNormal;
-in vec2 vUv;
-uniform vec3 uColor;
-${LIGHTING}
-out vec4 fragColor;
-void main() {
-  fragColor = vec4(shade(uColor, vPosition, vNormal), 1.0);
-}`;
 
-const WATER_FS = `#version 300 es
-precision highp float;
-in vec3 vPosition;
-in vec3 vNormal;
-in vec2 vUv;
-uniform float uTime;
-uniform vec3 uEye;
-out vec4 fragColor;
-void main() {
-  // Small moving ripples and a Fresnel-like rise of opacity at grazing angles.
-  vec2 p = vPosition.xz;
-  float ripple = 0.5 + 0.25 * sin(p.x * 3.1 + uTime * 1.7) + 0.25 * sin(p.y * 2.3 - uTime * 1.3);
-  vec3 toEye = normalize(uEye - vPosition);
-  float grazing = 1.0 - abs(toEye.y);
-  vec3 color = mix(vec3(0.05, 0.22, 0.35), vec3(0.35, 0.6, 0.75), ripple * 0.6 + grazing * 0.4);
-  fragColor = vec4(color, 0.55 + 0.35 * grazing);
-}`;
 
 // The environment: a full-screen triangle at the far plane; each pixel's ray
 // (rotation-only inverse view-projection) looks up the equirectangular image
@@ -175,36 +148,16 @@ function program(gl, vs, fs) {
   return { program: p, uniforms };
 }
 
-/** A cube of edge `size` centred at the origin: positions, normals, indices. */
-function cubeGeometry(size) {
-  const h = size / 2;
-  const faces = [
-    [[1, 0, 0], [0, 1, 0], [0, 0, 1]], [[-1, 0, 0], [0, 1, 0], [0, 0, -1]],
-    [[0, 1, 0], [0, 0, 1], [1, 0, 0]], [[0, -1, 0], [0, 0, -1], [1, 0, 0]],
-    [[0, 0, 1], [1, 0, 0], [0, 1, 0]], [[0, 0, -1], [-1, 0, 0], [0, 1, 0]],
-  ];
-  const positions = [], normals = [], indices = [];
-  for (const [n, a, b] of faces) {
-    const base = positions.length / 3;
-    for (const [s, t] of [[-1, -1], [1, -1], [1, 1], [-1, 1]]) {
-      for (let k = 0; k < 3; ++k) positions.push((n[k] + s * a[k] + t * b[k]) * h);
-      normals.push(...n);
-    }
-    indices.push(base, base + 1, base + 2, base, base + 2, base + 3);
-  }
-  return { positions: new Float32Array(positions), normals: new Float32Array(normals), indices: new Uint32Array(indices) };
-}
 
-/** Effects state; all optional. Positions in metres in the panorama frame. */
-export const DEFAULT_EFFECTS = Object.freeze({
-  lighting: false,        // Moving point lights using the normals.
-  water: false,           // A water surface rising and falling through the scene.
-  waterMinY: -1.6,        // Lowest water level (m, panorama Y).
-  waterMaxY: -0.4,        // Highest water level (m).
-  object: false,          // A small inserted cube.
-  objectPosition: [0.6, -0.4, -2.5],
-  objectSize: 0.3,        // Cube edge (m).
-});
+/**
+ * Effects state; all optional. `lighting` relights the photo's mesh; the
+ * other fields are the effect modules' defaults (effects.js).
+ * Positions in metres in the panorama frame.
+ */
+export const DEFAULT_EFFECTS = Object.freeze(Object.assign(
+  { lighting: false },  // Moving point lights using the normals.
+  ...EFFECTS.map((e) => e.defaults),
+));
 
 export class Renderer {
   /**
@@ -222,20 +175,16 @@ export class Renderer {
     this.canvas = canvas;
     this.sheetStretch = sheetStretch;
     this.scene = program(gl, SCENE_VS, SCENE_FS);
-    this.object = program(gl, SCENE_VS, OBJECT_FS);
-    this.water = program(gl, SCENE_VS, WATER_FS);
     this.environmentProgram = program(gl, ENVIRONMENT_VS, ENVIRONMENT_FS);
     this.environmentVao = gl.createVertexArray();  // No attributes: gl_VertexID.
     this.environment = null;  // Texture, or null: black background.
     this.coverageTarget = null;  // Framebuffer of backgroundFraction.
     this.mesh = null;
-    this.cube = this._upload(cubeGeometry(1));
-    const r = 1000;  // Water plane half-extent (m); far beyond any scene.
-    this.waterPlane = this._upload({
-      positions: new Float32Array([-r, 0, -r, r, 0, -r, r, 0, r, -r, 0, r]),
-      normals: new Float32Array([0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0]),
-      indices: new Uint32Array([0, 2, 1, 0, 3, 2]),
-    });
+    // The effect modules' programs and geometry, made once per context.
+    const effectContext = {
+      gl, program: (fs) => program(gl, SCENE_VS, fs), upload: (g) => this._upload(g), lighting: LIGHTING,
+    };
+    this.effects = EFFECTS.map((effect) => ({ effect, state: effect.init(effectContext) }));
     this.texture = null;
   }
 
@@ -422,38 +371,9 @@ export class Renderer {
     gl.bindVertexArray(this.mesh.vao);
     gl.drawElements(gl.TRIANGLES, this.mesh.count, gl.UNSIGNED_INT, 0);
 
-    if (effects.object) {
-      // The inserted object is lit by the moving lights if on, else a fixed key light.
-      gl.useProgram(this.object.program);
-      const s = effects.objectSize ?? DEFAULT_EFFECTS.objectSize;
-      const [ox, oy, oz] = effects.objectPosition ?? DEFAULT_EFFECTS.objectPosition;
-      setCommon(this.object, 2, new Float32Array([s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0, ox, oy, oz, 1]));
-      if (!effects.lighting) {
-        // Without the moving lights the object gets a fixed key light above the eye.
-        gl.uniform3fv(this.object.uniforms.uLightPosition, new Float32Array([eye[0] + 1, eye[1] + 2, eye[2] + 1, ...new Array(9).fill(0)]));
-        gl.uniform3fv(this.object.uniforms.uLightColor, new Float32Array([1.3, 1.3, 1.3, ...new Array(9).fill(0)]));
-        gl.uniform1i(this.object.uniforms.uLightCount, 1);
-      }
-      gl.uniform1f(this.object.uniforms.uAmbient, 0.35);
-      gl.uniform3fv(this.object.uniforms.uColor, [0.95, 0.75, 0.1]);
-      gl.bindVertexArray(this.cube.vao);
-      gl.drawElements(gl.TRIANGLES, this.cube.count, gl.UNSIGNED_INT, 0);
-    }
-
-    if (effects.water) {
-      const lo = effects.waterMinY ?? DEFAULT_EFFECTS.waterMinY;
-      const hi = effects.waterMaxY ?? DEFAULT_EFFECTS.waterMaxY;
-      const level = lo + (hi - lo) * (0.5 - 0.5 * Math.cos(timeSec * 0.4));
-      gl.useProgram(this.water.program);
-      setCommon(this.water, 0, new Float32Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, level, 0, 1]));
-      gl.uniform1f(this.water.uniforms.uTime, timeSec);
-      gl.enable(gl.BLEND);
-      gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
-      gl.depthMask(false);  // Transparent: tested against the photo's depth, not written.
-      gl.bindVertexArray(this.waterPlane.vao);
-      gl.drawElements(gl.TRIANGLES, this.waterPlane.count, gl.UNSIGNED_INT, 0);
-      gl.depthMask(true);
-      gl.disable(gl.BLEND);
+    const context = { gl, effects, eye, timeSec, setCommon };
+    for (const { effect, state } of this.effects) {
+      if (effects[effect.name]) effect.draw(state, context);
     }
     gl.bindVertexArray(null);
   }
@@ -486,8 +406,8 @@ export class Renderer {
       this.coverageTarget = null;
     }
     this._release(this.mesh);
-    this._release(this.cube);
-    this._release(this.waterPlane);
+    for (const { effect, state } of this.effects) effect.dispose(state, { gl: this.gl, release: (g) => this._release(g) });
+    this.effects = [];
     if (this.texture) this.gl.deleteTexture(this.texture);
     this.mesh = null;
     this.texture = null;
