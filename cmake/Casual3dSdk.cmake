@@ -8,6 +8,7 @@
 #   share/casual3d/viewer/              its web viewer (wasm-viewer/)
 #   include/casual3d/{format,encoder}/  public headers: #include <casual3d/format/x.h>
 #   lib/libcasual3d_{format,encoder}.a  static libraries
+#   lib/libcasual3d_base.a              what the encoder is built on (no headers)
 #   lib/cmake/casual3d/                 casual3d::format, casual3d::encoder
 #   lib/pkgconfig/casual3d-format.pc    the format library
 
@@ -96,6 +97,13 @@ foreach(lib ${CASUAL3D_SDK_LIBRARIES})
 endforeach()
 install(TARGETS ${CASUAL3D_SDK_LIBRARIES} EXPORT casual3dTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+# The static encoder library links casual3d_base (base/: threads, atomic
+# files, OpenEXR), which has no public headers and is no component of its own;
+# it is installed and exported for the encoder's link line.
+if(TARGET casual3d_encoder)
+  set_target_properties(casual3d_base PROPERTIES EXPORT_NAME base)
+  install(TARGETS casual3d_base EXPORT casual3dTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endif()
 install(EXPORT casual3dTargets NAMESPACE casual3d:: DESTINATION ${CASUAL3D_CMAKE_DIR})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/casual3dConfig.cmake.in
   ${PROJECT_BINARY_DIR}/sdk/casual3dConfig.cmake
