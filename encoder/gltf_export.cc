@@ -1,11 +1,6 @@
 #include "encoder/gltf_export.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <csetjmp>
 #include <cstdio>
@@ -26,6 +21,7 @@
 // The one translation unit that compiles tinygltf's implementation (see
 // gltf_tinygltf.h for why it is not taken from libtinygltf.so).
 #define TINYGLTF_IMPLEMENTATION
+#include "base/atomic_file.h"
 #include "encoder/gltf_tinygltf.h"
 #include "format/colour_atlas.h"
 #include "format/version.h"
@@ -651,40 +647,7 @@ Status ExportGlb(const Mesh& mesh, const Image8& atlas, const GltfExportOptions&
                  const std::string& path, GltfExportStats* stats) {
   CASUAL3D_ASSIGN_OR_RETURN(std::string glb, EncodeGlbString(mesh, atlas, options, stats));
 
-  // Atomic write: a temporary file in the target's folder (same file system),
-  // renamed over the target only once complete and flushed.
-  std::string tmp = path + ".tmp-XXXXXX";
-  const int fd = mkstemp(tmp.data());
-  if (fd < 0) return IoError(path + ": cannot create a file there (" + std::strerror(errno) + ")");
-  size_t written = 0;
-  while (written < glb.size()) {
-    const ssize_t r = write(fd, glb.data() + written, glb.size() - written);
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) {
-      const std::string reason = std::strerror(errno);
-      close(fd);
-      unlink(tmp.c_str());
-      return IoError(path + ": write failed (" + reason + ")");
-    }
-    written += static_cast<size_t>(r);
-  }
-  // mkstemp creates the file 0600; give it the usual permissions of a new file.
-  const mode_t mask = umask(0);
-  umask(mask);
-  fchmod(fd, 0666 & ~mask);
-  const bool synced = fsync(fd) == 0;
-  const std::string sync_reason = synced ? "" : std::strerror(errno);
-  if (close(fd) != 0 || !synced) {
-    const std::string reason = synced ? std::strerror(errno) : sync_reason;
-    unlink(tmp.c_str());
-    return IoError(path + ": write failed (" + reason + ")");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
-    unlink(tmp.c_str());
-    return IoError(path + ": cannot replace the file (" + reason + ")");
-  }
-  return Status::Ok();
+  return base::WriteFileAtomic(path, glb);
 }
 
 }  // namespace casual3d::encoder

@@ -745,7 +745,7 @@ TEST_F(GltfExportFileTest, WritesAtomicallyAndReplaces) {
   EXPECT_EQ(files, 1u);  // No temporary left behind.
   struct stat st;
   ASSERT_EQ(::stat(out.c_str(), &st), 0);
-  EXPECT_NE(st.st_mode & S_IRGRP, 0u) << "the file should not keep mkstemp's 0600 mode";
+  EXPECT_NE(st.st_mode & S_IRGRP, 0u) << "the file should have a new file's usual mode, not 0600";
 }
 
 TEST_F(GltfExportFileTest, FailsCleanlyWhenTheFolderIsMissing) {

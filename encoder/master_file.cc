@@ -1,27 +1,14 @@
 #include "encoder/master_file.h"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
+#include <array>
 #include <cstdint>
-#include <exception>
-#include <filesystem>
-#include <system_error>
-#include <thread>
+#include <optional>
+#include <string>
 #include <vector>
 
-#include <Imath/ImathMatrix.h>
-#include <Imath/ImathVec.h>
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
-#include <OpenEXR/ImfMatrixAttribute.h>
-#include <OpenEXR/ImfOutputFile.h>
-#include <OpenEXR/ImfStringAttribute.h>
-#include <OpenEXR/ImfTestFile.h>
-#include <OpenEXR/ImfVecAttribute.h>
+#include "base/exr_file.h"
+#include "base/parallel_for.h"
 
 namespace casual3d::encoder {
 namespace {
@@ -72,43 +59,71 @@ NodeArray<float>& FloatArray(LayerData& layer, int channel) {
 }
 
 // OpenEXR (de)compresses blocks of scanlines on this many threads.
-int NumThreads() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+int NumThreads() { return base::ResolveThreads(0); }
 
-std::string TempPathFor(const std::string& path) {
-  static std::atomic<int> counter{0};
-  return path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+std::string ChannelName(int layer, const char* name) {
+  return std::string(kLayerPrefix[layer]) + name;
 }
 
-void WriteExr(const TwoLayerPanorama& pano, const std::string& path) {
-  const int w = pano.width(), h = pano.height();
-  Imf::Header header(w, h);
-  header.compression() = Imf::ZIP_COMPRESSION;
-  header.insert("casual3d.format", Imf::StringAttribute(kFormatName));
-  header.insert("casual3d.version",
-                Imf::StringAttribute(std::to_string(kVersionMajor) + "." +
-                                     std::to_string(kVersionMinor)));
-  const PanoramaFrame& f = pano.frame();
-  header.insert("casual3d.centre",
-                Imf::V3dAttribute(Imath::V3d(f.centre[0], f.centre[1], f.centre[2])));
-  const double* r = f.rotation;
-  header.insert("casual3d.rotation", Imf::M33dAttribute(Imath::M33d(
-                                         r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8])));
+base::ExrHeader MasterHeader(const TwoLayerPanorama& pano) {
+  base::ExrHeader header;
+  header.width = pano.width();
+  header.height = pano.height();
+  header.compression = base::ExrCompression::kZip;
+  header.string_attributes = {
+      {"casual3d.format", kFormatName},
+      {"casual3d.version", std::to_string(kVersionMajor) + "." + std::to_string(kVersionMinor)}};
   if (pano.view_hints())
-    header.insert("casual3d.view", Imf::StringAttribute(SerializeViewHints(*pano.view_hints())));
+    header.string_attributes.emplace_back("casual3d.view", SerializeViewHints(*pano.view_hints()));
+  const PanoramaFrame& f = pano.frame();
+  header.v3d_attributes = {{"casual3d.centre", {f.centre[0], f.centre[1], f.centre[2]}}};
+  std::array<double, 9> rotation;
+  std::copy(f.rotation, f.rotation + 9, rotation.begin());
+  header.m33d_attributes = {{"casual3d.rotation", rotation}};
   for (int l = 0; l < kNumLayers; ++l) {
     for (const ByteChannel& c : kByteChannels)
-      header.channels().insert(std::string(kLayerPrefix[l]) + c.name, Imf::Channel(Imf::UINT));
+      header.channels.push_back({ChannelName(l, c.name), base::ExrPixelType::kUint});
     for (const FloatChannel& c : kFloatChannels)
-      header.channels().insert(std::string(kLayerPrefix[l]) + c.name, Imf::Channel(Imf::FLOAT));
+      header.channels.push_back({ChannelName(l, c.name), base::ExrPixelType::kFloat});
   }
-  Imf::OutputFile file(path.c_str(), header, NumThreads());
+  return header;
+}
 
+// The slices of a strip of `rows` rows from row y0: the byte-valued channels
+// as 32-bit words in `words` (UINT channels need them), the float channels
+// straight from the layers' arrays.
+std::vector<base::ExrSlice> StripSlices(const TwoLayerPanorama& pano, int y0,
+                                        std::vector<uint32_t>& words) {
+  const int w = pano.width();
+  const size_t strip_pixels = static_cast<size_t>(w) * kStripRows;
+  std::vector<base::ExrSlice> slices;
+  for (int l = 0; l < kNumLayers; ++l) {
+    for (int c = 0; c < kNumByteChannels; ++c) {
+      uint32_t* dst = words.data() + (l * kNumByteChannels + c) * strip_pixels;
+      slices.push_back({ChannelName(l, kByteChannels[c].name), base::ExrPixelType::kUint,
+                        reinterpret_cast<char*>(dst), sizeof(uint32_t), sizeof(uint32_t) * w});
+    }
+    for (int c = 0; c < kNumFloatChannels; ++c) {
+      const FloatChannel& fc = kFloatChannels[c];
+      const float* src = FloatArray(const_cast<LayerData&>(pano.layer(l)), c).data() +
+                         static_cast<size_t>(y0) * w * fc.stride + fc.component;
+      slices.push_back({ChannelName(l, fc.name), base::ExrPixelType::kFloat,
+                        reinterpret_cast<char*>(const_cast<float*>(src)), sizeof(float) * fc.stride,
+                        sizeof(float) * fc.stride * w});
+    }
+  }
+  return slices;
+}
+
+Status WriteExr(const TwoLayerPanorama& pano, const std::string& path) {
+  const int w = pano.width(), h = pano.height();
+  CASUAL3D_ASSIGN_OR_RETURN(base::ExrWriter file,
+                            base::ExrWriter::Create(path, MasterHeader(pano), NumThreads()));
   // UINT channels need 32-bit source data: convert one strip at a time.
   const size_t strip_pixels = static_cast<size_t>(w) * kStripRows;
   std::vector<uint32_t> words(strip_pixels * kNumLayers * kNumByteChannels);
   for (int y0 = 0; y0 < h; y0 += kStripRows) {
     const int rows = std::min(kStripRows, h - y0);
-    Imf::FrameBuffer fb;
     for (int l = 0; l < kNumLayers; ++l) {
       const LayerData& layer = pano.layer(l);
       for (int c = 0; c < kNumByteChannels; ++c) {
@@ -118,22 +133,11 @@ void WriteExr(const TwoLayerPanorama& pano, const std::string& path) {
         const size_t first = static_cast<size_t>(y0) * w;
         for (size_t i = 0; i < static_cast<size_t>(rows) * w; ++i)
           dst[i] = src[(first + i) * bc.stride + bc.component];
-        // OpenEXR addresses base + x * xStride + y * yStride with absolute y.
-        char* base = reinterpret_cast<char*>(dst) -
-                     static_cast<ptrdiff_t>(y0) * w * static_cast<ptrdiff_t>(sizeof(uint32_t));
-        fb.insert(std::string(kLayerPrefix[l]) + bc.name,
-                  Imf::Slice(Imf::UINT, base, sizeof(uint32_t), sizeof(uint32_t) * w));
-      }
-      for (const FloatChannel& fc : kFloatChannels) {
-        const float* src = (fc.stride == 1 ? layer.depth_m : layer.normal).data() + fc.component;
-        fb.insert(std::string(kLayerPrefix[l]) + fc.name,
-                  Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(src)),
-                             sizeof(float) * fc.stride, sizeof(float) * fc.stride * w));
       }
     }
-    file.setFrameBuffer(fb);
-    file.writePixels(rows);
+    CASUAL3D_RETURN_IF_ERROR(file.WriteRows(rows, StripSlices(pano, y0, words)));
   }
+  return file.Commit();
 }
 
 // Parses "major.minor"; false if malformed.
@@ -147,25 +151,21 @@ bool ParseVersion(const std::string& s, int* major, int* minor) {
   return true;
 }
 
-StatusOr<TwoLayerPanorama> ReadExr(const std::string& path) {
-  Imf::InputFile file(path.c_str(), NumThreads());
-  const Imf::Header& header = file.header();
-  const auto* format = header.findTypedAttribute<Imf::StringAttribute>("casual3d.format");
-  if (format == nullptr || format->value() != kFormatName)
+StatusOr<TwoLayerPanorama> ReadExr(base::ExrReader& file, const std::string& path) {
+  const std::optional<std::string> format = file.StringAttribute("casual3d.format");
+  if (!format || *format != kFormatName)
     return InvalidData(path + ": an OpenEXR file but not a casual3d master file (attribute "
                        "casual3d.format is missing or not \"casual3d-master\")");
-  const auto* version = header.findTypedAttribute<Imf::StringAttribute>("casual3d.version");
+  const std::optional<std::string> version = file.StringAttribute("casual3d.version");
   int major = 0, minor = 0;
-  if (version == nullptr || !ParseVersion(version->value(), &major, &minor))
+  if (!version || !ParseVersion(*version, &major, &minor))
     return InvalidData(path + ": attribute casual3d.version is missing or not \"major.minor\"");
   if (major != kVersionMajor)
-    return UnsupportedVersion(path + ": master file version " + version->value() +
+    return UnsupportedVersion(path + ": master file version " + *version +
                               " is not supported (this build reads 1.x)");
 
-  const Imath::Box2i dw = header.dataWindow();
-  const int64_t w64 = static_cast<int64_t>(dw.max.x) - dw.min.x + 1;
-  const int64_t h64 = static_cast<int64_t>(dw.max.y) - dw.min.y + 1;
-  if (dw.min.x != 0 || dw.min.y != 0 || w64 <= 0 || h64 <= 0)
+  const int64_t w64 = file.width(), h64 = file.height();
+  if (file.min_x() != 0 || file.min_y() != 0)
     return InvalidData(path + ": the data window must start at (0,0) and be non-empty");
   if (w64 > kMaxMasterWidth || h64 > kMaxMasterHeight)
     return LimitExceeded(path + ": " + std::to_string(w64) + "x" + std::to_string(h64) +
@@ -175,15 +175,15 @@ StatusOr<TwoLayerPanorama> ReadExr(const std::string& path) {
 
   for (int l = 0; l < kNumLayers; ++l) {
     for (const ByteChannel& c : kByteChannels) {
-      const std::string name = std::string(kLayerPrefix[l]) + c.name;
-      const Imf::Channel* ch = header.channels().findChannel(name);
-      if (ch == nullptr || ch->type != Imf::UINT || ch->xSampling != 1 || ch->ySampling != 1)
+      const std::string name = ChannelName(l, c.name);
+      const base::ExrChannel* ch = file.FindChannel(name);
+      if (ch == nullptr || ch->type != base::ExrPixelType::kUint || !ch->full_resolution)
         return InvalidData(path + ": channel " + name + " is missing or not full-resolution UINT");
     }
     for (const FloatChannel& c : kFloatChannels) {
-      const std::string name = std::string(kLayerPrefix[l]) + c.name;
-      const Imf::Channel* ch = header.channels().findChannel(name);
-      if (ch == nullptr || ch->type != Imf::FLOAT || ch->xSampling != 1 || ch->ySampling != 1)
+      const std::string name = ChannelName(l, c.name);
+      const base::ExrChannel* ch = file.FindChannel(name);
+      if (ch == nullptr || ch->type != base::ExrPixelType::kFloat || !ch->full_resolution)
         return InvalidData(path + ": channel " + name +
                            " is missing or not full-resolution FLOAT");
     }
@@ -191,20 +191,14 @@ StatusOr<TwoLayerPanorama> ReadExr(const std::string& path) {
 
   TwoLayerPanorama pano(w, h);
   PanoramaFrame& frame = pano.frame();
-  if (const auto* a = header.findTypedAttribute<Imf::V3dAttribute>("casual3d.centre")) {
-    frame.centre[0] = a->value().x;
-    frame.centre[1] = a->value().y;
-    frame.centre[2] = a->value().z;
-  } else {
-    return InvalidData(path + ": attribute casual3d.centre (v3d) is missing");
-  }
-  if (const auto* a = header.findTypedAttribute<Imf::M33dAttribute>("casual3d.rotation")) {
-    for (int i = 0; i < 9; ++i) frame.rotation[i] = a->value()[i / 3][i % 3];
-  } else {
-    return InvalidData(path + ": attribute casual3d.rotation (m33d) is missing");
-  }
-  if (const auto* a = header.findTypedAttribute<Imf::StringAttribute>("casual3d.view")) {
-    StatusOr<ViewHints> hints = ParseViewHints(a->value());
+  const std::optional<std::array<double, 3>> centre = file.V3dAttribute("casual3d.centre");
+  if (!centre) return InvalidData(path + ": attribute casual3d.centre (v3d) is missing");
+  std::copy(centre->begin(), centre->end(), frame.centre);
+  const std::optional<std::array<double, 9>> rotation = file.M33dAttribute("casual3d.rotation");
+  if (!rotation) return InvalidData(path + ": attribute casual3d.rotation (m33d) is missing");
+  std::copy(rotation->begin(), rotation->end(), frame.rotation);
+  if (const std::optional<std::string> view = file.StringAttribute("casual3d.view")) {
+    StatusOr<ViewHints> hints = ParseViewHints(*view);
     if (!hints.ok())
       return InvalidData(path + ": attribute casual3d.view: " + hints.status().message());
     pano.view_hints() = *hints;
@@ -214,26 +208,7 @@ StatusOr<TwoLayerPanorama> ReadExr(const std::string& path) {
   std::vector<uint32_t> words(strip_pixels * kNumLayers * kNumByteChannels);
   for (int y0 = 0; y0 < h; y0 += kStripRows) {
     const int rows = std::min(kStripRows, h - y0);
-    Imf::FrameBuffer fb;
-    for (int l = 0; l < kNumLayers; ++l) {
-      LayerData& layer = pano.layer(l);
-      for (int c = 0; c < kNumByteChannels; ++c) {
-        uint32_t* dst = words.data() + (l * kNumByteChannels + c) * strip_pixels;
-        char* base = reinterpret_cast<char*>(dst) -
-                     static_cast<ptrdiff_t>(y0) * w * static_cast<ptrdiff_t>(sizeof(uint32_t));
-        fb.insert(std::string(kLayerPrefix[l]) + kByteChannels[c].name,
-                  Imf::Slice(Imf::UINT, base, sizeof(uint32_t), sizeof(uint32_t) * w));
-      }
-      for (int c = 0; c < kNumFloatChannels; ++c) {
-        const FloatChannel& fc = kFloatChannels[c];
-        float* dst = FloatArray(layer, c).data() + fc.component;
-        fb.insert(std::string(kLayerPrefix[l]) + fc.name,
-                  Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(dst), sizeof(float) * fc.stride,
-                             sizeof(float) * fc.stride * w));
-      }
-    }
-    file.setFrameBuffer(fb);
-    file.readPixels(y0, y0 + rows - 1);
+    CASUAL3D_RETURN_IF_ERROR(file.ReadRows(y0, rows, StripSlices(pano, y0, words)));
     for (int l = 0; l < kNumLayers; ++l) {
       LayerData& layer = pano.layer(l);
       for (int c = 0; c < kNumByteChannels; ++c) {
@@ -266,35 +241,17 @@ Status WriteMasterFile(const TwoLayerPanorama& pano, const std::string& path) {
   if (!valid.ok())
     return InvalidArgument("refusing to write " + path + ": the panorama is invalid: " +
                            valid.message());
-  const std::string tmp = TempPathFor(path);
-  try {
-    WriteExr(pano, tmp);
-  } catch (const std::exception& e) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    return IoError(path + ": cannot write the master file: " + e.what());
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    return IoError(path + ": cannot move the finished master file into place: " + ec.message());
-  }
-  return Status::Ok();
+  return WriteExr(pano, path);
 }
 
 StatusOr<TwoLayerPanorama> ReadMasterFile(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    return NotFound(path + ": no such master file");
-  try {
-    if (!Imf::isOpenExrFile(path.c_str()))
-      return InvalidData(path + ": not an OpenEXR file");
-    return ReadExr(path);
-  } catch (const std::exception& e) {
-    return InvalidData(path + ": cannot read the master file: " + e.what());
+  StatusOr<base::ExrReader> file = base::ExrReader::Open(path, NumThreads());
+  if (!file.ok()) {
+    if (file.status().code() == StatusCode::kNotFound)
+      return NotFound(path + ": no such master file");
+    return file.status();
   }
+  return ReadExr(*file, path);
 }
 
 }  // namespace casual3d::encoder

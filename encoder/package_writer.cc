@@ -1,15 +1,14 @@
 #include "encoder/package_writer.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <mutex>
 #include <system_error>
-#include <thread>
+
+#include "base/atomic_file.h"
+#include "base/parallel_for.h"
 
 #include "encoder/absent_fill.h"
 #include "encoder/level_of_detail.h"
@@ -45,11 +44,6 @@ DepthQuantization DepthRange(const TwoLayerPanorama& pano) {
   // 4.2); every node then has code 1, which decodes to near_m exactly.
   if (!(q.far_m > q.near_m)) q.far_m = 2.0 * q.near_m;
   return q;
-}
-
-std::string UniqueSuffix() {
-  static std::atomic<int> counter{0};
-  return std::to_string(::getpid()) + "-" + std::to_string(counter++);
 }
 
 Status WriteBytes(const fs::path& path, const std::vector<uint8_t>& bytes) {
@@ -177,48 +171,35 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
     manifest.levels.push_back(std::move(L));
   }
 
-  std::atomic<size_t> next{0};
+  // Tiles are encoded in parallel; after a failure no further tile starts,
+  // and the first failing tile in job order is reported.
+  std::vector<Status> job_status(jobs.size());
   std::atomic<bool> failed{false};
-  std::mutex error_mutex;
-  Status first_error;
-  auto work = [&] {
-    while (!failed.load()) {
-      const size_t j = next.fetch_add(1);
-      if (j >= jobs.size()) return;
-      Job& job = jobs[j];
-      int x, y, w, h;
-      manifest.TileRect(job.level, job.tile, &x, &y, &w, &h);
-      Image8 image =
-          EncodeTileImage(*level_pano[job.level], x, y, w, h, job.kind, manifest.quantization());
-      if (options.fill_absent &&
-          (job.kind == TileImageKind::kDepth || job.kind == TileImageKind::kNormal))
-        FillAbsentCodes(*level_pano[job.level], x, y, w, h, &image);
-      WebpEncodeOptions webp;
-      webp.lossless = TileImageIsLossless(job.kind);
-      webp.quality = webp.lossless ? options.lossless_effort : options.color_quality;
-      webp.method = webp.lossless ? options.lossless_method : options.color_method;
-      StatusOr<std::vector<uint8_t>> bytes =
-          EncodeWebp(static_cast<const Image8&>(image).view(), webp);
-      if (!bytes.ok()) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!failed.exchange(true))
-          first_error = Status(bytes.status().code(), job.path + ": " + bytes.status().message());
-        return;
-      }
-      job.bytes = std::move(*bytes);
+  base::ParallelFor(0, static_cast<int64_t>(jobs.size()), base::ResolveThreads(options.num_threads),
+                    [&](int64_t j) {
+    if (failed.load()) return;
+    Job& job = jobs[j];
+    int x, y, w, h;
+    manifest.TileRect(job.level, job.tile, &x, &y, &w, &h);
+    Image8 image =
+        EncodeTileImage(*level_pano[job.level], x, y, w, h, job.kind, manifest.quantization());
+    if (options.fill_absent &&
+        (job.kind == TileImageKind::kDepth || job.kind == TileImageKind::kNormal))
+      FillAbsentCodes(*level_pano[job.level], x, y, w, h, &image);
+    WebpEncodeOptions webp;
+    webp.lossless = TileImageIsLossless(job.kind);
+    webp.quality = webp.lossless ? options.lossless_effort : options.color_quality;
+    webp.method = webp.lossless ? options.lossless_method : options.color_method;
+    StatusOr<std::vector<uint8_t>> bytes =
+        EncodeWebp(static_cast<const Image8&>(image).view(), webp);
+    if (!bytes.ok()) {
+      job_status[j] = Status(bytes.status().code(), job.path + ": " + bytes.status().message());
+      failed.store(true);
+      return;
     }
-  };
-  int threads = options.num_threads > 0 ? options.num_threads
-                                        : static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::max(1, std::min<int>(threads, static_cast<int>(jobs.size())));
-  if (threads == 1) {
-    work();
-  } else {
-    std::vector<std::thread> pool;
-    for (int i = 0; i < threads; ++i) pool.emplace_back(work);
-    for (std::thread& t : pool) t.join();
-  }
-  if (failed.load()) return first_error;
+    job.bytes = std::move(*bytes);
+  });
+  for (const Status& s : job_status) CASUAL3D_RETURN_IF_ERROR(s);
 
   std::sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.path < b.path; });
   PackageFiles files;
@@ -258,7 +239,7 @@ Status WritePackageFolder(const PackageFiles& files, const std::string& dir) {
       return InvalidArgument(dir + ": exists and is not a casual3d package (no manifest.json); "
                                    "refusing to replace it, choose another output folder");
   }
-  const fs::path tmp = clean.string() + ".tmp-" + UniqueSuffix();
+  const fs::path tmp = base::TemporaryPathFor(clean.string());
   fs::create_directories(tmp, ec);
   if (ec) return IoError(tmp.string() + ": cannot create the folder: " + ec.message());
   auto cleanup = [&] {
@@ -281,7 +262,7 @@ Status WritePackageFolder(const PackageFiles& files, const std::string& dir) {
   }
   fs::path old;
   if (fs::exists(clean, ec)) {
-    old = clean.string() + ".old-" + UniqueSuffix();
+    old = base::TemporaryPathFor(clean.string());
     fs::rename(clean, old, ec);
     if (ec) {
       cleanup();
@@ -301,15 +282,7 @@ Status WritePackageFolder(const PackageFiles& files, const std::string& dir) {
 
 Status WritePackageSingleFile(const PackageFiles& files, const std::string& path) {
   CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> container, BuildSingleFile(files));
-  const fs::path tmp = path + ".tmp-" + UniqueSuffix();
-  Status s = WriteBytes(tmp, container);
-  std::error_code ec;
-  if (s.ok()) {
-    fs::rename(tmp, path, ec);
-    if (ec) s = IoError(path + ": cannot move the finished file into place: " + ec.message());
-  }
-  if (!s.ok()) fs::remove(tmp, ec);
-  return s;
+  return base::WriteFileAtomic(path, container);
 }
 
 }  // namespace casual3d::encoder
