@@ -20,7 +20,6 @@ struct DenseCommandOptions {
   std::string out;
   bool no_near_envelope = false;
   bool no_gc_filter = false;
-  bool refine = false;
   bool no_flat_regions = false;
   bool no_relabel = false;
   bool no_fullres_refine = false;
@@ -59,7 +58,6 @@ void RunDense(const DenseCommandOptions& o) {
   depth::DenseOptions opt = o.dense;
   opt.use_near_envelope = !o.no_near_envelope;
   opt.use_gc_filter = !o.no_gc_filter;
-  opt.refine.enabled = o.refine;
   opt.flat.enabled = !o.no_flat_regions;
   opt.relabel.enabled = !o.no_relabel;
   opt.fullres.enabled = !o.no_fullres_refine;
@@ -122,8 +120,6 @@ void AddDenseCommand(CLI::App& app) {
   AddDescribedOption(cmd, "--free-space-rounds", opts->dense, opts->dense.visibility.rounds);
   AddDescribedOption(cmd, "--lambda-flat", opts->dense, opts->dense.mrf.lambda_flat);
   AddDescribedOption(cmd, "--relabel-neighbors", opts->dense, opts->dense.relabel.max_neighbors);
-  cmd->add_flag("--refine", opts->refine,
-                "Continuous depth search within one label of the MRF's (slower; helps wide baselines)");
   AddDescribedOption(cmd, "--threads", opts->dense, opts->dense.num_threads);
   AddDescribedOption(cmd, "--scale", opts->dense, opts->dense.working_scale);
   AddDescribedOption(cmd, "--depths", opts->dense, opts->dense.sweep.num_depths);

@@ -189,8 +189,6 @@ MrfResult SolveDepthMrf(const DensePlan& plan, int i, const DenseOptions& option
     for (size_t p = 0; p < np; ++p) r.trws_depth.data()[p] = static_cast<float>(vol.DepthOfLabel(res.labels[p]));
   }
   t0 = Clock::now();
-  if (options.refine.enabled)
-    fl = RefineContinuous(v, swept, vol, labels, fl, options.sweep, options.refine, threads);
   fl = SmoothSubLabel(vol, std::move(fl), v.color, options.sublabel, threads);
   // Within a fitted flat region the plane is the estimate: the photos carry
   // no evidence there to refine it by.

@@ -54,7 +54,6 @@ void WriteDenseJson(const std::string& path, const DenseReport& report, const De
   j["use_gc_filter"] = options.use_gc_filter;
   j["num_depths"] = options.sweep.num_depths;
   j["working_scale"] = options.working_scale;
-  j["continuous_refine"] = options.refine.enabled;
   j["cross_view_consistency"] = report.cross_view_consistency;
   j["options"] = util::FieldsJson(options);  // Every option (dense_stage.h).
   if (report.evaluated) {

@@ -20,8 +20,8 @@
 // pruning (median_prune.h), Poisson propagation, scaling and min filter
 // (near_envelope.h); MRF of Eq. 1-4 solved by TRW-S (mrf_trws.h); sub-label
 // edge-aware median against window fattening (edge_median.h); sub-label
-// refinement (sublabel_refine.h) with a continuous search around each label
-// (continuous_refine.h); joint bilateral weighted-median upsampling (upsample.h);
+// refinement (sublabel_refine.h); joint bilateral weighted-median upsampling
+// (upsample.h);
 // boundary relabelling and a full-resolution search (fullres_refine.h). Once
 // every photo has its map: the free-space check of the maps against each
 // other (visibility_filter.h).
@@ -34,7 +34,6 @@
 #include <vector>
 
 #include "format/status.h"
-#include "reconstruct/depth/continuous_refine.h"
 #include "reconstruct/depth/edge_median.h"
 #include "reconstruct/depth/flat_regions.h"
 #include "reconstruct/depth/fullres_refine.h"
@@ -118,7 +117,6 @@ struct DenseOptions {
   MrfTermOptions mrf;
   EdgeMedianOptions edge_median;  // In working pixels, like the sweep's window (fattening scale).
   SubLabelOptions sublabel;
-  ContinuousRefineOptions refine;  // Between the sub-label fit and its smoothing.
   UpsampleOptions upsample;
   BoundaryRelabelOptions relabel;  // After upsampling, before fullres.
   FullResRefineOptions fullres;    // After upsampling.
@@ -152,7 +150,6 @@ struct DenseOptions {
     v.Struct("mrf", o.mrf);
     v.Struct("edge_median", o.edge_median);
     v.Struct("sublabel", o.sublabel);
-    v.Struct("refine", o.refine);
     v.Struct("upsample", o.upsample);
     v.Struct("relabel", o.relabel);
     v.Struct("fullres", o.fullres);

@@ -208,17 +208,8 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
   for (size_t i = 0; i < n; ++i) inv_image.data()[i] = 1.0f / depth.data()[i];
   const int diameter = 2 * options.radius + 1;
   const ImageF min_image = MinFilter(inv_image, diameter);
-  // The maximum only serves the nearer candidate.
-  ImageF max_image;
-  if (options.test_nearer) {
-    ImageF neg_inv(w, h, 1);
-    for (size_t i = 0; i < n; ++i) neg_inv.data()[i] = -inv_image.data()[i];
-    max_image = MinFilter(neg_inv, diameter);
-    for (size_t i = 0; i < n; ++i) max_image.data()[i] = -max_image.data()[i];
-  }
   const float* inv = inv_image.data();
   const float* inv_min = min_image.data();
-  const float* inv_max = max_image.data();
   const float jump = static_cast<float>(options.min_jump_labels * inv_step);
   const float same = static_cast<float>(inv_step);
   // The band: pixels within `radius` of a depth edge, two 4-neighbours
@@ -275,12 +266,10 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
     for (int x = 0; x < w; ++x) {
       const size_t p = static_cast<size_t>(y) * w + x;
       if (!near_edge[p]) continue;
-      // Only candidates at least a label away count (by default only the
-      // farther one): most pixels of a band are already on that side.
+      // Only a farther surface at least a label away counts: most pixels of
+      // a band are already on that side.
       const float cur = inv[p];
-      const bool far_differs = cur - inv_min[p] >= same;
-      const bool near_differs = options.test_nearer && inv_max[p] - cur >= same;
-      if (!far_differs && !near_differs) continue;
+      if (cur - inv_min[p] < same) continue;
       // The colour-weighted window of the reference: pixel (u, v) weighs
       // exp(-|c_uv - c_xy|^2 / (2 sigma_color^2)).
       const float* c0 = &color.at(x, y, 0);
@@ -346,10 +335,10 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       if (base < options.min_gain) continue;
       // Candidates: the colour-weighted median of the farther depths in the
       // band window (the surface of the pixel's own colour beyond the edge),
-      // the farthest depth, and with test_nearer the nearest.
-      float cands[3];
+      // and the farthest depth.
+      float cands[2];
       int num_cands = 0;
-      if (far_differs) {
+      {
         int ns = 0;
         for (int v = std::max(0, y - R); v <= std::min(h - 1, y + R); v += cs)
           for (int u = std::max(0, x - R); u <= std::min(w - 1, x + R); u += cs) {
@@ -377,8 +366,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
           }
         }
       }
-      if (far_differs) cands[num_cands++] = inv_min[p];
-      if (near_differs) cands[num_cands++] = inv_max[p];
+      cands[num_cands++] = inv_min[p];
       float best_inv = cur, best_cost = base;
       for (int ci = 0; ci < num_cands; ++ci) {
         const float cand = cands[ci];

@@ -78,16 +78,15 @@ struct FullResRefineOptions {
 // candidates: the colour-weighted median of the band window's farther
 // depths (every 4th pixel both ways, weights
 // exp(-|c_q - c_p|^2 / (2 sigma_color^2)): the surface of the pixel's own
-// colour beyond the edge) and the farthest depth; with `test_nearer` also
-// the nearest. The test is a colour-weighted ZNCC (adaptive support
-// weights, Yoon and Kweon 2006) over the matching window, with the same
-// weights, so that the pole's pixels hardly count in the wall pixel's
-// window. The candidate of least cost (mean of the best best_k of the first
-// `max_neighbors` neighbours, each capped at the best one's plus
-// occlusion_truncation) wins when it beats the current depth's cost by
-// `min_gain` (a current cost below min_gain skips the candidates: none can
-// win). Only farther candidates by default: fattening moves the near
-// side's depth outwards.
+// colour beyond the edge) and the farthest depth. The test is a
+// colour-weighted ZNCC (adaptive support weights, Yoon and Kweon 2006) over
+// the matching window, with the same weights, so that the pole's pixels
+// hardly count in the wall pixel's window. The candidate of least cost
+// (mean of the best best_k of the first `max_neighbors` neighbours, each
+// capped at the best one's plus occlusion_truncation) wins when it beats the
+// current depth's cost by `min_gain` (a current cost below min_gain skips
+// the candidates: none can win). Only farther candidates: fattening moves
+// the near side's depth outwards.
 struct BoundaryRelabelOptions {
   bool enabled = true;
   // Full-resolution pixels: how far the working resolution's fattening
@@ -111,7 +110,6 @@ struct BoundaryRelabelOptions {
   double ncc_epsilon = 2.5e-5;    // [0, 1].
   double texture_sigma = 0.02;    // Texture weight var / (var + sigma^2). (0, 1].
   double min_texture = 0.1;       // [0, 1].
-  bool test_nearer = false;
 
   template <typename Self, typename Visitor>
   static void DescribeFields(Self& o, Visitor& v) {
@@ -129,8 +127,6 @@ struct BoundaryRelabelOptions {
     v.Field("ncc_epsilon", o.ncc_epsilon, R::Closed(0, 1), "Variance added to both windows");
     v.Field("texture_sigma", o.texture_sigma, R::OpenClosed(0, 1), "Texture weight var / (var + sigma^2)");
     v.Field("min_texture", o.min_texture, R::Closed(0, 1), "Pixels with a lower texture weight keep their depth");
-    v.Field("test_nearer", o.test_nearer, R::Any(),
-            "Also test the nearest depth within radius (by default only the farthest)");
     v.Require(o.window_step <= o.window_radius, "window_step", "must not exceed window_radius");
   }
   Status Check() const { return util::CheckFields(*this); }

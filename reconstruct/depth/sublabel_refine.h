@@ -54,8 +54,8 @@ std::vector<float> RefineSubLabel(const CostVolume& volume, const std::vector<in
                                   const ImageF& color, const SubLabelOptions& options,
                                   int num_threads = 0);
 
-// The two steps on their own, so that another per-pixel refinement
-// (continuous_refine.h) can run between them: RefineSubLabel(...) equals
+// The two steps on their own (the dense stage times them apart):
+// RefineSubLabel(...) equals
 // SmoothSubLabel(volume, FitSubLabel(volume, labels, ...), color, ...).
 std::vector<float> FitSubLabel(const CostVolume& volume, const std::vector<int>& labels,
                                const SubLabelOptions& options, int num_threads = 0);
