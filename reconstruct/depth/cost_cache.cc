@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstdio>
 #include <fstream>
 
+#include "base/atomic_file.h"
 #include "reconstruct/io/file_util.h"
 
 namespace casual3d::depth {
@@ -15,8 +15,7 @@ constexpr size_t kCacheChunk = size_t{1} << 20;  // Costs per chunk.
 }  // namespace
 
 void WriteCostCache(const std::string& path, const CostVolume& vol) {
-  const std::string tmp = io::TemporaryPathFor(path);
-  {
+  io::ThrowIfError(base::WriteAtomically(path, [&](const std::string& tmp) {
     std::ofstream f(tmp, std::ios::binary);
     std::vector<uint16_t> q(std::min(kCacheChunk, vol.cost.size()));
     for (size_t begin = 0; begin < vol.cost.size(); begin += kCacheChunk) {
@@ -33,19 +32,16 @@ void WriteCostCache(const std::string& path, const CostVolume& vol) {
     }
     f.write(reinterpret_cast<const char*>(vol.photo_weight.data()),
             static_cast<std::streamsize>(vol.photo_weight.size() * sizeof(float)));
-    if (!f) {
-      f.close();
-      std::remove(tmp.c_str());
-      throw io::IoError(path + ": cannot write the cost cache (disk full?)");
-    }
-  }
-  io::CommitTemporary(tmp, path);
+    f.close();
+    if (!f) return IoError(path + ": cannot write the cost cache (disk full?)");
+    return Status::Ok();
+  }));
 }
 
 void ReadCostCache(const std::string& path, size_t total, std::vector<float>* cost, ImageF* photo_weight) {
   cost->resize(total);
   std::ifstream f(path, std::ios::binary);
-  if (!f) throw io::IoError(path + ": cost cache missing; rerun the sweep of this photo");
+  if (!f) throw io::IoException(path + ": cost cache missing; rerun the sweep of this photo");
   std::vector<uint16_t> q(std::min(kCacheChunk, total));
   for (size_t begin = 0; begin < total && f; begin += kCacheChunk) {
     const size_t count = std::min(kCacheChunk, total - begin);
@@ -56,7 +52,7 @@ void ReadCostCache(const std::string& path, size_t total, std::vector<float>* co
   if (photo_weight)
     f.read(reinterpret_cast<char*>(photo_weight->data()),
            static_cast<std::streamsize>(photo_weight->width() * photo_weight->height() * sizeof(float)));
-  if (!f) throw io::IoError(path + ": cost cache truncated; rerun the sweep of this photo");
+  if (!f) throw io::IoException(path + ": cost cache truncated; rerun the sweep of this photo");
 }
 
 }  // namespace casual3d::depth

@@ -14,12 +14,12 @@
 namespace casual3d::depth {
 
 // Writes `vol`'s costs and photo weights to `path` atomically, converting in
-// chunks (no second copy of the volume in memory). Throws io::IoError.
+// chunks (no second copy of the volume in memory). Throws io::IoException.
 void WriteCostCache(const std::string& path, const CostVolume& vol);
 
 // Reads a cache's costs into `*cost` (resized to `total` floats, its old
 // contents overwritten) and, when `photo_weight` is given (allocated to the
-// volume's size), its photo weights. Throws io::IoError naming `path` when
+// volume's size), its photo weights. Throws io::IoException naming `path` when
 // the file is missing or shorter than that.
 void ReadCostCache(const std::string& path, size_t total, std::vector<float>* cost, ImageF* photo_weight);
 

@@ -1,10 +1,10 @@
 #pragma once
 
-// Float OpenEXR images with named channels, through the OpenEXR 3.1 C++ API:
-// depth maps ("Z"), ground-truth panoramas ("front.R", ..., "back.Z"), and any
+// Float OpenEXR images with named channels, through base/exr_file.h: depth
+// maps ("Z"), ground-truth panoramas ("front.R", ..., "back.Z"), and any
 // other multi-channel float data. Pixels are interleaved in casual3d::ImageF in
 // the order of the channel names given. Writes are atomic (temporary file, then
-// rename); failures throw IoError naming the file.
+// rename); failures throw IoException naming the file.
 //
 // Note: OpenEXR stores channels sorted by name; ReadExr returns them in that
 // (file) order, ReadExrChannels in the order asked for.
@@ -12,13 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "base/exr_file.h"
 #include "format/image.h"
 #include "reconstruct/io/file_util.h"
 
 namespace casual3d::io {
 
-enum class ExrCompression { kNone, kZip, kPiz };
-enum class ExrPixelType { kFloat, kHalf };
+using base::ExrCompression;
+using base::ExrPixelType;  // kFloat or kHalf here.
 
 struct ExrWriteOptions {
   ExrCompression compression = ExrCompression::kZip;  // Lossless in all cases.
@@ -39,7 +40,7 @@ struct ExrImage {
 // Limit on each side of an image that the readers accept.
 constexpr int kMaxExrSide = 65536;
 
-// Writes `pixels` with one named channel per image channel. Throws IoError if
+// Writes `pixels` with one named channel per image channel. Throws IoException if
 // the names are empty, duplicated or fewer/more than the channels, or the
 // write fails; `path` is then left untouched.
 void WriteExr(const std::string& path, const ImageView<const float>& pixels,
@@ -55,7 +56,7 @@ inline void WriteExr(const std::string& path, const ImageF& pixels,
 ExrImage ReadExr(const std::string& path);
 
 // Reads the named channels, in the order given (converted to float). Throws
-// IoError naming the first missing channel.
+// IoException naming the first missing channel.
 ImageF ReadExrChannels(const std::string& path, const std::vector<std::string>& channel_names);
 
 // The channel names stored in the file (sorted, as OpenEXR keeps them).

@@ -90,25 +90,25 @@ TEST_F(ExrIoTest, HalfIsApproximate) {
 
 TEST_F(ExrIoTest, ErrorsNameTheFileAndLeaveNothingBehind) {
   const ImageF img = Pattern(4, 4, 2);
-  EXPECT_THROW(WriteExr(Path("a.exr"), img, {"Z"}), IoError);       // Count mismatch.
-  EXPECT_THROW(WriteExr(Path("a.exr"), img, {"Z", "Z"}), IoError);  // Repeated.
-  EXPECT_THROW(WriteExr(Path("nodir/a.exr"), img, {"X", "Y"}), IoError);
+  EXPECT_THROW(WriteExr(Path("a.exr"), img, {"Z"}), IoException);       // Count mismatch.
+  EXPECT_THROW(WriteExr(Path("a.exr"), img, {"Z", "Z"}), IoException);  // Repeated.
+  EXPECT_THROW(WriteExr(Path("nodir/a.exr"), img, {"X", "Y"}), IoException);
   EXPECT_TRUE(fs::is_empty(dir_));
 
   WriteExr(Path("b.exr"), img, {"X", "Y"});
   try {
     ReadExrChannels(Path("b.exr"), {"X", "Z"});
-    FAIL() << "expected IoError";
-  } catch (const IoError& e) {
+    FAIL() << "expected IoException";
+  } catch (const IoException& e) {
     EXPECT_EQ(std::string(e.what()), Path("b.exr") + ": OpenEXR channel 'Z' is missing");
   }
   WriteFileAtomic(Path("junk.exr"), "not an exr file");
-  EXPECT_THROW(ReadExr(Path("junk.exr")), IoError);
-  EXPECT_THROW(ReadExr(Path("missing.exr")), IoError);
+  EXPECT_THROW(ReadExr(Path("junk.exr")), IoException);
+  EXPECT_THROW(ReadExr(Path("missing.exr")), IoException);
   // A truncated file is refused, not crashed on.
   const std::string bytes = ReadFile(Path("b.exr"));
   WriteFileAtomic(Path("cut.exr"), bytes.substr(0, bytes.size() / 2));
-  EXPECT_THROW(ReadExr(Path("cut.exr")), IoError);
+  EXPECT_THROW(ReadExr(Path("cut.exr")), IoException);
 }
 
 }  // namespace

@@ -1,36 +1,38 @@
 #pragma once
 
-// File helpers shared by every writer in reconstruct/: atomic writes (data goes
-// to a temporary file next to the destination, renamed over it only when
-// complete, so that readers never see a half-written file) and the error type
-// that reconstruct/io raises.
+// File helpers of reconstruct/: the exception reconstruct/ raises for
+// input/output failures (STYLE.md, "Errors": inside reconstruct/, I/O failures
+// raise an error naming the input and the reason), and the throwing forms of
+// base/atomic_file.h's writes (a temporary file next to the destination,
+// renamed over it only when complete, so that readers never see a
+// half-written file).
 
 #include <stdexcept>
 #include <string>
 
+#include "format/status.h"
+
 namespace casual3d::io {
 
 // An input/output failure; what() names the file and the reason, e.g.
-// "photos/IMG_7.jpg: not a decodable image".
-class IoError : public std::runtime_error {
+// "photos/IMG_7.jpg: not a decodable image". The thrown counterpart of a
+// kIoError (or kInvalidData, kNotFound) Status from the layers below.
+class IoException : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
-// A temporary path in the same directory as `path` (so that rename() is atomic),
-// unique to this process and call: "<path>.tmp-<pid>-<counter>".
-std::string TemporaryPathFor(const std::string& path);
+// Throws IoException(status.message()) unless `status` is OK.
+void ThrowIfError(const Status& status);
 
-// Renames `tmp_path` over `path`; on failure removes `tmp_path` and throws IoError.
-void CommitTemporary(const std::string& tmp_path, const std::string& path);
-
-// Writes `bytes` to `path` atomically. Creates no directories. Throws IoError.
+// Writes `bytes` to `path` atomically (base::WriteFileAtomic). Creates no
+// directories. Throws IoException.
 void WriteFileAtomic(const std::string& path, const std::string& bytes);
 
-// Reads a whole file. Throws IoError ("path: cannot open (No such file or directory)").
+// Reads a whole file. Throws IoException ("path: cannot open (No such file or directory)").
 std::string ReadFile(const std::string& path);
 
-// Creates `dir` and its parents if missing. Throws IoError if that fails or a
+// Creates `dir` and its parents if missing. Throws IoException if that fails or a
 // non-directory is in the way.
 void CreateDirectories(const std::string& dir);
 

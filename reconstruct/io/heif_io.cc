@@ -58,11 +58,11 @@ Image8 DecodeHeif(const std::string& bytes, const std::string& name, int max_sid
   Context context;
   std::string why;
   const Handle handle = OpenPrimary(bytes, &context, &why);
-  if (!handle) throw IoError(name + ": not a decodable HEIF image (" + why + ")");
+  if (!handle) throw IoException(name + ": not a decodable HEIF image (" + why + ")");
   const int width = heif_image_handle_get_width(handle.get());
   const int height = heif_image_handle_get_height(handle.get());
   if (width > max_side || height > max_side) {
-    throw IoError(name + ": image of " + std::to_string(width) + "x" + std::to_string(height) +
+    throw IoException(name + ": image of " + std::to_string(width) + "x" + std::to_string(height) +
                   " exceeds the limit of " + std::to_string(max_side) + " pixels per side");
   }
   const int bits = heif_image_handle_get_luma_bits_per_pixel(handle.get());
@@ -74,14 +74,14 @@ Image8 DecodeHeif(const std::string& bytes, const std::string& name, int max_sid
                         high ? heif_chroma_interleaved_RRGGBB_LE : heif_chroma_interleaved_RGB,
                         nullptr);
   if (err.code != heif_error_Ok) {
-    throw IoError(name + ": not a decodable HEIF image (" + err.message + ")");
+    throw IoException(name + ": not a decodable HEIF image (" + err.message + ")");
   }
   const std::unique_ptr<heif_image, ImageDeleter> image(raw);
   int stride = 0;
   const uint8_t* plane = heif_image_get_plane_readonly(image.get(), heif_channel_interleaved, &stride);
   const int w = heif_image_get_width(image.get(), heif_channel_interleaved);
   const int h = heif_image_get_height(image.get(), heif_channel_interleaved);
-  if (plane == nullptr || w <= 0 || h <= 0) throw IoError(name + ": HEIF image without pixels");
+  if (plane == nullptr || w <= 0 || h <= 0) throw IoException(name + ": HEIF image without pixels");
   Image8 out(w, h, 3);
   if (!high) {
     for (int y = 0; y < h; ++y) std::memcpy(&out.at(0, y, 0), plane + static_cast<size_t>(y) * stride, w * 3);

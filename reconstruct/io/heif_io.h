@@ -23,7 +23,7 @@ struct HeifImageInfo {
 
 // Decodes the primary image of a HEIF file as upright 8-bit RGB; images with
 // more than 8 bits per channel are scaled (value * 255 / (2^bits - 1), rounded).
-// Throws IoError naming `name` for undecodable data or an image larger than
+// Throws IoException naming `name` for undecodable data or an image larger than
 // `max_side` pixels per side.
 Image8 DecodeHeif(const std::string& bytes, const std::string& name, int max_side,
                   HeifImageInfo* info = nullptr);

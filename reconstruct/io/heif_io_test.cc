@@ -123,7 +123,7 @@ TEST(HeifIoTest, BrokenHeifIsNamed) {
   try {
     DecodeImage(bytes, "photos/IMG_1.HEIC");
     FAIL() << "no error";
-  } catch (const IoError& e) {
+  } catch (const IoException& e) {
     EXPECT_NE(std::string(e.what()).find("photos/IMG_1.HEIC"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(LooksLikeHeif("not a heif file"));

@@ -14,7 +14,7 @@ namespace {
 
 // Converts 1-, 3- or 4-channel 8-bit RGB(A) to what imencode expects (grey, BGR, BGRA).
 cv::Mat ToEncoderLayout(const ImageView<const uint8_t>& image, const std::string& name) {
-  if (image.empty()) throw IoError(name + ": cannot write an empty image");
+  if (image.empty()) throw IoException(name + ": cannot write an empty image");
   const cv::Mat mat = ToMat(image);
   cv::Mat out;
   switch (image.channels()) {
@@ -27,7 +27,7 @@ cv::Mat ToEncoderLayout(const ImageView<const uint8_t>& image, const std::string
       cv::cvtColor(mat, out, cv::COLOR_RGBA2BGRA);
       return out;
     default:
-      throw IoError(name + ": cannot write an image with " + std::to_string(image.channels()) +
+      throw IoException(name + ": cannot write an image with " + std::to_string(image.channels()) +
                     " channels (expected 1, 3 or 4)");
   }
 }
@@ -39,9 +39,9 @@ std::string Encode(const cv::Mat& mat, const char* ext, const std::vector<int>& 
   try {
     ok = cv::imencode(ext, mat, buffer, params);
   } catch (const cv::Exception& e) {
-    throw IoError(name + ": cannot encode (" + e.what() + ")");
+    throw IoException(name + ": cannot encode (" + e.what() + ")");
   }
-  if (!ok) throw IoError(name + ": cannot encode");
+  if (!ok) throw IoException(name + ": cannot encode");
   return std::string(buffer.begin(), buffer.end());
 }
 
@@ -114,7 +114,7 @@ bool JpegSize(const std::string& bytes, int* width, int* height) {
 
 Image8 DecodeImage(const std::string& bytes, const std::string& name,
                    const ReadImageOptions& options, DecodedImageInfo* info) {
-  if (bytes.empty()) throw IoError(name + ": not a decodable image (empty file)");
+  if (bytes.empty()) throw IoException(name + ": not a decodable image (empty file)");
   DecodedImageInfo found;
   if (LooksLikeHeif(bytes)) {
     Image8 image = DecodeHeif(bytes, name, options.max_side);
@@ -127,7 +127,7 @@ Image8 DecodeImage(const std::string& bytes, const std::string& name,
   if (jpeg) {
     found.format = "jpeg";
     if (!JpegIsComplete(bytes)) {
-      throw IoError(name + ": truncated JPEG (the data ends before the end-of-image marker)");
+      throw IoException(name + ": truncated JPEG (the data ends before the end-of-image marker)");
     }
     const int64_t pixels = static_cast<int64_t>(stored_width) * stored_height;
     if (options.min_decoded_pixels > 0) {
@@ -158,10 +158,10 @@ Image8 DecodeImage(const std::string& bytes, const std::string& name,
     decoded.release();
   }
   if (decoded.empty() || decoded.type() != CV_8UC3) {
-    throw IoError(name + ": not a decodable image");
+    throw IoException(name + ": not a decodable image");
   }
   if (decoded.cols > options.max_side || decoded.rows > options.max_side) {
-    throw IoError(name + ": image of " + std::to_string(decoded.cols) + "x" +
+    throw IoException(name + ": image of " + std::to_string(decoded.cols) + "x" +
                   std::to_string(decoded.rows) + " exceeds the limit of " +
                   std::to_string(options.max_side) + " pixels per side");
   }
@@ -196,9 +196,9 @@ bool JpegOptions::Check(std::string* why) const {
 
 std::string EncodeJpeg(const ImageView<const uint8_t>& image, const JpegOptions& options) {
   std::string why;
-  if (!options.Check(&why)) throw IoError(why);
+  if (!options.Check(&why)) throw IoException(why);
   if (image.channels() != 1 && image.channels() != 3) {
-    throw IoError("JPEG needs 1 or 3 channels, got " + std::to_string(image.channels()));
+    throw IoException("JPEG needs 1 or 3 channels, got " + std::to_string(image.channels()));
   }
   // Baseline, no chroma subsampling change: libjpeg's output is a pure function
   // of the pixels and the quality, so captures are reproducible byte for byte.
@@ -209,9 +209,9 @@ std::string EncodeJpeg(const ImageView<const uint8_t>& image, const JpegOptions&
 void WriteJpeg(const std::string& path, const ImageView<const uint8_t>& image,
                const JpegOptions& options) {
   std::string why;
-  if (!options.Check(&why)) throw IoError(path + ": " + why);
+  if (!options.Check(&why)) throw IoException(path + ": " + why);
   if (image.channels() != 1 && image.channels() != 3) {
-    throw IoError(path + ": JPEG needs 1 or 3 channels, got " +
+    throw IoException(path + ": JPEG needs 1 or 3 channels, got " +
                   std::to_string(image.channels()));
   }
   WriteFileAtomic(path, Encode(ToEncoderLayout(image, path), ".jpg",

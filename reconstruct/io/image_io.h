@@ -2,7 +2,7 @@
 
 // Reading photos (JPEG, PNG, TIFF and whatever else OpenCV's imgcodecs decodes,
 // and HEIF/HEIC through heif_io.h) into casual3d::Image8, and writing JPEG and PNG. Pixels are RGB (not OpenCV's BGR).
-// Every write is atomic (temporary file, then rename). Failures throw IoError
+// Every write is atomic (temporary file, then rename). Failures throw IoException
 // naming the file: "photos/IMG_7.jpg: not a decodable image".
 
 #include <cstdint>
@@ -60,7 +60,7 @@ struct JpegOptions {
 
 // Encodes an RGB (3 channels) or grey (1 channel) 8-bit view as JPEG.
 std::string EncodeJpeg(const ImageView<const uint8_t>& image, const JpegOptions& options = {});
-// Writes a JPEG file atomically. Throws IoError (bad options, bad channel count,
+// Writes a JPEG file atomically. Throws IoException (bad options, bad channel count,
 // or the write failed).
 void WriteJpeg(const std::string& path, const ImageView<const uint8_t>& image,
                const JpegOptions& options = {});

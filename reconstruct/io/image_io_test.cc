@@ -87,8 +87,8 @@ TEST_F(ImageIoTest, JpegRoundTripIsCloseAndQualityMatters) {
 
 TEST_F(ImageIoTest, JpegQualityIsChecked) {
   const Image8 img = Ramp();
-  EXPECT_THROW(WriteJpeg(Path("q.jpg"), img, {0}), IoError);
-  EXPECT_THROW(WriteJpeg(Path("q.jpg"), img, {101}), IoError);
+  EXPECT_THROW(WriteJpeg(Path("q.jpg"), img, {0}), IoException);
+  EXPECT_THROW(WriteJpeg(Path("q.jpg"), img, {101}), IoException);
   EXPECT_FALSE(fs::exists(Path("q.jpg")));
 }
 
@@ -96,19 +96,19 @@ TEST_F(ImageIoTest, GarbageIsNotADecodableImage) {
   WriteFileAtomic(Path("junk.jpg"), "this is not an image at all");
   try {
     ReadImage(Path("junk.jpg"));
-    FAIL() << "expected IoError";
-  } catch (const IoError& e) {
+    FAIL() << "expected IoException";
+  } catch (const IoException& e) {
     EXPECT_EQ(std::string(e.what()), Path("junk.jpg") + ": not a decodable image");
   }
   WriteFileAtomic(Path("empty.png"), "");
-  EXPECT_THROW(ReadImage(Path("empty.png")), IoError);
+  EXPECT_THROW(ReadImage(Path("empty.png")), IoException);
 }
 
 TEST_F(ImageIoTest, MissingFileNamesThePath) {
   try {
     ReadImage(Path("nope.jpg"));
-    FAIL() << "expected IoError";
-  } catch (const IoError& e) {
+    FAIL() << "expected IoException";
+  } catch (const IoException& e) {
     EXPECT_NE(std::string(e.what()).find(Path("nope.jpg") + ": cannot open"), std::string::npos)
         << e.what();
   }
@@ -116,8 +116,8 @@ TEST_F(ImageIoTest, MissingFileNamesThePath) {
 
 TEST_F(ImageIoTest, FailedWriteLeavesNothingBehind) {
   const Image8 img = Ramp();
-  EXPECT_THROW(WritePng(Path("no_such_dir/a.png"), img.view()), IoError);
-  EXPECT_THROW(WritePng(Path("two.png"), Image8(4, 4, 2)), IoError);
+  EXPECT_THROW(WritePng(Path("no_such_dir/a.png"), img.view()), IoException);
+  EXPECT_THROW(WritePng(Path("two.png"), Image8(4, 4, 2)), IoException);
   EXPECT_TRUE(fs::is_empty(dir_));
 }
 
@@ -156,7 +156,7 @@ TEST_F(ImageIoTest, MaxSideIsEnforced) {
   WritePng(Path("big.png"), Ramp(40, 30));
   ReadImageOptions options;
   options.max_side = 32;
-  EXPECT_THROW(ReadImage(Path("big.png"), options), IoError);
+  EXPECT_THROW(ReadImage(Path("big.png"), options), IoException);
 }
 
 TEST_F(ImageIoTest, TruncatedJpegIsRefusedAndCompleteOnesPass) {
@@ -172,8 +172,8 @@ TEST_F(ImageIoTest, TruncatedJpegIsRefusedAndCompleteOnesPass) {
   EXPECT_FALSE(JpegIsComplete(ReadFile(Path("cut.jpg"))));
   try {
     ReadImage(Path("cut.jpg"));
-    FAIL() << "expected IoError";
-  } catch (const IoError& e) {
+    FAIL() << "expected IoException";
+  } catch (const IoException& e) {
     EXPECT_NE(std::string(e.what()).find(Path("cut.jpg") + ": truncated JPEG"), std::string::npos)
         << e.what();
   }

@@ -59,7 +59,7 @@ struct CaptureSummary {
 };
 
 // Writes the capture folder `dir` (created if missing; existing files of the
-// layout are replaced, each atomically). Throws std::runtime_error (io::IoError
+// layout are replaced, each atomically). Throws std::runtime_error (io::IoException
 // for files) with one line naming the problem; options are checked first.
 CaptureSummary GenerateCapture(const SynthOptions& options, const std::string& dir);
 
