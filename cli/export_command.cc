@@ -15,9 +15,9 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "base/parallel_for.h"
 #include "cli/command.h"
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
@@ -72,9 +72,7 @@ TwoLayerPanorama LoadPanorama(const ExportOptions& opts) {
 
   ReadOptions read;
   read.level = opts.level;
-  read.num_threads = opts.num_threads > 0
-                         ? opts.num_threads
-                         : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  read.num_threads = base::ResolveThreads(opts.num_threads);
   if (read.num_threads > 256) read.num_threads = 256;
   const encoder::WebpImageDecoder decoder;
 

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
+#include "base/parallel_for.h"
 #include "cli/command.h"
 #include "encoder/webp_codec.h"
 #include "format/file_source.h"
@@ -23,7 +23,7 @@ void RunValidate(const std::string& path, int threads) {
   if (!source.ok()) throw std::runtime_error(source.status().message());
   encoder::WebpImageDecoder decoder;
   ReadOptions options;
-  options.num_threads = threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
+  options.num_threads = base::ResolveThreads(threads);
   options.max_pixels = int64_t{kMaxPackageWidth} * kMaxPackageHeight;
   Manifest manifest;
   int levels = 1;

@@ -499,7 +499,7 @@ DenseReport FinishDense(const DensePlan& plan, const DenseOptions& options, std:
                         const std::vector<ImageF>& ground_truth, const std::string& out_dir,
                         std::chrono::steady_clock::time_point start, double seconds_load) {
   const int n = plan.size();
-  const int threads = ResolveThreads(options.num_threads);
+  const int threads = base::ResolveThreads(options.num_threads);
   if (options.visibility.enabled) CheckFreeSpaceAll(plan, options, threads, shells, &depth, &photos);
 
   // Outputs and evaluation of the final maps.
@@ -531,7 +531,7 @@ DenseReport FinishDense(const DensePlan& plan, const DenseOptions& options, std:
       final_low[i] = ResizeNearest(depth[i], plan.ws.views[i].camera.width, plan.ws.views[i].camera.height);
       low_ptrs[i] = &final_low[i];
     }
-    ParallelFor(0, n, threads, [&](int64_t i) {
+    base::ParallelFor(0, n, threads, [&](int64_t i) {
       photos[i].cross_view_consistency =
           CrossViewConsistency(static_cast<int>(i), view_ptrs, low_ptrs, plan.ws.ranked_neighbors[i]);
     });

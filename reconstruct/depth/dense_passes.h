@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
+#include "base/parallel_for.h"
 #include "reconstruct/depth/dense_stage.h"
 #include "reconstruct/depth/huge_pages.h"
-#include "reconstruct/depth/parallel.h"
 #include "reconstruct/depth/workspace.h"
 
 namespace casual3d::depth {
@@ -85,7 +85,7 @@ template <typename Body>
 void ForEachPhoto(const DensePlan& plan, const std::vector<int>& photos, int outer, Body&& body) {
   std::mutex mutex;
   std::string first_error;
-  ParallelFor(0, static_cast<int64_t>(photos.size()), outer, [&](int64_t k) {
+  base::ParallelFor(0, static_cast<int64_t>(photos.size()), outer, [&](int64_t k) {
     const int i = photos[k];
     try {
       body(i);

@@ -17,7 +17,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   const Status st = options.Check();
   if (!st.ok()) throw std::invalid_argument(st.message());
   const auto t_start = std::chrono::steady_clock::now();
-  const int threads = ResolveThreads(options.num_threads);
+  const int threads = base::ResolveThreads(options.num_threads);
   if (!options.ground_truth_dir.empty() && !fs::is_directory(options.ground_truth_dir))
     throw std::runtime_error(options.ground_truth_dir + ": ground-truth folder does not exist");
 

@@ -273,7 +273,7 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
   }
   result.ran = static_cast<int>(todo.size());
   if (todo.empty()) return result;
-  const int threads = ResolveThreads(options.num_threads);
+  const int threads = base::ResolveThreads(options.num_threads);
   const int outer = std::min<int>(threads, static_cast<int>(todo.size()));
   const int inner = std::max(1, threads / outer);
   if (pass == DensePass::kSweep) {

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/parallel_for.h"
 #include "reconstruct/depth/avx2_clones.h"
 #include "reconstruct/depth/colour_weights.h"
 #include "reconstruct/depth/label_histogram.h"
-#include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
 
@@ -62,7 +62,7 @@ std::vector<int> EdgeAwareMedian(const std::vector<int>& labels, int num_labels,
   const ColourPlanes planes = SplitColour(color);
 
   std::vector<int> out(n);
-  ParallelFor(0, h, ResolveThreads(num_threads), [&](int64_t y) {
+  base::ParallelFor(0, h, base::ResolveThreads(num_threads), [&](int64_t y) {
     std::vector<float> hist(num_labels, 0.0f), wgt(2 * r + 1);
     FilterRow(static_cast<int>(y), labels, planes, w, h, r, spatial.data(), inv2s2, hist.data(), wgt.data(),
               out.data());

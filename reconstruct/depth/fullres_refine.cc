@@ -1,18 +1,17 @@
 #include "reconstruct/depth/fullres_refine.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
-#include <thread>
 #include <utility>
 
+#include "base/parallel_for.h"
 #include "reconstruct/depth/avx2_clones.h"
 #include "reconstruct/depth/colour_weights.h"
 #include "reconstruct/depth/fast_exp.h"
 #include "reconstruct/depth/near_envelope.h"
-#include "reconstruct/depth/parallel.h"
 #include "reconstruct/depth/plane_sweep.h"
 #include "reconstruct/depth/zncc_stream.h"
 
@@ -56,40 +55,42 @@ ImageF RefineFullResolution(const ImageF& gray, const PinholeCamera& camera, con
 
   // Costs of every offset, plane-major.
   std::vector<float> costs(static_cast<size_t>(steps) * n);
-  std::atomic<int> next(0);
-  auto worker = [&]() {
-    ZnccStream stream(w, h, r, num_nb, options.best_k, static_cast<float>(options.occlusion_truncation), eps,
-                      gray.data(), &windows);
-    std::vector<float> inv_row(w);
-    int last_row = -1;
-    for (;;) {
-      const int j = next.fetch_add(1);
-      if (j >= steps) break;
-      const float shift = static_cast<float>(offset(j) * inv_step);
-      float* plane = costs.data() + static_cast<size_t>(j) * n;
-      last_row = -1;
-      stream.Run(
-          [&](int k, int y, float* values, float* invalid) {
-            if (y != last_row) {
-              const float* src = inv0.data() + static_cast<size_t>(y) * w;
-              for (int x = 0; x < w; ++x) inv_row[x] = std::max(0.0f, src[x] + shift);
-              last_row = y;
-            }
-            // The plane part at inverse depth 0; each pixel adds its own inv * b.
-            const PlaneHomography& hm = warps[k].hom;
-            sweep::WarpRowPerPixel(warps[k].gray->data(), warps[k].gray->width(), warps[k].gray->height(),
-                                   hm.Row(y, 0.0f), inv_row.data(), hm.b, w, values, invalid);
-          },
-          [&](int y) { return plane + static_cast<size_t>(y) * w; });
-    }
+  // Per thread: a ZNCC stream and a row of shifted inverse depths, made on
+  // its first offset.
+  struct Scratch {
+    std::optional<ZnccStream> stream;
+    std::vector<float> inv_row;
   };
-  {
-    const int threads = std::max(1, std::min(num_threads, steps));
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& th : pool) th.join();
-  }
+  const int threads = std::max(1, std::min(num_threads, steps));
+  std::vector<Scratch> scratch(threads);
+  base::ParallelFor(0, steps, threads, [&](int64_t step, int thread) {
+    Scratch& own = scratch[thread];
+    if (!own.stream) {
+      own.stream.emplace(w, h, r, num_nb, options.best_k,
+                         static_cast<float>(options.occlusion_truncation), eps, gray.data(),
+                         &windows);
+      own.inv_row.resize(w);
+    }
+    std::vector<float>& inv_row = own.inv_row;
+    const int j = static_cast<int>(step);
+    const float shift = static_cast<float>(offset(j) * inv_step);
+    float* plane = costs.data() + static_cast<size_t>(j) * n;
+    int last_row = -1;
+    own.stream->Run(
+        [&](int k, int y, float* values, float* invalid) {
+          if (y != last_row) {
+            const float* src = inv0.data() + static_cast<size_t>(y) * w;
+            for (int x = 0; x < w; ++x) inv_row[x] = std::max(0.0f, src[x] + shift);
+            last_row = y;
+          }
+          // The plane part at inverse depth 0; each pixel adds its own inv * b.
+          const PlaneHomography& hm = warps[k].hom;
+          sweep::WarpRowPerPixel(warps[k].gray->data(), warps[k].gray->width(),
+                                 warps[k].gray->height(), hm.Row(y, 0.0f), inv_row.data(), hm.b,
+                                 w, values, invalid);
+        },
+        [&](int y) { return plane + static_cast<size_t>(y) * w; });
+  });
 
   // Per pixel: the offset of least cost, a parabola through it and its two
   // neighbours; interior minima of textured pixels move the depth.
@@ -249,7 +250,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
 
   ImageF out = depth;
   std::vector<long long> changed_rows(h, 0);
-  ParallelFor(0, h, std::max(1, num_threads), [&](int64_t yy) {
+  base::ParallelFor(0, h, std::max(1, num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
     // The window's samples, padded to a multiple of 8 with zero weights:
     // the cost's loops run on eight samples at a time.

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "reconstruct/depth/parallel.h"
+#include "base/parallel_for.h"
 
 namespace casual3d::depth {
 
@@ -39,7 +39,7 @@ ImageF GeometricConsistencyFilter(int ref, const std::vector<const DenseView*>& 
   const int min_support = std::min<int>(options.min_support, static_cast<int>(checks.size()));
   if (min_support == 0) return out;
 
-  ParallelFor(0, src.height(), ResolveThreads(num_threads), [&](int64_t yy) {
+  base::ParallelFor(0, src.height(), base::ResolveThreads(num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
     for (int x = 0; x < src.width(); ++x) {
       const double d = src.at(x, y);

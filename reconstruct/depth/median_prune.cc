@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "base/parallel_for.h"
 #include "reconstruct/depth/avx2_clones.h"
 #include "reconstruct/depth/colour_weights.h"
 #include "reconstruct/depth/label_histogram.h"
-#include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
 namespace {
@@ -30,7 +30,7 @@ ImageF MedianPrune(const ImageF& depth, const LabelGrid& grid, const MedianPrune
   if (!st.ok()) throw std::invalid_argument(st.message());
   const int w = depth.width(), h = depth.height(), r = options.small_radius;
   ImageF out(w, h, 1, 0.0f);
-  ParallelFor(0, h, ResolveThreads(num_threads), [&](int64_t yy) {
+  base::ParallelFor(0, h, base::ResolveThreads(num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
     std::vector<float> labels;
     labels.reserve((2 * r + 1) * (2 * r + 1));
@@ -126,7 +126,7 @@ ImageF BilateralMedianPrune(const ImageF& depth, const ImageF& color, const Labe
   const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
 
   ImageF out(w, h, 1, 0.0f);
-  ParallelFor(0, h, ResolveThreads(num_threads), [&](int64_t yy) {
+  base::ParallelFor(0, h, base::ResolveThreads(num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
     std::vector<float> hist(bins, 0.0f), wgt(2 * r + 8);
     std::vector<int> med(w);

@@ -1,14 +1,13 @@
 #include "reconstruct/depth/plane_sweep.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
+#include "base/parallel_for.h"
 #include "reconstruct/depth/huge_pages.h"
-#include "reconstruct/depth/parallel.h"
 #include "reconstruct/depth/sweep_kernels.h"
 #include "reconstruct/depth/zncc_stream.h"
 
@@ -48,7 +47,7 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
   const size_t n = static_cast<size_t>(w) * h;
   const int r = options.window_radius;
   const int num_labels = options.num_depths;
-  const int threads = ResolveThreads(options.num_threads);
+  const int threads = base::ResolveThreads(options.num_threads);
 
   CostVolume vol;
   vol.width = w;
@@ -70,7 +69,7 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
     // colour-similarity weights to the centre pixel.
     const float inv2s2 =
         static_cast<float>(1.0 / (2.0 * options.texture_color_sigma * options.texture_color_sigma));
-    ParallelFor(0, h, threads, [&](int64_t yy) {
+    base::ParallelFor(0, h, threads, [&](int64_t yy) {
       const int y = static_cast<int>(yy);
       for (int x = 0; x < w; ++x) {
         const float* c0 = &ref.color.at(x, y, 0);
@@ -110,42 +109,42 @@ CostVolume ComputeCostVolume(const DenseView& ref, const std::vector<const Dense
   const int num_groups = (num_labels + kGroup - 1) / kGroup;
   // Every label of every pixel is written below (the groups cover all labels).
   TakeBufferForOverwrite(pool, &vol.cost, n * num_labels);
-  std::atomic<int> next_group(0);
-  auto worker = [&]() {
-    ZnccStream stream(w, h, r, num_nb, best_k, truncation, eps, gi, &windows);
-    std::vector<float> group(static_cast<size_t>(kGroup) * n);
-    for (;;) {
-      const int group_index = next_group.fetch_add(1);
-      if (group_index >= num_groups) break;
-      const int k0 = group_index * kGroup, k1 = std::min(num_labels, k0 + kGroup);
-      for (int k = k0; k < k1; ++k) {
-        const float inv_d = static_cast<float>(vol.InvDepthOfLabel(k));
-        float* plane = group.data() + static_cast<size_t>(k - k0) * n;
-        stream.Run(
-            [&](int j, int y, float* values, float* invalid) {
-              const NeighborWarp& wp = warps[j];
-              sweep::WarpRow(wp.view->gray.data(), wp.view->gray.width(), wp.view->gray.height(),
-                             wp.hom.Row(y, inv_d), w, values, invalid);
-            },
-            [&](int y) { return plane + static_cast<size_t>(y) * w; });
-      }
-      // Plane-major group to pixel-major volume.
-      sweep::PlanesToPixelMajor(group.data(), n, k1 - k0, vol.cost.data() + k0, num_labels);
-    }
+  // Per thread: a ZNCC stream and the group's buffer, made on its first group.
+  struct Scratch {
+    std::optional<ZnccStream> stream;
+    std::vector<float> group;
   };
-  {
-    std::vector<std::thread> pool;
-    for (int t = 1; t < std::min(threads, num_groups); ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& th : pool) th.join();
-  }
+  std::vector<Scratch> scratch(std::min(threads, num_groups));
+  base::ParallelFor(0, num_groups, threads, [&](int64_t group_index, int thread) {
+    Scratch& own = scratch[thread];
+    if (!own.stream) {
+      own.stream.emplace(w, h, r, num_nb, best_k, truncation, eps, gi, &windows);
+      own.group.resize(static_cast<size_t>(kGroup) * n);
+    }
+    ZnccStream& stream = *own.stream;
+    std::vector<float>& group = own.group;
+    const int k0 = static_cast<int>(group_index) * kGroup, k1 = std::min(num_labels, k0 + kGroup);
+    for (int k = k0; k < k1; ++k) {
+      const float inv_d = static_cast<float>(vol.InvDepthOfLabel(k));
+      float* plane = group.data() + static_cast<size_t>(k - k0) * n;
+      stream.Run(
+          [&](int j, int y, float* values, float* invalid) {
+            const NeighborWarp& wp = warps[j];
+            sweep::WarpRow(wp.view->gray.data(), wp.view->gray.width(), wp.view->gray.height(),
+                           wp.hom.Row(y, inv_d), w, values, invalid);
+          },
+          [&](int y) { return plane + static_cast<size_t>(y) * w; });
+    }
+    // Plane-major group to pixel-major volume.
+    sweep::PlanesToPixelMajor(group.data(), n, k1 - k0, vol.cost.data() + k0, num_labels);
+  });
   return vol;
 }
 
 ImageF WinnerTakesAll(const CostVolume& volume, int num_threads) {
   ImageF depth(volume.width, volume.height, 1, 0.0f);
   const int L = volume.num_labels;
-  ParallelFor(0, volume.height, ResolveThreads(num_threads), [&](int64_t y) {
+  base::ParallelFor(0, volume.height, base::ResolveThreads(num_threads), [&](int64_t y) {
     for (int x = 0; x < volume.width; ++x) {
       const float* c = volume.Costs(x, static_cast<int>(y));
       int best = 0;

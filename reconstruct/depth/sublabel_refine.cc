@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "reconstruct/depth/parallel.h"
+#include "base/parallel_for.h"
 
 namespace casual3d::depth {
 
@@ -28,11 +28,11 @@ std::vector<float> FitSubLabel(const CostVolume& volume, const std::vector<int>&
   CheckSizes(volume, labels.size(), nullptr);
   const int w = volume.width, h = volume.height, L = volume.num_labels;
   const size_t np = static_cast<size_t>(w) * h;
-  const int threads = ResolveThreads(num_threads);
+  const int threads = base::ResolveThreads(num_threads);
 
   // Parabola through the cost around the best label next to k.
   std::vector<float> f(np);
-  ParallelFor(0, h, threads, [&](int64_t y) {
+  base::ParallelFor(0, h, threads, [&](int64_t y) {
     for (int x = 0; x < w; ++x) {
       const size_t p = static_cast<size_t>(y) * w + x;
       const int k = labels[p];
@@ -64,7 +64,7 @@ std::vector<float> SmoothSubLabel(const CostVolume& volume, std::vector<float> f
   CheckSizes(volume, f.size(), &color);
   const int w = volume.width, h = volume.height;
   const size_t np = static_cast<size_t>(w) * h;
-  const int threads = ResolveThreads(num_threads);
+  const int threads = base::ResolveThreads(num_threads);
 
   // Edge-aware weighted mean, Jacobi passes.
   const int r = options.smooth_radius;
@@ -76,7 +76,7 @@ std::vector<float> SmoothSubLabel(const CostVolume& volume, std::vector<float> f
     conf[p] = volume.photo_weight.data()[p] + static_cast<float>(options.confidence_floor);
   std::vector<float> next(np);
   for (int it = 0; it < options.smooth_iterations; ++it) {
-    ParallelFor(0, h, threads, [&](int64_t yy) {
+    base::ParallelFor(0, h, threads, [&](int64_t yy) {
       const int y = static_cast<int>(yy);
       for (int x = 0; x < w; ++x) {
         const size_t p = static_cast<size_t>(y) * w + x;

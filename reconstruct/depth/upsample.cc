@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "base/parallel_for.h"
 #include "reconstruct/depth/colour_weights.h"
-#include "reconstruct/depth/parallel.h"
 
 namespace casual3d::depth {
 
@@ -47,7 +47,7 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
   // samples are sorted once (stably, in scanning order among equal values)
   // and each pixel only weighs them, then walks them in that order to its
   // weighted median.
-  ParallelFor(0, hh, ResolveThreads(options.num_threads), [&](int64_t yy) {
+  base::ParallelFor(0, hh, base::ResolveThreads(options.num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
     const size_t max_samples = static_cast<size_t>(taps) * taps;
     std::vector<float> value(max_samples), weight(max_samples), spatial(max_samples);

@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
-#include <thread>
 #include <utility>
 
+#include "base/parallel_for.h"
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
 #include "encoder/webp_codec.h"
@@ -295,9 +295,8 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
 
   PhotoModelEvaluation eval;
   eval.label = photo3d_path;
-  const int threads = options.num_threads > 0 ? options.num_threads
-                                              : std::max(1u, std::thread::hardware_concurrency());
-  LoadedPhoto3d photo3d = LoadPhoto3d(photo3d_path, static_cast<int>(threads));
+  const int threads = base::ResolveThreads(options.num_threads);
+  LoadedPhoto3d photo3d = LoadPhoto3d(photo3d_path, threads);
   eval.source = photo3d.source;
   eval.package_bytes = photo3d.package_bytes;
   eval.pano_width = photo3d.pano.width();

@@ -3,26 +3,27 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <thread>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+
+#include "base/parallel_for.h"
 
 namespace casual3d::normals {
 namespace {
 
 using Vec3 = Eigen::Vector3f;
 
+// Runs fn(node) for every node of `count` on all cores, a thread for every
+// 4096 nodes at most.
 template <typename Fn>
-void ParallelRange(size_t count, Fn fn) {
-  const size_t threads = std::max<size_t>(1, std::min<size_t>(count / 4096 + 1,
-                                                              std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (size_t t = 0; t < threads; ++t) {
-    pool.emplace_back([&, t] { fn(count * t / threads, count * (t + 1) / threads); });
-  }
-  for (std::thread& th : pool) th.join();
+void ParallelNodes(size_t count, Fn fn) {
+  constexpr int64_t kGrain = 4096;
+  const int threads =
+      static_cast<int>(std::min<int64_t>(count / kGrain + 1, base::ResolveThreads(0)));
+  base::ParallelFor(0, static_cast<int64_t>(count), threads,
+                    [&](int64_t node) { fn(static_cast<size_t>(node)); }, kGrain);
 }
 
 // The nodes of both layers, numbered layer * n + pixel, with their links as
@@ -114,38 +115,34 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
   // 1. Forward-difference normals, oriented towards the centre.
   std::vector<Vec3> raw(num_nodes, Vec3::Zero());
   std::vector<float> weight(num_nodes, 0.0f);
-  ParallelRange(num_nodes, [&](size_t begin, size_t end) {
-    for (size_t node = begin; node < end; ++node) {
-      if (!g.present[node]) continue;
-      Vec3 tu, tv;
-      if (!Tangent(g, node, kRight, kLeft, &tu) || !Tangent(g, node, kDown, kUp, &tv)) continue;
-      Vec3 nrm = tu.cross(tv);
-      const float len = nrm.norm();
-      if (!(len > 0)) continue;
-      nrm /= len;
-      if (nrm.dot(g.position[node]) > 0) nrm = -nrm;
-      raw[node] = nrm;
-      weight[node] = 1.0f;
-    }
+  ParallelNodes(num_nodes, [&](size_t node) {
+    if (!g.present[node]) return;
+    Vec3 tu, tv;
+    if (!Tangent(g, node, kRight, kLeft, &tu) || !Tangent(g, node, kDown, kUp, &tv)) return;
+    Vec3 nrm = tu.cross(tv);
+    const float len = nrm.norm();
+    if (!(len > 0)) return;
+    nrm /= len;
+    if (nrm.dot(g.position[node]) > 0) nrm = -nrm;
+    raw[node] = nrm;
+    weight[node] = 1.0f;
   });
 
   // Smoothing (Eq. 5, binary weights): x_i = (w_i x'_i + s sum_j x_j) / (w_i + s deg_i).
   const float s = static_cast<float>(options.smoothness);
   std::vector<Vec3> base = raw, next(num_nodes, Vec3::Zero());
   for (int it = 0; it < options.iterations; ++it) {
-    ParallelRange(num_nodes, [&](size_t begin, size_t end) {
-      for (size_t node = begin; node < end; ++node) {
-        if (!g.present[node]) continue;
-        Vec3 sum = weight[node] * raw[node];
-        float total = weight[node];
-        for (int d = 0; d < kNumDirections; ++d) {
-          const int64_t j = g.next(node, d);
-          if (j < 0) continue;
-          sum += s * base[j];
-          total += s;
-        }
-        next[node] = total > 0 ? Vec3(sum / total) : Vec3::Zero();
+    ParallelNodes(num_nodes, [&](size_t node) {
+      if (!g.present[node]) return;
+      Vec3 sum = weight[node] * raw[node];
+      float total = weight[node];
+      for (int d = 0; d < kNumDirections; ++d) {
+        const int64_t j = g.next(node, d);
+        if (j < 0) continue;
+        sum += s * base[j];
+        total += s;
       }
+      next[node] = total > 0 ? Vec3(sum / total) : Vec3::Zero();
     });
     base.swap(next);
   }
@@ -154,20 +151,18 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
   // repeated detail_radius times), then its gradient along the links.
   std::vector<float> low = g.luminance, low_next(num_nodes, 0.0f);
   for (int it = 0; it < options.detail_radius; ++it) {
-    ParallelRange(num_nodes, [&](size_t begin, size_t end) {
-      for (size_t node = begin; node < end; ++node) {
-        if (!g.present[node]) continue;
-        float sum = low[node];
-        int count = 1;
-        for (int d = 0; d < kNumDirections; ++d) {
-          const int64_t j = g.next(node, d);
-          if (j >= 0) {
-            sum += low[j];
-            ++count;
-          }
+    ParallelNodes(num_nodes, [&](size_t node) {
+      if (!g.present[node]) return;
+      float sum = low[node];
+      int count = 1;
+      for (int d = 0; d < kNumDirections; ++d) {
+        const int64_t j = g.next(node, d);
+        if (j >= 0) {
+          sum += low[j];
+          ++count;
         }
-        low_next[node] = sum / count;
       }
+      low_next[node] = sum / count;
     });
     low.swap(low_next);
   }
@@ -183,33 +178,31 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
   // 3. Combine (Eq. 14 to 16) and 4. write, leaving sky for below.
   const float k = static_cast<float>(options.detail_strength);
   std::vector<Vec3> result(num_nodes, Vec3::Zero());
-  ParallelRange(num_nodes, [&](size_t begin, size_t end) {
-    for (size_t node = begin; node < end; ++node) {
-      if (!g.present[node]) continue;
-      const size_t pixel = node % g.n;
-      const Vec3& r = g.ray[pixel];
-      Vec3 nf = base[node];
-      if (!(nf.norm() > 1e-6f)) nf = -r;  // No geometry around: face the centre.
-      nf.normalize();
-      Vec3 n = nf;
-      if (k > 0) {
-        // East and south unit vectors of the pixel (image x and y).
-        const float lon = std::atan2(r.x(), -r.z());
-        const float lat = std::asin(std::clamp(r.y(), -1.0f, 1.0f));
-        const Vec3 east(std::cos(lon), 0.0f, std::sin(lon));
-        const Vec3 south(std::sin(lat) * std::sin(lon), -std::cos(lat),
-                         -std::sin(lat) * std::cos(lon));
-        const float hx = derivative(node, kRight, kLeft);
-        const float hy = derivative(node, kDown, kUp);
-        // Detail normal in the radial frame R_s: facing the centre, tilted by
-        // the height gradient (brighter is nearer).
-        const Vec3 ni = (-r - k * hx * east - k * hy * south).normalized();
-        // n_c = R_f^-1 R_s n_i: carry the tilt from facing the centre (-r) to
-        // the base normal, by the minimal rotation (defined for floors too).
-        n = (MinimalRotation(-r, nf) * ni).normalized();
-      }
-      result[node] = n;
+  ParallelNodes(num_nodes, [&](size_t node) {
+    if (!g.present[node]) return;
+    const size_t pixel = node % g.n;
+    const Vec3& r = g.ray[pixel];
+    Vec3 nf = base[node];
+    if (!(nf.norm() > 1e-6f)) nf = -r;  // No geometry around: face the centre.
+    nf.normalize();
+    Vec3 n = nf;
+    if (k > 0) {
+      // East and south unit vectors of the pixel (image x and y).
+      const float lon = std::atan2(r.x(), -r.z());
+      const float lat = std::asin(std::clamp(r.y(), -1.0f, 1.0f));
+      const Vec3 east(std::cos(lon), 0.0f, std::sin(lon));
+      const Vec3 south(std::sin(lat) * std::sin(lon), -std::cos(lat),
+                       -std::sin(lat) * std::cos(lon));
+      const float hx = derivative(node, kRight, kLeft);
+      const float hy = derivative(node, kDown, kUp);
+      // Detail normal in the radial frame R_s: facing the centre, tilted by
+      // the height gradient (brighter is nearer).
+      const Vec3 ni = (-r - k * hx * east - k * hy * south).normalized();
+      // n_c = R_f^-1 R_s n_i: carry the tilt from facing the centre (-r) to
+      // the base normal, by the minimal rotation (defined for floors too).
+      n = (MinimalRotation(-r, nf) * ni).normalized();
     }
+    result[node] = n;
   });
 
   // 4. Sky: far, untextured front nodes connected to the top of the content.

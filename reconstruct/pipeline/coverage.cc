@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
-#include "reconstruct/depth/parallel.h"
+#include "base/parallel_for.h"
 
 namespace casual3d::pipeline {
 namespace {
@@ -103,8 +103,8 @@ Image8 FieldOfViewMask(const ImageF& depth_m, const PanoramaFrame& frame,
   }
 
   Image8 mask(W, H, 1, 0);
-  depth::ParallelFor(
-      0, H, depth::ResolveThreads(num_threads),
+  base::ParallelFor(
+      0, H, base::ResolveThreads(num_threads),
       [&](int64_t y64) {
         const int y = static_cast<int>(y64);
         size_t last_hit = 0;  // Neighbouring pixels usually fall in the same photo.

@@ -1,15 +1,13 @@
 #include "reconstruct/render/mesh_renderer.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "base/parallel_for.h"
 #include "format/sheet_stretch.h"
 
 namespace casual3d::render {
@@ -52,23 +50,6 @@ int64_t FloorDiv(int64_t a, int64_t b) {  // b > 0.
 }
 int64_t CeilDiv(int64_t a, int64_t b) { return -FloorDiv(-a, b); }  // b > 0.
 
-void ParallelFor(int64_t n, int num_threads, const std::function<void(int64_t)>& fn) {
-  const int64_t workers = std::min<int64_t>(num_threads, n);
-  if (workers <= 1) {
-    for (int64_t i = 0; i < n; ++i) fn(i);
-    return;
-  }
-  std::atomic<int64_t> next{0};
-  std::vector<std::thread> pool;
-  pool.reserve(workers);
-  for (int64_t t = 0; t < workers; ++t) {
-    pool.emplace_back([&] {
-      for (int64_t i = next++; i < n; i = next++) fn(i);
-    });
-  }
-  for (std::thread& thread : pool) thread.join();
-}
-
 std::string Dims(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 class Rasterizer {
@@ -87,9 +68,7 @@ class Rasterizer {
     planes_[3] = {{-view.fx, 0, w + g - view.cx}, 0};
     planes_[4] = {{0, view.fy, view.cy + g}, 0};
     planes_[5] = {{0, -view.fy, h + g - view.cy}, 0};
-    num_threads_ = options.num_threads > 0
-                       ? options.num_threads
-                       : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    num_threads_ = base::ResolveThreads(options.num_threads);
     const Eigen::Vector3d eye = -view.rotation.transpose() * view.translation;
     for (int k = 0; k < 3; ++k) eye_[k] = eye[k];
   }
@@ -112,7 +91,7 @@ class Rasterizer {
       result.triangle_ids = Image<uint32_t>(view_.width, view_.height, 1, kNoTriangle);
       ids_ = result.triangle_ids.data();
     }
-    ParallelFor(num_bands_, num_threads_,
+    base::ParallelFor(0, num_bands_, num_threads_,
                 [&](int64_t band) { RasterBand(static_cast<int>(band)); });
 
     result.depth = ImageF(view_.width, view_.height, 1, 0.0f);
@@ -133,7 +112,7 @@ class Rasterizer {
     cam_.resize(3 * n);
     const int64_t kChunk = 1 << 16;
     const int64_t chunks = (static_cast<int64_t>(n) + kChunk - 1) / kChunk;
-    ParallelFor(chunks, num_threads_, [&](int64_t chunk) {
+    base::ParallelFor(0, chunks, num_threads_, [&](int64_t chunk) {
       const size_t end = std::min(n, static_cast<size_t>((chunk + 1) * kChunk));
       for (size_t i = static_cast<size_t>(chunk * kChunk); i < end; ++i) {
         const Eigen::Vector3d p(mesh_.positions[3 * i], mesh_.positions[3 * i + 1],
@@ -256,7 +235,7 @@ class Rasterizer {
     const int64_t kChunk = 1 << 15;
     const int64_t chunks = (static_cast<int64_t>(num_triangles) + kChunk - 1) / kChunk;
     std::vector<std::vector<std::vector<uint32_t>>> per_chunk(chunks);
-    ParallelFor(chunks, num_threads_, [&](int64_t chunk) {
+    base::ParallelFor(0, chunks, num_threads_, [&](int64_t chunk) {
       std::vector<std::vector<uint32_t>>& lists = per_chunk[chunk];
       lists.resize(num_bands_);
       ScreenVertex poly[kMaxPolygon];

@@ -4,8 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "base/parallel_for.h"
 
 namespace casual3d::render {
 namespace {
@@ -78,54 +79,44 @@ RenderResult RenderPhotoView(const Mesh& mesh, ImageView<const uint8_t> atlas,
   result.color = Image8(width, height, 3);
   result.depth = ImageF(width, height, 1, 0.0f);
   result.mask = Image8(width, height, 1, 0);
-  auto resample_rows = [&](int row_begin, int row_end) {
-    for (int j = row_begin; j < row_end; ++j) {
-      for (int i = 0; i < width; ++i) {
-        uint8_t* out = &result.color.at(i, j, 0);
-        for (int c = 0; c < 3; ++c) out[c] = options.background[c];
-        const Eigen::Vector2d q = undistorted(i + 0.5, j + 0.5);
-        if (!q.allFinite()) continue;
-        const double qx = q.x() + pad_x, qy = q.y() + pad_y;
-        if (!(qx >= 0.0 && qy >= 0.0 && qx < view.width && qy < view.height)) continue;
-        const int nx = static_cast<int>(qx), ny = static_cast<int>(qy);
-        if (canvas.mask.at(nx, ny) == 0) continue;
-        result.mask.at(i, j) = 255;
-        result.depth.at(i, j) = canvas.depth.at(nx, ny);
-        // Bilinear over the covered neighbours only.
-        const double sx = qx - 0.5, sy = qy - 0.5;
-        const int x0 = static_cast<int>(std::floor(sx)), y0 = static_cast<int>(std::floor(sy));
-        const double ax = sx - x0, ay = sy - y0;
-        double sum[3] = {0, 0, 0}, weight = 0.0;
-        for (int dy = 0; dy < 2; ++dy) {
-          for (int dx = 0; dx < 2; ++dx) {
-            const int x = x0 + dx, y = y0 + dy;
-            if (x < 0 || y < 0 || x >= view.width || y >= view.height) continue;
-            if (canvas.mask.at(x, y) == 0) continue;
-            const double w = (dx ? ax : 1.0 - ax) * (dy ? ay : 1.0 - ay);
-            for (int c = 0; c < 3; ++c) sum[c] += w * canvas.color.at(x, y, c);
-            weight += w;
-          }
+  auto resample_row = [&](int j) {
+    for (int i = 0; i < width; ++i) {
+      uint8_t* out = &result.color.at(i, j, 0);
+      for (int c = 0; c < 3; ++c) out[c] = options.background[c];
+      const Eigen::Vector2d q = undistorted(i + 0.5, j + 0.5);
+      if (!q.allFinite()) continue;
+      const double qx = q.x() + pad_x, qy = q.y() + pad_y;
+      if (!(qx >= 0.0 && qy >= 0.0 && qx < view.width && qy < view.height)) continue;
+      const int nx = static_cast<int>(qx), ny = static_cast<int>(qy);
+      if (canvas.mask.at(nx, ny) == 0) continue;
+      result.mask.at(i, j) = 255;
+      result.depth.at(i, j) = canvas.depth.at(nx, ny);
+      // Bilinear over the covered neighbours only.
+      const double sx = qx - 0.5, sy = qy - 0.5;
+      const int x0 = static_cast<int>(std::floor(sx)), y0 = static_cast<int>(std::floor(sy));
+      const double ax = sx - x0, ay = sy - y0;
+      double sum[3] = {0, 0, 0}, weight = 0.0;
+      for (int dy = 0; dy < 2; ++dy) {
+        for (int dx = 0; dx < 2; ++dx) {
+          const int x = x0 + dx, y = y0 + dy;
+          if (x < 0 || y < 0 || x >= view.width || y >= view.height) continue;
+          if (canvas.mask.at(x, y) == 0) continue;
+          const double w = (dx ? ax : 1.0 - ax) * (dy ? ay : 1.0 - ay);
+          for (int c = 0; c < 3; ++c) sum[c] += w * canvas.color.at(x, y, c);
+          weight += w;
         }
-        if (weight <= 0.0) {  // Only the nearest pixel itself has weight 0.
-          for (int c = 0; c < 3; ++c) out[c] = canvas.color.at(nx, ny, c);
-          continue;
-        }
-        for (int c = 0; c < 3; ++c) {
-          out[c] = static_cast<uint8_t>(std::clamp(std::lround(sum[c] / weight), 0L, 255L));
-        }
+      }
+      if (weight <= 0.0) {  // Only the nearest pixel itself has weight 0.
+        for (int c = 0; c < 3; ++c) out[c] = canvas.color.at(nx, ny, c);
+        continue;
+      }
+      for (int c = 0; c < 3; ++c) {
+        out[c] = static_cast<uint8_t>(std::clamp(std::lround(sum[c] / weight), 0L, 255L));
       }
     }
   };
-  const int threads =
-      std::min(height, options.num_threads > 0
-                           ? options.num_threads
-                           : std::max(1, static_cast<int>(std::thread::hardware_concurrency())));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) {
-    pool.emplace_back(resample_rows, height * t / threads, height * (t + 1) / threads);
-  }
-  resample_rows(0, height / threads);
-  for (std::thread& thread : pool) thread.join();
+  base::ParallelFor(0, height, base::ResolveThreads(options.num_threads),
+                    [&](int64_t j) { resample_row(static_cast<int>(j)); });
   for (size_t k = 0; k < result.mask.size(); ++k)
     result.covered_pixels += result.mask.data()[k] != 0;
   return result;

@@ -4,11 +4,11 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
+
+#include "base/parallel_for.h"
 
 // On x86-64 the tile kernel is compiled twice, for AVX2 + FMA (eight lanes)
 // and for the baseline (four lanes), and the first call picks one by the
@@ -272,33 +272,18 @@ std::vector<FeatureMatches> MatchPairs(const std::vector<SiftDescriptors>& photo
                                   " photos");
   std::vector<FeatureMatches> out(pairs.size());
   const int total = static_cast<int>(pairs.size());
-  int threads = num_threads > 0 ? num_threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::max(1, std::min(threads, total));
-  std::atomic<int> next(0);
+  const int threads = std::max(1, std::min(base::ResolveThreads(num_threads), total));
+  std::vector<Workspace> workspaces(threads);  // One per thread.
   std::mutex mutex;
   int done = 0;
-  std::exception_ptr error;
-  auto worker = [&]() {
-    Workspace ws;
-    for (int k; (k = next.fetch_add(1)) < total;) {
-      try {
-        out[k] = Match(photos[pairs[k].first], photos[pairs[k].second], options, &ws);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!error) error = std::current_exception();
-        next.store(total);
-        return;
-      }
-      std::lock_guard<std::mutex> lock(mutex);
-      ++done;
-      if (on_pair && !on_pair(done, total)) next.store(total);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& th : pool) th.join();
-  if (error) std::rethrow_exception(error);
+  std::atomic<bool> cancelled(false);
+  base::ParallelFor(0, total, threads, [&](int64_t k, int thread) {
+    if (cancelled.load()) return;
+    out[k] = Match(photos[pairs[k].first], photos[pairs[k].second], options, &workspaces[thread]);
+    std::lock_guard<std::mutex> lock(mutex);
+    ++done;
+    if (on_pair && !on_pair(done, total)) cancelled.store(true);
+  });
   return out;
 }
 

@@ -4,7 +4,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
-#include <thread>
+
+#include "base/parallel_for.h"
 
 namespace casual3d::stitch {
 namespace {
@@ -65,17 +66,6 @@ double ParallaxDeg(const Vec3d& dir, double depth, const Vec3d& camera) {
   return std::acos(std::clamp(c, -1.0, 1.0)) * kRadToDeg;
 }
 
-// Runs `fn(row_begin, row_end)` over rows on all cores.
-template <typename Fn>
-void ParallelRows(int rows, Fn fn) {
-  const int threads = std::max(1, std::min<int>(rows, std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&, t] { fn(rows * t / threads, rows * (t + 1) / threads); });
-  }
-  for (std::thread& th : pool) th.join();
-}
-
 StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
                           const std::vector<warp::WarpedView>& coarse,
                           const std::vector<ViewGeometry>& views, int pano_width,
@@ -99,36 +89,35 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
 
   GridMrf mrf(sw, sh, L, /*wrap_x=*/true);
   const float tol = static_cast<float>(options.gc_depth_tolerance);
-  ParallelRows(sh, [&](int row_begin, int row_end) {
-    for (int y = row_begin; y < row_end; ++y) {
-      for (int x = 0; x < sw; ++x) {
-        const int p = y * sw + x;
-        const Vec3d dir = EquirectPixelToDirection(x + 0.5, y + 0.5, sw, sh);
-        const float front_depth = front ? front->solve_depth_m.at(x, y) : 0.0f;
-        for (int l = 0; l < L; ++l) {
-          const float d = stack.depth[stack.at(l, p)];
-          if (!(d > 0)) continue;
-          if (back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance)) continue;
-          double cost = options.lambda_stretch * stack.stretch[stack.at(l, p)];
-          cost += options.lambda_parallax *
-                  std::min(1.0, ParallaxDeg(dir, d, views[l].centre) / options.parallax_scale_deg);
-          if (options.lambda_gc > 0) {
-            int support = 0;
-            for (int k = 0; k < L && support < options.gc_min_support; ++k) {
-              if (k == l) continue;
-              const float dk = stack.depth[stack.at(k, p)];
-              bool agrees = dk > 0 && std::abs(dk - d) <= tol * d;
-              if (!agrees && back) {
-                const float fk = front_stack.depth[front_stack.at(k, p)];
-                agrees = fk > 0 && std::abs(fk - d) <= tol * d;
-              }
-              support += agrees;
+  base::ParallelFor(0, sh, base::ResolveThreads(0), [&](int64_t y64) {
+    const int y = static_cast<int>(y64);
+    for (int x = 0; x < sw; ++x) {
+      const int p = y * sw + x;
+      const Vec3d dir = EquirectPixelToDirection(x + 0.5, y + 0.5, sw, sh);
+      const float front_depth = front ? front->solve_depth_m.at(x, y) : 0.0f;
+      for (int l = 0; l < L; ++l) {
+        const float d = stack.depth[stack.at(l, p)];
+        if (!(d > 0)) continue;
+        if (back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance)) continue;
+        double cost = options.lambda_stretch * stack.stretch[stack.at(l, p)];
+        cost += options.lambda_parallax *
+                std::min(1.0, ParallaxDeg(dir, d, views[l].centre) / options.parallax_scale_deg);
+        if (options.lambda_gc > 0) {
+          int support = 0;
+          for (int k = 0; k < L && support < options.gc_min_support; ++k) {
+            if (k == l) continue;
+            const float dk = stack.depth[stack.at(k, p)];
+            bool agrees = dk > 0 && std::abs(dk - d) <= tol * d;
+            if (!agrees && back) {
+              const float fk = front_stack.depth[front_stack.at(k, p)];
+              agrees = fk > 0 && std::abs(fk - d) <= tol * d;
             }
-            cost += options.lambda_gc *
-                    std::max(0.0, 1.0 - static_cast<double>(support) / options.gc_min_support);
+            support += agrees;
           }
-          mrf.data_cost(p, l) = static_cast<float>(cost);
+          cost += options.lambda_gc *
+                  std::max(0.0, 1.0 - static_cast<double>(support) / options.gc_min_support);
         }
+        mrf.data_cost(p, l) = static_cast<float>(cost);
       }
     }
   });
@@ -175,82 +164,85 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
   const int r = options.upsample_radius;
   const double inv_two_sigma2 =
       1.0 / (2.0 * options.upsample_sigma_color * options.upsample_sigma_color);
-  ParallelRows(H, [&](int row_begin, int row_end) {
+  // Whether label l's warp has a depth at pixel (x, y) (its crop coordinates
+  // in lx, ly) that this layer may take: for the back layer, not nearer than
+  // the front.
+  const auto usable = [&](int l, int x, int y, float front_depth, int* lx, int* ly) {
+    const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
+    if (!layer.ToCrop(x, y, W, lx, ly)) return false;
+    const float d = layer.depth_m.at(*lx, *ly);
+    if (!(d > 0)) return false;
+    return !(back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance));
+  };
+  base::ParallelFor(0, H, base::ResolveThreads(0), [&](int64_t y64) {
+    const int y = static_cast<int>(y64);
     std::vector<int> candidates;
     std::vector<double> scores;
-    for (int y = row_begin; y < row_end; ++y) {
-      const double fy = (y + 0.5) * scale - 0.5;
-      const int cy0 = static_cast<int>(std::lround(fy));
-      for (int x = 0; x < W; ++x) {
-        const double fx = (x + 0.5) * scale - 0.5;
-        const int cx0 = static_cast<int>(std::lround(fx));
-        candidates.clear();
-        scores.clear();
-        const float front_depth = front ? front->depth_m.at(x, y) : 0.0f;
-        for (int dy = -r; dy <= r; ++dy) {
-          const int qy = cy0 + dy;
-          if (qy < 0 || qy >= sh) continue;
-          for (int dx = -r; dx <= r; ++dx) {
-            const int qx = WrapColumn(cx0 + dx, sw);
-            const int l = out.solve_label.at(qx, qy);
-            if (l < 0) continue;
-            const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
-            int lx, ly;
-            if (!layer.ToCrop(x, y, W, &lx, &ly)) continue;
-            const float d = layer.depth_m.at(lx, ly);
-            if (!(d > 0)) continue;
-            if (back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance)) continue;
-            double diff2 = 0;
-            for (int c = 0; c < 3; ++c) {
-              const double e = layer.rgb.at(lx, ly, c) - solve_rgb.at(qx, qy, c);
-              diff2 += e * e;
-            }
-            const double ddx = (cx0 + dx) - fx, ddy = qy - fy;
-            // Stretched fragments (depth-edge triangles) almost never win.
-            const double w = std::exp(-(ddx * ddx + ddy * ddy) * 0.5) *
-                             std::exp(-diff2 / 3.0 * inv_two_sigma2) *
-                             std::exp(-kUpsampleStretchWeight * layer.stretch.at(lx, ly));
-            auto it = std::find(candidates.begin(), candidates.end(), l);
-            if (it == candidates.end()) {
-              candidates.push_back(l);
-              scores.push_back(w + 1e-12);
-            } else {
-              scores[it - candidates.begin()] += w;
-            }
+    const double fy = (y + 0.5) * scale - 0.5;
+    const int cy0 = static_cast<int>(std::lround(fy));
+    for (int x = 0; x < W; ++x) {
+      const double fx = (x + 0.5) * scale - 0.5;
+      const int cx0 = static_cast<int>(std::lround(fx));
+      candidates.clear();
+      scores.clear();
+      const float front_depth = front ? front->depth_m.at(x, y) : 0.0f;
+      for (int dy = -r; dy <= r; ++dy) {
+        const int qy = cy0 + dy;
+        if (qy < 0 || qy >= sh) continue;
+        for (int dx = -r; dx <= r; ++dx) {
+          const int qx = WrapColumn(cx0 + dx, sw);
+          const int l = out.solve_label.at(qx, qy);
+          if (l < 0) continue;
+          const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
+          int lx, ly;
+          if (!usable(l, x, y, front_depth, &lx, &ly)) continue;
+          double diff2 = 0;
+          for (int c = 0; c < 3; ++c) {
+            const double e = layer.rgb.at(lx, ly, c) - solve_rgb.at(qx, qy, c);
+            diff2 += e * e;
+          }
+          const double ddx = (cx0 + dx) - fx, ddy = qy - fy;
+          // Stretched fragments (depth-edge triangles) almost never win.
+          const double w = std::exp(-(ddx * ddx + ddy * ddy) * 0.5) *
+                           std::exp(-diff2 / 3.0 * inv_two_sigma2) *
+                           std::exp(-kUpsampleStretchWeight * layer.stretch.at(lx, ly));
+          auto it = std::find(candidates.begin(), candidates.end(), l);
+          if (it == candidates.end()) {
+            candidates.push_back(l);
+            scores.push_back(w + 1e-12);
+          } else {
+            scores[it - candidates.begin()] += w;
           }
         }
-        int best = -1;
-        double best_score = -1;
-        for (size_t i = 0; i < candidates.size(); ++i) {
-          if (scores[i] > best_score) {
-            best_score = scores[i];
-            best = candidates[i];
-          }
-        }
-        if (best < 0) {
-          // No nearby label reaches this pixel: take the least stretched warp.
-          float best_stretch = 2.0f;
-          for (int l = 0; l < L; ++l) {
-            const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
-            int lx, ly;
-            if (!layer.ToCrop(x, y, W, &lx, &ly)) continue;
-            const float d = layer.depth_m.at(lx, ly);
-            if (!(d > 0)) continue;
-            if (back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance)) continue;
-            if (layer.stretch.at(lx, ly) < best_stretch) {
-              best_stretch = layer.stretch.at(lx, ly);
-              best = l;
-            }
-          }
-          if (best < 0) continue;
-        }
-        const warp::WarpedLayer& layer = back ? full[best].back : full[best].front;
-        int lx, ly;
-        layer.ToCrop(x, y, W, &lx, &ly);
-        out.label.at(x, y) = static_cast<int16_t>(best);
-        out.depth_m.at(x, y) = layer.depth_m.at(lx, ly);
-        for (int c = 0; c < 3; ++c) out.rgb.at(x, y, c) = layer.rgb.at(lx, ly, c);
       }
+      int best = -1;
+      double best_score = -1;
+      for (size_t i = 0; i < candidates.size(); ++i) {
+        if (scores[i] > best_score) {
+          best_score = scores[i];
+          best = candidates[i];
+        }
+      }
+      if (best < 0) {
+        // No nearby label reaches this pixel: take the least stretched warp.
+        float best_stretch = 2.0f;
+        for (int l = 0; l < L; ++l) {
+          const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
+          int lx, ly;
+          if (!usable(l, x, y, front_depth, &lx, &ly)) continue;
+          if (layer.stretch.at(lx, ly) < best_stretch) {
+            best_stretch = layer.stretch.at(lx, ly);
+            best = l;
+          }
+        }
+        if (best < 0) continue;
+      }
+      const warp::WarpedLayer& layer = back ? full[best].back : full[best].front;
+      int lx, ly;
+      layer.ToCrop(x, y, W, &lx, &ly);
+      out.label.at(x, y) = static_cast<int16_t>(best);
+      out.depth_m.at(x, y) = layer.depth_m.at(lx, ly);
+      for (int c = 0; c < 3; ++c) out.rgb.at(x, y, c) = layer.rgb.at(lx, ly, c);
     }
   });
   return out;

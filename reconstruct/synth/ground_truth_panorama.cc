@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "reconstruct/synth/parallel_rows.h"
+#include "base/parallel_for.h"
 
 namespace casual3d::synth {
 
@@ -28,7 +28,8 @@ GroundTruthPanorama RenderGroundTruthPanorama(const Scene& scene, const Panorama
   constexpr float kInf = std::numeric_limits<float>::infinity();
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-  ParallelRows(height, num_threads, [&](int y) {
+  base::ParallelFor(0, height, base::ResolveThreads(num_threads), [&](int64_t y64) {
+    const int y = static_cast<int>(y64);
     for (int x = 0; x < width; ++x) {
       const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, width, height);
       const Eigen::Vector3d dir = (pano_to_world * Eigen::Vector3d(d.x, d.y, d.z)).normalized();

@@ -4,7 +4,7 @@
 #include <limits>
 #include <vector>
 
-#include "reconstruct/synth/parallel_rows.h"
+#include "base/parallel_for.h"
 #include "reconstruct/synth/procedural_texture.h"
 #include "reconstruct/synth/srgb.h"
 
@@ -70,7 +70,8 @@ PhotoRender RenderPhoto(const Scene& scene, const geometry::Camera& camera,
   std::vector<int> surface(static_cast<size_t>(w) * h);
 
   // Pass 1: one ray through each pixel centre.
-  ParallelRows(h, options.num_threads, [&](int y) {
+  base::ParallelFor(0, h, base::ResolveThreads(options.num_threads), [&](int64_t y64) {
+    const int y = static_cast<int>(y64);
     for (int x = 0; x < w; ++x) {
       Hit hit;
       double depth;
@@ -86,7 +87,8 @@ PhotoRender RenderPhoto(const Scene& scene, const geometry::Camera& camera,
   const int n = options.edge_samples;
   std::vector<int> edges_per_row(h, 0);
   if (n > 1) {
-    ParallelRows(h, options.num_threads, [&](int y) {
+    base::ParallelFor(0, h, base::ResolveThreads(options.num_threads), [&](int64_t y64) {
+      const int y = static_cast<int>(y64);
       for (int x = 0; x < w; ++x) {
         const int s = surface[static_cast<size_t>(y) * w + x];
         const bool edge = (x > 0 && surface[static_cast<size_t>(y) * w + x - 1] != s) ||

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "reconstruct/synth/parallel_rows.h"
+#include "base/parallel_for.h"
 #include "reconstruct/synth/procedural_texture.h"
 #include "reconstruct/synth/srgb.h"
 
@@ -42,7 +42,8 @@ geometry::SparseModel MakeGroundTruthModel(const std::vector<Scene>& scenes, con
   // concatenated in task order, so the model is independent of threading.
   const int tasks = n * gy;
   std::vector<std::vector<Candidate>> per_task(tasks);
-  ParallelRows(tasks, options.num_threads, [&](int task) {
+  base::ParallelFor(0, tasks, base::ResolveThreads(options.num_threads), [&](int64_t task64) {
+    const int task = static_cast<int>(task64);
     const int i = task / gy, row = task % gy;
     for (int col = 0; col < gx; ++col) {
       const uint64_t h = Hash(options.seed, 0x5BA85E, task, col);

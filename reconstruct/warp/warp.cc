@@ -1,13 +1,13 @@
 #include "reconstruct/warp/warp.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-#include <thread>
 
 #include <Eigen/Core>
+
+#include "base/parallel_for.h"
 
 namespace casual3d::warp {
 namespace {
@@ -293,26 +293,8 @@ std::vector<WarpedView> WarpViews(const std::vector<SourceView>& views, const Pa
   if (const Status st = options.Check(); !st.ok())
     throw std::invalid_argument("warp options: " + st.message());
   std::vector<WarpedView> out(views.size());
-  if (num_threads <= 0) num_threads = std::max(1u, std::thread::hardware_concurrency());
-  num_threads = std::min<int>(num_threads, static_cast<int>(views.size()));
-  std::atomic<size_t> next{0};
-  std::vector<std::exception_ptr> errors(views.size());
-  auto work = [&] {
-    for (size_t i = next++; i < views.size(); i = next++) {
-      try {
-        out[i] = WarpView(views[i], frame, options);
-      } catch (...) {
-        errors[i] = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int t = 1; t < num_threads; ++t) threads.emplace_back(work);
-  work();
-  for (std::thread& t : threads) t.join();
-  for (const std::exception_ptr& e : errors) {
-    if (e) std::rethrow_exception(e);
-  }
+  base::ParallelFor(0, static_cast<int64_t>(views.size()), base::ResolveThreads(num_threads),
+                    [&](int64_t i) { out[i] = WarpView(views[i], frame, options); });
   return out;
 }
 
