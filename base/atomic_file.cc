@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <system_error>
 
 namespace casual3d::base {
 namespace {
@@ -62,6 +64,25 @@ Status WriteFileAtomic(const std::string& path, const void* data, size_t size) {
     if (!closed) return CannotWrite(path, std::strerror(errno));
     return Status::Ok();
   });
+}
+
+Status ReplaceFolder(const std::string& staged, const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::string old;
+  if (fs::exists(dir, ec)) {
+    old = TemporaryPathFor(dir);
+    fs::rename(dir, old, ec);
+    if (ec) return IoError(dir + ": cannot move the previous folder aside (" + ec.message() + ")");
+  }
+  fs::rename(staged, dir, ec);
+  if (ec) {
+    const std::string reason = ec.message();
+    if (!old.empty()) fs::rename(old, dir, ec);
+    return IoError(dir + ": cannot move the new folder into place (" + reason + ")");
+  }
+  if (!old.empty()) fs::remove_all(old, ec);
+  return Status::Ok();
 }
 
 }  // namespace casual3d::base

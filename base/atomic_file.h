@@ -4,7 +4,8 @@
 // data goes to a temporary file beside the destination (the same folder, so
 // the same file system) and is renamed over it only once complete, so that a
 // reader sees the old file or the new one, never half of one. A failed write
-// leaves the destination as it was and no temporary file behind.
+// leaves the destination as it was and no temporary file behind. Folders
+// written whole (a package, a stage's output) are swapped in the same way.
 
 #include <cstddef>
 #include <cstdint>
@@ -43,5 +44,14 @@ inline Status WriteFileAtomic(const std::string& path, std::string_view bytes) {
 inline Status WriteFileAtomic(const std::string& path, const std::vector<uint8_t>& bytes) {
   return WriteFileAtomic(path, bytes.data(), bytes.size());
 }
+
+// Puts the folder `staged`, written beside `dir`, in the place of `dir`: an
+// existing `dir` is first renamed aside (TemporaryPathFor), then `staged` is
+// renamed to `dir` and the old folder removed. Readers see the old folder or
+// the new one, never a mix. If `staged` cannot be moved into place the old
+// folder is put back and kIoError "<dir>: cannot move the new folder into
+// place (<reason>)" returned ("... the previous folder aside ..." when the old
+// one cannot be moved); `staged` is then left for the caller to remove.
+Status ReplaceFolder(const std::string& staged, const std::string& dir);
 
 }  // namespace casual3d::base

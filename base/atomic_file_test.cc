@@ -106,5 +106,31 @@ TEST_F(AtomicFileTest, AFailedRenameLeavesTheTargetAndNoTemporaryFile) {
   EXPECT_EQ(Listing(), "taken;");
 }
 
+TEST_F(AtomicFileTest, ReplaceFolderSwapsAWholeFolder) {
+  const std::string dir = Path("out"), staged = Path("out.staged");
+  fs::create_directories(staged);
+  std::ofstream(staged + "/a.txt") << "first";
+  ASSERT_TRUE(ReplaceFolder(staged, dir).ok());  // No folder there yet.
+  EXPECT_EQ(Contents(dir + "/a.txt"), "first");
+  fs::create_directories(staged);
+  std::ofstream(staged + "/b.txt") << "second";
+  ASSERT_TRUE(ReplaceFolder(staged, dir).ok());
+  EXPECT_FALSE(fs::exists(dir + "/a.txt"));  // The old folder's files went with it.
+  EXPECT_EQ(Contents(dir + "/b.txt"), "second");
+  EXPECT_EQ(Listing(), "out;");
+}
+
+TEST_F(AtomicFileTest, AFailedReplaceFolderPutsTheOldFolderBack) {
+  const std::string dir = Path("out");
+  fs::create_directories(dir);
+  std::ofstream(dir + "/a.txt") << "old";
+  const Status s = ReplaceFolder(Path("never-written"), dir);
+  EXPECT_EQ(s.code(), StatusCode::kIoError);
+  EXPECT_EQ(s.message().rfind(dir + ": cannot move the new folder into place (", 0), 0u)
+      << s.message();
+  EXPECT_EQ(Contents(dir + "/a.txt"), "old");
+  EXPECT_EQ(Listing(), "out;");
+}
+
 }  // namespace
 }  // namespace casual3d::base

@@ -4,12 +4,12 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
 #include <vector>
 
+#include "base/atomic_file.h"
 #include "reconstruct/util/html.h"
 
 namespace casual3d::cli {
@@ -32,31 +32,10 @@ fs::path ExecutableDir() {
   return fs::path(std::string(buffer.data(), static_cast<size_t>(n))).parent_path();
 }
 
-std::string TempSuffix() {
-  std::random_device rd;
-  return ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(rd() % 1000000);
-}
-
-// Writes `bytes` to `path` through a temporary file in the same folder.
+// Writes `bytes` to `path` atomically (base/atomic_file.h).
 void WriteFileAtomically(const fs::path& path, const std::string& bytes) {
-  const fs::path tmp = path.string() + TempSuffix();
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      throw std::runtime_error(path.string() +
-                               ": cannot write (check the folder exists and is writable)");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error(path.string() + ": cannot rename the temporary file into place");
-  }
+  const Status written = base::WriteFileAtomic(path.string(), bytes);
+  if (!written.ok()) throw std::runtime_error(written.message());
 }
 
 std::string ReadFile(const fs::path& path) {
@@ -66,7 +45,6 @@ std::string ReadFile(const fs::path& path) {
   ss << in.rdbuf();
   return ss.str();
 }
-
 
 }  // namespace
 

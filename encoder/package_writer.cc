@@ -260,24 +260,9 @@ Status WritePackageFolder(const PackageFiles& files, const std::string& dir) {
       return s;
     }
   }
-  fs::path old;
-  if (fs::exists(clean, ec)) {
-    old = base::TemporaryPathFor(clean.string());
-    fs::rename(clean, old, ec);
-    if (ec) {
-      cleanup();
-      return IoError(dir + ": cannot move the previous package aside: " + ec.message());
-    }
-  }
-  fs::rename(tmp, clean, ec);
-  if (ec) {
-    const std::string message = ec.message();
-    if (!old.empty()) fs::rename(old, clean, ec);
-    cleanup();
-    return IoError(dir + ": cannot move the new package into place: " + message);
-  }
-  if (!old.empty()) fs::remove_all(old, ec);
-  return Status::Ok();
+  const Status swapped = base::ReplaceFolder(tmp.string(), clean.string());
+  if (!swapped.ok()) cleanup();
+  return swapped;
 }
 
 Status WritePackageSingleFile(const PackageFiles& files, const std::string& path) {

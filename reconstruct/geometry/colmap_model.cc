@@ -1,7 +1,5 @@
 #include "reconstruct/geometry/colmap_model.h"
 
-#include <unistd.h>
-
 #include <cerrno>
 #include <climits>
 #include <cmath>
@@ -11,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 #include <system_error>
+
+#include "base/atomic_file.h"
 
 namespace casual3d::geometry {
 namespace {
@@ -228,30 +228,11 @@ class BinaryWriter {
   std::string bytes_;
 };
 
-// Writes `contents` to `path` through a temporary file in the same folder and
-// a rename, so that readers never see a half-written file.
+// Writes `contents` to `path` atomically (base/atomic_file.h), so that
+// readers never see a half-written file.
 void WriteFileAtomically(const std::string& path, const std::string& contents) {
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-  {
-    std::ofstream file(tmp, std::ios::binary | std::ios::trunc);
-    if (!file.is_open()) {
-      throw ModelError(path + ": cannot write (" + std::strerror(errno) + ")");
-    }
-    file.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    file.close();
-    if (!file) {
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      throw ModelError(path + ": write failed (disk full?)");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw ModelError(path + ": cannot rename the temporary file into place (" + ec.message() + ")");
-  }
+  const Status written = base::WriteFileAtomic(path, contents);
+  if (!written.ok()) throw ModelError(written.message());
 }
 
 void CreateDir(const std::string& dir) {

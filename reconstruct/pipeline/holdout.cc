@@ -1,12 +1,11 @@
 #include "reconstruct/pipeline/holdout.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
 
+#include "base/atomic_file.h"
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/pipeline/panorama_stage.h"
 #include "reconstruct/sfm/scene_setup.h"
@@ -32,7 +31,7 @@ void WriteTrainingWorkspace(const std::string& sparse_dir, const std::vector<std
                             const std::string& train_dir) {
   const fs::path src(sparse_dir);
   const fs::path dst(train_dir);
-  const fs::path tmp = dst.string() + ".tmp-" + std::to_string(::getpid());
+  const fs::path tmp = base::TemporaryPathFor(dst.string());
   std::error_code ec;
   fs::remove_all(tmp, ec);
   fs::create_directories(tmp / "sparse", ec);
@@ -91,11 +90,8 @@ void WriteTrainingWorkspace(const std::string& sparse_dir, const std::vector<std
       if (ec) throw std::runtime_error(from.string() + ": cannot link or copy into " + to.string());
     }
   }
-  fs::remove_all(dst, ec);
-  fs::rename(tmp, dst, ec);
-  if (ec)
-    throw std::runtime_error(dst.string() + ": cannot move the training workspace in place (" +
-                             ec.message() + ")");
+  const Status moved = base::ReplaceFolder(tmp.string(), dst.string());
+  if (!moved.ok()) throw std::runtime_error(moved.message());
 }
 
 }  // namespace casual3d::pipeline

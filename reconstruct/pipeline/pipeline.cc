@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "base/atomic_file.h"
 #include "encoder/master_file.h"
 #include "encoder/package_writer.h"
 #include "format/sha256.h"
@@ -81,11 +82,7 @@ void RunIntoFolder(const fs::path& dir, const fs::path& key_path, const std::str
   fs::remove_all(tmp, ec);
   fs::remove(key_path, ec);
   run(tmp);
-  fs::remove_all(dir, ec);
-  fs::rename(tmp, dir, ec);
-  if (ec)
-    throw std::runtime_error(dir.string() + ": cannot move the stage output in place (" +
-                             ec.message() + ")");
+  io::ThrowIfError(base::ReplaceFolder(tmp.string(), dir.string()));
   io::WriteFileAtomic(key_path.string(), key);
 }
 

@@ -1,7 +1,6 @@
 #include "reconstruct/sfm/sparse_stage.h"
 
 #include <stdlib.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -15,10 +14,10 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
 #include <nlohmann/json.hpp>
 
+#include "base/atomic_file.h"
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/sfm/colmap_database.h"
@@ -150,26 +149,13 @@ class StagingDir {
   // Moves the staging folder to `output`, replacing an existing one only now.
   void Commit(bool overwrite) {
     std::error_code ec;
-    fs::path old;
-    if (fs::exists(output_, ec)) {
-      if (!overwrite) {
-        throw std::runtime_error(output_.string() +
-                                 ": already exists; pass --overwrite or choose another folder");
-      }
-      old = output_.string() + ".old-" + std::to_string(::getpid());
-      fs::rename(output_, old, ec);
-      if (ec) {
-        throw std::runtime_error(output_.string() + ": cannot replace it: " + ec.message());
-      }
+    if (fs::exists(output_, ec) && !overwrite) {
+      throw std::runtime_error(output_.string() +
+                               ": already exists; pass --overwrite or choose another folder");
     }
-    fs::rename(path_, output_, ec);
-    if (ec) {
-      if (!old.empty()) fs::rename(old, output_);
-      throw std::runtime_error(output_.string() + ": cannot move the finished output in place: " +
-                               ec.message());
-    }
+    const Status moved = base::ReplaceFolder(path_.string(), output_.string());
+    if (!moved.ok()) throw std::runtime_error(moved.message());
     committed_ = true;
-    if (!old.empty()) fs::remove_all(old, ec);
   }
 
  private:
