@@ -24,6 +24,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "base/testing/scratch_dir.h"
 #include "encoder/gltf_tinygltf.h"
 #include "format/mesh_builder.h"
 #include "format/mesh_simplify.h"
@@ -715,14 +716,8 @@ TEST(GltfExportTest, SimplifiedMeshMeetsTheTriangleBudget) {
 
 class GltfExportFileTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("casual3d_gltf_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  casual3d::testing::ScratchDir scratch_{"gltf_test"};
+  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(GltfExportFileTest, WritesAtomicallyAndReplaces) {

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/testing/scratch_dir.h"
 #include "format/package_test_scene.h"
 
 namespace casual3d::encoder {
@@ -19,16 +20,9 @@ namespace fs = std::filesystem;
 
 class MasterFileTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("casual3d_master_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  casual3d::testing::ScratchDir scratch_{"master_test"};
+  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(MasterFileTest, RoundTripIsBitExact) {

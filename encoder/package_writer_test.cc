@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/testing/scratch_dir.h"
 #include "encoder/level_of_detail.h"
 #include "encoder/webp_codec.h"
 #include "format/file_source.h"
@@ -23,17 +24,11 @@ namespace fs = std::filesystem;
 class PackageWriterTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("casual3d_package_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
     pano_ = casual3d::testing::MakePackageTestPanorama(512, 256);
     options_.tile_size = 128;
     options_.levels = 3;
     options_.num_threads = 2;
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   PackageFiles Encode(PackageStats* stats = nullptr) {
     StatusOr<PackageFiles> files = EncodePackage(pano_, options_, stats);
@@ -41,7 +36,8 @@ class PackageWriterTest : public ::testing::Test {
     return files.ok() ? *files : PackageFiles();
   }
 
-  fs::path dir_;
+  casual3d::testing::ScratchDir scratch_{"package_test"};
+  const fs::path dir_ = scratch_.path();
   TwoLayerPanorama pano_;
   PackageOptions options_;
   WebpImageDecoder decoder_;

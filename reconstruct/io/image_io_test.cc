@@ -16,6 +16,7 @@
 #include <jpeglib.h>
 #include <opencv2/imgproc.hpp>
 
+#include "base/testing/scratch_dir.h"
 #include "reconstruct/io/cv_bridge.h"
 
 namespace casual3d::io {
@@ -25,14 +26,9 @@ namespace fs = std::filesystem;
 
 class ImageIoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("casual3d_image_io_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  casual3d::testing::ScratchDir scratch_{"image_io_test"};
+  const fs::path dir_ = scratch_.path();
 };
 
 // A smooth colour ramp with a distinct value in each channel, 40x30.
