@@ -15,41 +15,29 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class AtomicFileTest : public ::testing::Test {
+class AtomicFileTest : public casual3d::testing::TestWithScratchDir {
  protected:
-  std::string Path(const std::string& name) const { return scratch_.Path(name); }
-
-  static std::string Contents(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  }
-
   // The names in the folder: a temporary file left behind shows here.
   std::string Listing() const {
     std::string names;
     for (const auto& e : fs::directory_iterator(dir_)) names += e.path().filename().string() + ";";
     return names;
   }
-
-  casual3d::testing::ScratchDir scratch_{"atomic_file"};
-  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(AtomicFileTest, WritesAndReplaces) {
-  const std::string path = Path("a.bin");
+  const std::string path = scratch_.Path("a.bin");
   ASSERT_TRUE(WriteFileAtomic(path, std::string("first")).ok());
-  EXPECT_EQ(Contents(path), "first");
+  EXPECT_EQ(casual3d::testing::ReadWholeFile(path), "first");
   ASSERT_TRUE(WriteFileAtomic(path, std::vector<uint8_t>{'2', 'n', 'd'}).ok());
-  EXPECT_EQ(Contents(path), "2nd");
+  EXPECT_EQ(casual3d::testing::ReadWholeFile(path), "2nd");
   ASSERT_TRUE(WriteFileAtomic(path, std::string()).ok());
   EXPECT_EQ(fs::file_size(path), 0u);
   EXPECT_EQ(Listing(), "a.bin;");
 }
 
 TEST_F(AtomicFileTest, TemporaryPathsAreBesideTheTargetAndDistinct) {
-  const std::string path = Path("x.exr");
+  const std::string path = scratch_.Path("x.exr");
   const std::string a = TemporaryPathFor(path), b = TemporaryPathFor(path);
   EXPECT_NE(a, b);
   EXPECT_EQ(fs::path(a).parent_path(), dir_);
@@ -57,7 +45,7 @@ TEST_F(AtomicFileTest, TemporaryPathsAreBesideTheTargetAndDistinct) {
 }
 
 TEST_F(AtomicFileTest, AMissingFolderIsAnIoErrorNamingThePath) {
-  const std::string path = Path("no/such/folder/a.bin");
+  const std::string path = scratch_.Path("no/such/folder/a.bin");
   const Status s = WriteFileAtomic(path, std::string("data"));
   EXPECT_EQ(s.code(), StatusCode::kIoError);
   EXPECT_EQ(s.message().rfind(path + ": cannot write (", 0), 0u) << s.message();
@@ -65,7 +53,7 @@ TEST_F(AtomicFileTest, AMissingFolderIsAnIoErrorNamingThePath) {
 }
 
 TEST_F(AtomicFileTest, AFailedWriteLeavesTheTargetAndNoTemporaryFile) {
-  const std::string path = Path("a.txt");
+  const std::string path = scratch_.Path("a.txt");
   ASSERT_TRUE(WriteFileAtomic(path, std::string("old")).ok());
   std::string seen_tmp;
   const Status s = WriteAtomically(path, [&](const std::string& tmp) {
@@ -76,12 +64,12 @@ TEST_F(AtomicFileTest, AFailedWriteLeavesTheTargetAndNoTemporaryFile) {
   EXPECT_EQ(s.message(), path + ": disk full");
   EXPECT_FALSE(seen_tmp.empty());
   EXPECT_FALSE(fs::exists(seen_tmp));
-  EXPECT_EQ(Contents(path), "old");
+  EXPECT_EQ(casual3d::testing::ReadWholeFile(path), "old");
   EXPECT_EQ(Listing(), "a.txt;");
 }
 
 TEST_F(AtomicFileTest, AnExceptionFromTheWriterIsRethrownAndCleanedUp) {
-  const std::string path = Path("a.txt");
+  const std::string path = scratch_.Path("a.txt");
   ASSERT_TRUE(WriteFileAtomic(path, std::string("old")).ok());
   EXPECT_THROW(WriteAtomically(path,
                                [&](const std::string& tmp) -> Status {
@@ -89,46 +77,46 @@ TEST_F(AtomicFileTest, AnExceptionFromTheWriterIsRethrownAndCleanedUp) {
                                  throw std::runtime_error("encoder failed");
                                }),
                std::runtime_error);
-  EXPECT_EQ(Contents(path), "old");
+  EXPECT_EQ(casual3d::testing::ReadWholeFile(path), "old");
   EXPECT_EQ(Listing(), "a.txt;");
 }
 
 TEST_F(AtomicFileTest, AFailedRenameLeavesTheTargetAndNoTemporaryFile) {
   // A non-empty folder where the file should go: the rename fails.
-  const std::string path = Path("taken");
+  const std::string path = scratch_.Path("taken");
   fs::create_directories(dir_ / "taken");
   std::ofstream((dir_ / "taken" / "keep.txt").string()) << "kept";
   const Status s = WriteFileAtomic(path, std::string("data"));
   EXPECT_EQ(s.code(), StatusCode::kIoError);
   EXPECT_EQ(s.message().rfind(path + ": cannot write (", 0), 0u) << s.message();
   EXPECT_TRUE(fs::is_directory(path));
-  EXPECT_EQ(Contents(Path("taken/keep.txt")), "kept");
+  EXPECT_EQ(casual3d::testing::ReadWholeFile(scratch_.Path("taken/keep.txt")), "kept");
   EXPECT_EQ(Listing(), "taken;");
 }
 
 TEST_F(AtomicFileTest, ReplaceFolderSwapsAWholeFolder) {
-  const std::string dir = Path("out"), staged = Path("out.staged");
+  const std::string dir = scratch_.Path("out"), staged = scratch_.Path("out.staged");
   fs::create_directories(staged);
   std::ofstream(staged + "/a.txt") << "first";
   ASSERT_TRUE(ReplaceFolder(staged, dir).ok());  // No folder there yet.
-  EXPECT_EQ(Contents(dir + "/a.txt"), "first");
+  EXPECT_EQ(casual3d::testing::ReadWholeFile(dir + "/a.txt"), "first");
   fs::create_directories(staged);
   std::ofstream(staged + "/b.txt") << "second";
   ASSERT_TRUE(ReplaceFolder(staged, dir).ok());
   EXPECT_FALSE(fs::exists(dir + "/a.txt"));  // The old folder's files went with it.
-  EXPECT_EQ(Contents(dir + "/b.txt"), "second");
+  EXPECT_EQ(casual3d::testing::ReadWholeFile(dir + "/b.txt"), "second");
   EXPECT_EQ(Listing(), "out;");
 }
 
 TEST_F(AtomicFileTest, AFailedReplaceFolderPutsTheOldFolderBack) {
-  const std::string dir = Path("out");
+  const std::string dir = scratch_.Path("out");
   fs::create_directories(dir);
   std::ofstream(dir + "/a.txt") << "old";
-  const Status s = ReplaceFolder(Path("never-written"), dir);
+  const Status s = ReplaceFolder(scratch_.Path("never-written"), dir);
   EXPECT_EQ(s.code(), StatusCode::kIoError);
   EXPECT_EQ(s.message().rfind(dir + ": cannot move the new folder into place (", 0), 0u)
       << s.message();
-  EXPECT_EQ(Contents(dir + "/a.txt"), "old");
+  EXPECT_EQ(casual3d::testing::ReadWholeFile(dir + "/a.txt"), "old");
   EXPECT_EQ(Listing(), "out;");
 }
 

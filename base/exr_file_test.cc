@@ -14,14 +14,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class ExrFileTest : public ::testing::Test {
+class ExrFileTest : public casual3d::testing::TestWithScratchDir {
  protected:
   size_t FilesInFolder() const {
     return std::distance(fs::directory_iterator(dir_), fs::directory_iterator());
   }
-
-  casual3d::testing::ScratchDir scratch_{"exr_file"};
-  const fs::path dir_ = scratch_.path();
 };
 
 template <typename T>

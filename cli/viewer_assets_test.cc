@@ -10,21 +10,14 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/testing/scratch_dir.h"
+
 namespace casual3d::cli {
 namespace {
 namespace fs = std::filesystem;
 
-std::string Read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void Write(const fs::path& p, const std::string& s) {
-  std::ofstream out(p, std::ios::binary);
-  out << s;
-}
+using casual3d::testing::ReadWholeFile;
+using casual3d::testing::WriteWholeFile;
 
 class ViewerAssetsTest : public ::testing::Test {
  protected:
@@ -33,8 +26,8 @@ class ViewerAssetsTest : public ::testing::Test {
     fs::remove_all(root_);
     fs::create_directories(root_ / "viewer");
     fs::create_directories(root_ / "package");
-    Write(root_ / "viewer" / "casual3d-viewer.js", "export {};\n");
-    Write(root_ / "viewer" / "casual3d-format.wasm", std::string("\0asm\1\0\0\0", 8));
+    WriteWholeFile(root_ / "viewer" / "casual3d-viewer.js", "export {};\n");
+    WriteWholeFile(root_ / "viewer" / "casual3d-format.wasm", std::string("\0asm\1\0\0\0", 8));
     setenv("CASUAL3D_VIEWER_DIR", (root_ / "viewer").c_str(), 1);
   }
   void TearDown() override {
@@ -50,9 +43,9 @@ TEST_F(ViewerAssetsTest, FindsTheViewerThroughTheEnvironment) {
 
 TEST_F(ViewerAssetsTest, CopiesTheViewerAndWritesTheIndexPage) {
   WriteViewerPage(root_ / "package");
-  EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-viewer.js"), "export {};\n");
-  EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-format.wasm").size(), 8u);
-  const std::string html = Read(root_ / "package" / "index.html");
+  EXPECT_EQ(ReadWholeFile(root_ / "package" / "viewer" / "casual3d-viewer.js"), "export {};\n");
+  EXPECT_EQ(ReadWholeFile(root_ / "package" / "viewer" / "casual3d-format.wasm").size(), 8u);
+  const std::string html = ReadWholeFile(root_ / "package" / "index.html");
   EXPECT_NE(html.find("<script type=\"module\" src=\"viewer/casual3d-viewer.js\"></script>"),
             std::string::npos);
   EXPECT_NE(html.find("<casual3d-viewer src=\"manifest.json\""), std::string::npos);
@@ -65,14 +58,14 @@ TEST_F(ViewerAssetsTest, CopiesTheViewerAndWritesTheIndexPage) {
   }
   EXPECT_EQ(files, 3);
   // Writing again replaces the files in place.
-  Write(root_ / "viewer" / "casual3d-viewer.js", "export const v = 2;\n");
+  WriteWholeFile(root_ / "viewer" / "casual3d-viewer.js", "export const v = 2;\n");
   WriteViewerPage(root_ / "package");
-  EXPECT_EQ(Read(root_ / "package" / "viewer" / "casual3d-viewer.js"), "export const v = 2;\n");
+  EXPECT_EQ(ReadWholeFile(root_ / "package" / "viewer" / "casual3d-viewer.js"), "export const v = 2;\n");
 }
 
 TEST_F(ViewerAssetsTest, TitlesThePageAsAsked) {
   WriteViewerPage(root_ / "package", {}, "fern");
-  EXPECT_NE(Read(root_ / "package" / "index.html").find("<title>fern - casual3d</title>"),
+  EXPECT_NE(ReadWholeFile(root_ / "package" / "index.html").find("<title>fern - casual3d</title>"),
             std::string::npos);
   EXPECT_EQ(FolderName(root_ / "out" / "fern" / ""), "fern");
   EXPECT_EQ(FolderName(root_ / "out" / "fern" / "."), "fern");
@@ -97,7 +90,7 @@ TEST_F(ViewerAssetsTest, CaptureAdviceFillsTheInfoPanel) {
   EXPECT_EQ(quiet.find("info-open"), std::string::npos);
   // With warnings: open at load, each warning marked, the text escaped.
   WriteViewerPage(root_ / "package", {"The camera moved 1.84 m.", "Photos a<b>.jpg & c.jpg overlap nothing."});
-  const std::string html = Read(root_ / "package" / "index.html");
+  const std::string html = ReadWholeFile(root_ / "package" / "index.html");
   EXPECT_NE(html.find("<casual3d-viewer src=\"manifest.json\" controls info-open>"), std::string::npos) << html;
   EXPECT_NE(html.find("<p class=\"warning\">Photos a&lt;b&gt;.jpg &amp; c.jpg overlap nothing.</p>"),
             std::string::npos)

@@ -714,11 +714,7 @@ TEST(GltfExportTest, SimplifiedMeshMeetsTheTriangleBudget) {
             3 * stats.num_triangles);
 }
 
-class GltfExportFileTest : public ::testing::Test {
- protected:
-  casual3d::testing::ScratchDir scratch_{"gltf_test"};
-  const fs::path dir_ = scratch_.path();
-};
+class GltfExportFileTest : public casual3d::testing::TestWithScratchDir {};
 
 TEST_F(GltfExportFileTest, WritesAtomicallyAndReplaces) {
   const Mesh mesh = MakeSphereBand(6, 3, 1);

@@ -18,12 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class MasterFileTest : public ::testing::Test {
- protected:
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  casual3d::testing::ScratchDir scratch_{"master_test"};
-  const fs::path dir_ = scratch_.path();
-};
+class MasterFileTest : public casual3d::testing::TestWithScratchDir {};
 
 TEST_F(MasterFileTest, RoundTripIsBitExact) {
   TwoLayerPanorama pano = casual3d::testing::MakePackageTestPanorama(256, 128);
@@ -34,7 +29,7 @@ TEST_F(MasterFileTest, RoundTripIsBitExact) {
   // Values that a lossy or half-float path would change.
   pano.layer(kFront).depth_m[5] = 1.0f + 1e-7f * 3;
   ASSERT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
-  const std::string path = Path("pano.exr");
+  const std::string path = scratch_.Path("pano.exr");
   Status written = WriteMasterFile(pano, path);
   ASSERT_TRUE(written.ok()) << written.ToString();
   StatusOr<TwoLayerPanorama> read = ReadMasterFile(path);
@@ -55,8 +50,8 @@ TEST_F(MasterFileTest, RoundTripIsBitExact) {
 
 TEST_F(MasterFileTest, OddSizeAcrossStripBoundaries) {
   TwoLayerPanorama pano = casual3d::testing::MakePackageTestPanorama(130, 65 + 64);
-  ASSERT_TRUE(WriteMasterFile(pano, Path("odd.exr")).ok());
-  StatusOr<TwoLayerPanorama> read = ReadMasterFile(Path("odd.exr"));
+  ASSERT_TRUE(WriteMasterFile(pano, scratch_.Path("odd.exr")).ok());
+  StatusOr<TwoLayerPanorama> read = ReadMasterFile(scratch_.Path("odd.exr"));
   ASSERT_TRUE(read.ok()) << read.status().ToString();
   EXPECT_TRUE(*read == pano);
 }
@@ -65,31 +60,31 @@ TEST_F(MasterFileTest, RefusesInvalidPanoramaAndLeavesNoFile) {
   TwoLayerPanorama pano = casual3d::testing::MakePackageTestPanorama(64, 32);
   pano.layer(kFront).links[0] = SetLink(0, kRight, Link::kBack);  // Not mutual.
   pano.layer(kBack).present[1] = 0;
-  Status s = WriteMasterFile(pano, Path("bad.exr"));
+  Status s = WriteMasterFile(pano, scratch_.Path("bad.exr"));
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
-  EXPECT_FALSE(fs::exists(Path("bad.exr")));
+  EXPECT_FALSE(fs::exists(scratch_.Path("bad.exr")));
 }
 
 TEST_F(MasterFileTest, MissingFileIsNotFound) {
-  StatusOr<TwoLayerPanorama> read = ReadMasterFile(Path("nope.exr"));
+  StatusOr<TwoLayerPanorama> read = ReadMasterFile(scratch_.Path("nope.exr"));
   EXPECT_EQ(read.status().code(), StatusCode::kNotFound);
   EXPECT_NE(read.status().message().find("nope.exr"), std::string::npos);
 }
 
 TEST_F(MasterFileTest, GarbageAndTruncatedFilesAreInvalidData) {
   {
-    std::ofstream f(Path("garbage.exr"), std::ios::binary);
+    std::ofstream f(scratch_.Path("garbage.exr"), std::ios::binary);
     f << "this is not an image at all";
   }
-  EXPECT_EQ(ReadMasterFile(Path("garbage.exr")).status().code(), StatusCode::kInvalidData);
+  EXPECT_EQ(ReadMasterFile(scratch_.Path("garbage.exr")).status().code(), StatusCode::kInvalidData);
 
   TwoLayerPanorama pano = casual3d::testing::MakePackageTestPanorama(64, 32);
-  ASSERT_TRUE(WriteMasterFile(pano, Path("full.exr")).ok());
-  std::ifstream in(Path("full.exr"), std::ios::binary);
+  ASSERT_TRUE(WriteMasterFile(pano, scratch_.Path("full.exr")).ok());
+  std::ifstream in(scratch_.Path("full.exr"), std::ios::binary);
   std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(bytes.size(), 1000u);
   for (size_t keep : {size_t{8}, size_t{200}, bytes.size() / 2, bytes.size() - 3}) {
-    const std::string cut = Path("cut_" + std::to_string(keep) + ".exr");
+    const std::string cut = scratch_.Path("cut_" + std::to_string(keep) + ".exr");
     std::ofstream out(cut, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(keep));
     out.close();
@@ -100,7 +95,7 @@ TEST_F(MasterFileTest, GarbageAndTruncatedFilesAreInvalidData) {
   for (size_t pos = bytes.size() / 3; pos < bytes.size(); pos += bytes.size() / 7) {
     std::vector<char> bad = bytes;
     bad[pos] = static_cast<char>(bad[pos] ^ 0x5A);
-    const std::string p = Path("flip.exr");
+    const std::string p = scratch_.Path("flip.exr");
     std::ofstream out(p, std::ios::binary);
     out.write(bad.data(), static_cast<std::streamsize>(bad.size()));
     out.close();

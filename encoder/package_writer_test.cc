@@ -21,7 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class PackageWriterTest : public ::testing::Test {
+class PackageWriterTest : public casual3d::testing::TestWithScratchDir {
  protected:
   void SetUp() override {
     pano_ = casual3d::testing::MakePackageTestPanorama(512, 256);
@@ -36,8 +36,6 @@ class PackageWriterTest : public ::testing::Test {
     return files.ok() ? *files : PackageFiles();
   }
 
-  casual3d::testing::ScratchDir scratch_{"package_test"};
-  const fs::path dir_ = scratch_.path();
   TwoLayerPanorama pano_;
   PackageOptions options_;
   WebpImageDecoder decoder_;

@@ -8,6 +8,8 @@
 #include <random>
 #include <sstream>
 
+#include "base/testing/scratch_dir.h"
+
 namespace casual3d::geometry {
 namespace {
 
@@ -35,17 +37,8 @@ std::string TempDir(const std::string& name) {
   return dir.string();
 }
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream out;
-  out << file.rdbuf();
-  return out.str();
-}
-
-void WriteFile(const std::string& path, const std::string& contents) {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  file << contents;
-}
+using casual3d::testing::ReadWholeFile;
+using casual3d::testing::WriteWholeFile;
 
 // A small but complete model: three camera models, images with and without
 // observations, points with tracks, values that need all 17 digits.
@@ -164,7 +157,7 @@ TEST(ColmapModelTest, TextBinaryTextRoundTripIsExact) {
   ExpectModelsEqual(model, from_bin);
   WriteModelText(from_bin, text2);
   for (const char* name : {"cameras.txt", "images.txt", "points3D.txt"}) {
-    EXPECT_EQ(ReadFile(text1 + "/" + name), ReadFile(text2 + "/" + name)) << name;
+    EXPECT_EQ(ReadWholeFile(text1 + "/" + name), ReadWholeFile(text2 + "/" + name)) << name;
   }
   // ReadModel prefers binary; no temporary files are left behind.
   ExpectModelsEqual(model, ReadModel(bin));
@@ -195,32 +188,32 @@ TEST(ColmapModelTest, BinaryLayoutMatchesColmap) {
   model.images[2] = image;
   const std::string dir = TempDir("layout");
   WriteModelBinary(model, dir);
-  const std::string cams = ReadFile(dir + "/cameras.bin");
+  const std::string cams = ReadWholeFile(dir + "/cameras.bin");
   ASSERT_EQ(cams.size(), 56u);
   EXPECT_EQ(cams.substr(0, 8), std::string("\x01\0\0\0\0\0\0\0", 8));
   EXPECT_EQ(cams.substr(8, 4), std::string("\x05\0\0\0", 4));
   EXPECT_EQ(cams.substr(12, 4), std::string("\0\0\0\0", 4));
   EXPECT_EQ(cams.substr(16, 8), std::string("\x80\x02\0\0\0\0\0\0", 8));  // 640
   // images.bin: 8 + (4 + 56 + 4 + 6 + 8 + 24) bytes; the point3D id is all ones.
-  const std::string imgs = ReadFile(dir + "/images.bin");
+  const std::string imgs = ReadWholeFile(dir + "/images.bin");
   ASSERT_EQ(imgs.size(), 8u + 4 + 56 + 4 + 6 + 8 + 24);
   EXPECT_EQ(imgs.substr(72, 6), std::string("a.jpg\0", 6));
   EXPECT_EQ(imgs.substr(imgs.size() - 8), std::string(8, '\xff'));
-  EXPECT_EQ(ReadFile(dir + "/points3D.bin"), std::string(8, '\0'));
+  EXPECT_EQ(ReadWholeFile(dir + "/points3D.bin"), std::string(8, '\0'));
 }
 
 TEST(ColmapModelTest, TextToleratesCommentsBlankLinesAndCrlf) {
   const std::string dir = TempDir("tolerant");
-  WriteFile(dir + "/cameras.txt",
+  WriteWholeFile(dir + "/cameras.txt",
             "# a comment\n\n   \n1 PINHOLE 640 480 500 500 320 240\r\n# trailing comment\n\n");
-  WriteFile(dir + "/images.txt",
+  WriteWholeFile(dir + "/images.txt",
             "# header\n\n"
             "1 1 0 0 0 0.5 0 -1 1 img one.png\n"
             "10.5 20.25 7 30 40 -1\n"
             "\n"
             "  2 2 0 0 0 0 0 0 1 b.png\n"
             "\n");
-  WriteFile(dir + "/points3D.txt", "\n# none\n7 1 2 3 255 128 0 0.5 1 0\n");
+  WriteWholeFile(dir + "/points3D.txt", "\n# none\n7 1 2 3 255 128 0 0.5 1 0\n");
   const SparseModel model = ReadModelText(dir);
   ASSERT_EQ(model.cameras.size(), 1u);
   EXPECT_EQ(model.cameras.at(1).params, (std::vector<double>{500, 500, 320, 240}));
@@ -267,7 +260,7 @@ TEST(ColmapModelTest, RejectsMalformedText) {
        cams + ":1: invalid camera: focal length is not positive"},
   };
   for (const Case& c : camera_cases) {
-    WriteFile(cams, c.contents);
+    WriteWholeFile(cams, c.contents);
     ExpectModelError([&] { ReadCamerasText(cams); }, c.message);
   }
 
@@ -284,7 +277,7 @@ TEST(ColmapModelTest, RejectsMalformedText) {
       {"1 1 0 0 0 0 0 nan 1 a.png\n\n", imgs + ":1: expected TZ (a finite number), got 'nan'"},
   };
   for (const Case& c : image_cases) {
-    WriteFile(imgs, c.contents);
+    WriteWholeFile(imgs, c.contents);
     ExpectModelError([&] { ReadImagesText(imgs); }, c.message);
   }
 
@@ -297,14 +290,14 @@ TEST(ColmapModelTest, RejectsMalformedText) {
        pts + ":1: expected R, G or B (an integer from 0 to 255), got '256'"},
   };
   for (const Case& c : point_cases) {
-    WriteFile(pts, c.contents);
+    WriteWholeFile(pts, c.contents);
     ExpectModelError([&] { ReadPoints3DText(pts); }, c.message);
   }
 
   // An image referring to a camera that does not exist.
-  WriteFile(cams, "1 PINHOLE 640 480 500 500 320 240\n");
-  WriteFile(imgs, "4 1 0 0 0 0 0 0 9 x.png\n\n");
-  WriteFile(pts, "");
+  WriteWholeFile(cams, "1 PINHOLE 640 480 500 500 320 240\n");
+  WriteWholeFile(imgs, "4 1 0 0 0 0 0 0 9 x.png\n\n");
+  WriteWholeFile(pts, "");
   ExpectModelError(
       [&] { ReadModelText(dir); },
       imgs + ": image 4 (x.png) refers to camera 9, which the cameras file does not define");
@@ -322,17 +315,17 @@ TEST(ColmapModelTest, RejectsMalformedBinary) {
   const std::string dir = TempDir("binary");
   WriteModelBinary(MakeModel(), dir);
   const std::string cams = dir + "/cameras.bin";
-  const std::string good_cams = ReadFile(cams);
+  const std::string good_cams = ReadWholeFile(cams);
 
   // Three cameras in 32 bytes cannot be: the count is rejected up front.
-  WriteFile(cams, good_cams.substr(0, 40));
+  WriteWholeFile(cams, good_cams.substr(0, 40));
   ExpectModelError([&] { ReadCamerasBinary(cams); },
                    cams +
                        ": offset 0: number of cameras 3 needs at least 24 bytes each but only "
                        "32 bytes remain");
   // One camera, truncated in the middle of its parameters.
   const std::string one_camera = std::string("\x01\0\0\0\0\0\0\0", 8) + good_cams.substr(8);
-  WriteFile(cams, one_camera.substr(0, 40));
+  WriteWholeFile(cams, one_camera.substr(0, 40));
   ExpectModelError([&] { ReadCamerasBinary(cams); },
                    cams +
                        ": offset 40: truncated: expected camera parameter (8 bytes) but the file "
@@ -340,7 +333,7 @@ TEST(ColmapModelTest, RejectsMalformedBinary) {
   // An absurd count is rejected before anything is allocated.
   std::string huge = good_cams;
   huge.replace(0, 8, std::string("\xff\xff\xff\xff\xff\xff\xff\x7f", 8));
-  WriteFile(cams, huge);
+  WriteWholeFile(cams, huge);
   ExpectModelError([&] { ReadCamerasBinary(cams); },
                    cams +
                        ": offset 0: number of cameras 9223372036854775807 needs at least 24 "
@@ -349,17 +342,17 @@ TEST(ColmapModelTest, RejectsMalformedBinary) {
   // Unknown model id.
   std::string bad_model = good_cams;
   bad_model[12] = 11;
-  WriteFile(cams, bad_model);
+  WriteWholeFile(cams, bad_model);
   ExpectModelError([&] { ReadCamerasBinary(cams); },
                    cams +
                        ": offset 12: expected a supported camera model id (0-4: SIMPLE_PINHOLE, "
                        "PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV), got 11");
   // Trailing garbage.
-  WriteFile(cams, good_cams + "xyz");
+  WriteWholeFile(cams, good_cams + "xyz");
   ExpectModelError([&] { ReadCamerasBinary(cams); },
                    cams + ": offset " + std::to_string(good_cams.size()) +
                        ": unexpected trailing bytes after the last camera");
-  WriteFile(cams, "");
+  WriteWholeFile(cams, "");
   ExpectModelError([&] { ReadCamerasBinary(cams); },
                    cams +
                        ": offset 0: truncated: expected number of cameras (8 bytes) but the "
@@ -367,9 +360,9 @@ TEST(ColmapModelTest, RejectsMalformedBinary) {
 
   // images.bin: a name without its terminating NUL, and a huge 2D point count.
   const std::string imgs = dir + "/images.bin";
-  const std::string good_imgs = ReadFile(imgs);
+  const std::string good_imgs = ReadWholeFile(imgs);
   const std::string one_image = std::string("\x01\0\0\0\0\0\0\0", 8) + good_imgs.substr(8);
-  WriteFile(imgs, one_image.substr(0, 8 + 4 + 56 + 4 + 9));
+  WriteWholeFile(imgs, one_image.substr(0, 8 + 4 + 56 + 4 + 9));
   ExpectModelError([&] { ReadImagesBinary(imgs); },
                    imgs +
                        ": offset 72: truncated: image name has no terminating NUL before the "
@@ -377,7 +370,7 @@ TEST(ColmapModelTest, RejectsMalformedBinary) {
   const size_t name_end = good_imgs.find('\0', 72);
   std::string many = good_imgs;
   many.replace(name_end + 1, 8, std::string("\0\0\0\0\0\0\0\x01", 8));
-  WriteFile(imgs, many);
+  WriteWholeFile(imgs, many);
   try {
     ReadImagesBinary(imgs);
     ADD_FAILURE() << "no error";
@@ -390,9 +383,9 @@ TEST(ColmapModelTest, RejectsMalformedBinary) {
 
   // points3D.bin cut short in every possible place: always a ModelError.
   const std::string pts = dir + "/points3D.bin";
-  const std::string good_pts = ReadFile(pts);
+  const std::string good_pts = ReadWholeFile(pts);
   for (size_t size = 0; size < good_pts.size(); ++size) {
-    WriteFile(pts, good_pts.substr(0, size));
+    WriteWholeFile(pts, good_pts.substr(0, size));
     EXPECT_THROW(ReadPoints3DBinary(pts), ModelError) << "size " << size;
   }
 }
@@ -405,7 +398,7 @@ TEST(ColmapModelTest, CorruptedBinaryNeverCrashes) {
   std::mt19937 rng(5);
   for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
     const std::string path = dir + "/" + name;
-    const std::string good = ReadFile(path);
+    const std::string good = ReadWholeFile(path);
     int errors = 0;
     for (int trial = 0; trial < 300; ++trial) {
       std::string bad = good;
@@ -414,7 +407,7 @@ TEST(ColmapModelTest, CorruptedBinaryNeverCrashes) {
         bad[rng() % bad.size()] = static_cast<char>(rng() % 256);
       }
       if (trial % 3 == 0) bad.resize(rng() % bad.size());
-      WriteFile(path, bad);
+      WriteWholeFile(path, bad);
       try {
         if (name[0] == 'c') ReadCamerasBinary(path);
         if (name[0] == 'i') ReadImagesBinary(path);
@@ -436,7 +429,7 @@ TEST(ColmapModelTest, WriterReplacesExistingFiles) {
   model.points.clear();
   WriteModelText(model, dir);
   EXPECT_TRUE(ReadModelText(dir).points.empty());
-  EXPECT_EQ(ReadFile(dir + "/points3D.txt"),
+  EXPECT_EQ(ReadWholeFile(dir + "/points3D.txt"),
             "# 3D point list with one line of data per point:\n"
             "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
             "# Number of points: 0, mean track length: 0\n");

@@ -9,21 +9,13 @@
 
 #include <gtest/gtest.h>
 
+#include "base/testing/scratch_dir.h"
 namespace casual3d::io {
 namespace {
 
 namespace fs = std::filesystem;
 
-class ExrIoTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("casual3d_exr_io_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
-};
+class ExrIoTest : public casual3d::testing::TestWithScratchDir {};
 
 ImageF Pattern(int w, int h, int c) {
   ImageF img(w, h, c);
@@ -38,13 +30,13 @@ TEST_F(ExrIoTest, MultiChannelRoundTripIsExact) {
   img.at(3, 4, 2) = std::numeric_limits<float>::infinity();
   img.at(5, 6, 1) = std::numeric_limits<float>::quiet_NaN();
   const std::vector<std::string> names = {"front.Z", "back.Z", "A"};
-  WriteExr(Path("m.exr"), img, names);
+  WriteExr(scratch_.Path("m.exr"), img, names);
 
   // The file keeps channels sorted by name.
-  EXPECT_EQ(ReadExrChannelNames(Path("m.exr")),
+  EXPECT_EQ(ReadExrChannelNames(scratch_.Path("m.exr")),
             (std::vector<std::string>{"A", "back.Z", "front.Z"}));
 
-  const ImageF back = ReadExrChannels(Path("m.exr"), names);
+  const ImageF back = ReadExrChannels(scratch_.Path("m.exr"), names);
   ASSERT_EQ(back.width(), 37);
   ASSERT_EQ(back.height(), 19);
   ASSERT_EQ(back.channels(), 3);
@@ -55,7 +47,7 @@ TEST_F(ExrIoTest, MultiChannelRoundTripIsExact) {
       EXPECT_EQ(back.data()[i], img.data()[i]) << i;
     }
   }
-  const ExrImage all = ReadExr(Path("m.exr"));
+  const ExrImage all = ReadExr(scratch_.Path("m.exr"));
   ASSERT_EQ(all.channels.size(), 3u);
   EXPECT_EQ(all.channels[0], "A");
   EXPECT_EQ(all.pixels.at(7, 8, 0), img.at(7, 8, 2));
@@ -68,8 +60,8 @@ TEST_F(ExrIoTest, SingleChannelFromStridedViewAndCompressions) {
   for (ExrCompression c : {ExrCompression::kNone, ExrCompression::kZip, ExrCompression::kPiz}) {
     ExrWriteOptions options;
     options.compression = c;
-    WriteExr(Path("z.exr"), crop, {"Z"}, options);
-    const ImageF z = ReadExrChannels(Path("z.exr"), {"Z"});
+    WriteExr(scratch_.Path("z.exr"), crop, {"Z"}, options);
+    const ImageF z = ReadExrChannels(scratch_.Path("z.exr"), {"Z"});
     ASSERT_EQ(z.width(), 20);
     ASSERT_EQ(z.height(), 15);
     EXPECT_EQ(z.at(0, 0), big.at(10, 5));
@@ -81,8 +73,8 @@ TEST_F(ExrIoTest, HalfIsApproximate) {
   const ImageF img = Pattern(16, 8, 1);
   ExrWriteOptions options;
   options.pixel_type = ExrPixelType::kHalf;
-  WriteExr(Path("h.exr"), img, {"Y"}, options);
-  const ImageF back = ReadExrChannels(Path("h.exr"), {"Y"});
+  WriteExr(scratch_.Path("h.exr"), img, {"Y"}, options);
+  const ImageF back = ReadExrChannels(scratch_.Path("h.exr"), {"Y"});
   for (size_t i = 0; i < img.size(); ++i) {
     EXPECT_NEAR(back.data()[i], img.data()[i], 1e-3 * (1 + std::abs(img.data()[i])));
   }
@@ -90,25 +82,25 @@ TEST_F(ExrIoTest, HalfIsApproximate) {
 
 TEST_F(ExrIoTest, ErrorsNameTheFileAndLeaveNothingBehind) {
   const ImageF img = Pattern(4, 4, 2);
-  EXPECT_THROW(WriteExr(Path("a.exr"), img, {"Z"}), IoException);       // Count mismatch.
-  EXPECT_THROW(WriteExr(Path("a.exr"), img, {"Z", "Z"}), IoException);  // Repeated.
-  EXPECT_THROW(WriteExr(Path("nodir/a.exr"), img, {"X", "Y"}), IoException);
+  EXPECT_THROW(WriteExr(scratch_.Path("a.exr"), img, {"Z"}), IoException);       // Count mismatch.
+  EXPECT_THROW(WriteExr(scratch_.Path("a.exr"), img, {"Z", "Z"}), IoException);  // Repeated.
+  EXPECT_THROW(WriteExr(scratch_.Path("nodir/a.exr"), img, {"X", "Y"}), IoException);
   EXPECT_TRUE(fs::is_empty(dir_));
 
-  WriteExr(Path("b.exr"), img, {"X", "Y"});
+  WriteExr(scratch_.Path("b.exr"), img, {"X", "Y"});
   try {
-    ReadExrChannels(Path("b.exr"), {"X", "Z"});
+    ReadExrChannels(scratch_.Path("b.exr"), {"X", "Z"});
     FAIL() << "expected IoException";
   } catch (const IoException& e) {
-    EXPECT_EQ(std::string(e.what()), Path("b.exr") + ": OpenEXR channel 'Z' is missing");
+    EXPECT_EQ(std::string(e.what()), scratch_.Path("b.exr") + ": OpenEXR channel 'Z' is missing");
   }
-  WriteFileAtomic(Path("junk.exr"), "not an exr file");
-  EXPECT_THROW(ReadExr(Path("junk.exr")), IoException);
-  EXPECT_THROW(ReadExr(Path("missing.exr")), IoException);
+  WriteFileAtomic(scratch_.Path("junk.exr"), "not an exr file");
+  EXPECT_THROW(ReadExr(scratch_.Path("junk.exr")), IoException);
+  EXPECT_THROW(ReadExr(scratch_.Path("missing.exr")), IoException);
   // A truncated file is refused, not crashed on.
-  const std::string bytes = ReadFile(Path("b.exr"));
-  WriteFileAtomic(Path("cut.exr"), bytes.substr(0, bytes.size() / 2));
-  EXPECT_THROW(ReadExr(Path("cut.exr")), IoException);
+  const std::string bytes = ReadFile(scratch_.Path("b.exr"));
+  WriteFileAtomic(scratch_.Path("cut.exr"), bytes.substr(0, bytes.size() / 2));
+  EXPECT_THROW(ReadExr(scratch_.Path("cut.exr")), IoException);
 }
 
 }  // namespace

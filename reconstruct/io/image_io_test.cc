@@ -24,12 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class ImageIoTest : public ::testing::Test {
- protected:
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  casual3d::testing::ScratchDir scratch_{"image_io_test"};
-  const fs::path dir_ = scratch_.path();
-};
+class ImageIoTest : public casual3d::testing::TestWithScratchDir {};
 
 // A smooth colour ramp with a distinct value in each channel, 40x30.
 Image8 Ramp(int w = 40, int h = 30) {
@@ -46,8 +41,8 @@ Image8 Ramp(int w = 40, int h = 30) {
 
 TEST_F(ImageIoTest, PngRoundTripIsExactAndKeepsRgbOrder) {
   const Image8 img = Ramp();
-  WritePng(Path("a.png"), img.view());
-  const Image8 back = ReadImage(Path("a.png"));
+  WritePng(scratch_.Path("a.png"), img.view());
+  const Image8 back = ReadImage(scratch_.Path("a.png"));
   EXPECT_EQ(back, img);
   // Red grows with x: a BGR/RGB swap would put the ramp in channel 2.
   EXPECT_EQ(back.at(39, 0, 0), 255);
@@ -57,8 +52,8 @@ TEST_F(ImageIoTest, PngRoundTripIsExactAndKeepsRgbOrder) {
 TEST_F(ImageIoTest, GreyPngIsExpandedToRgb) {
   Image8 grey(8, 4, 1);
   for (int i = 0; i < 32; ++i) grey.data()[i] = static_cast<uint8_t>(i * 8);
-  WritePng(Path("g.png"), grey);
-  const Image8 back = ReadImage(Path("g.png"));
+  WritePng(scratch_.Path("g.png"), grey);
+  const Image8 back = ReadImage(scratch_.Path("g.png"));
   ASSERT_EQ(back.channels(), 3);
   for (int y = 0; y < 4; ++y)
     for (int x = 0; x < 8; ++x)
@@ -67,53 +62,53 @@ TEST_F(ImageIoTest, GreyPngIsExpandedToRgb) {
 
 TEST_F(ImageIoTest, JpegRoundTripIsCloseAndQualityMatters) {
   const Image8 img = Ramp(64, 48);
-  WriteJpeg(Path("hi.jpg"), img, {95});
-  WriteJpeg(Path("lo.jpg"), img, {30});
-  const Image8 back = ReadImage(Path("hi.jpg"));
+  WriteJpeg(scratch_.Path("hi.jpg"), img, {95});
+  WriteJpeg(scratch_.Path("lo.jpg"), img, {30});
+  const Image8 back = ReadImage(scratch_.Path("hi.jpg"));
   ASSERT_EQ(back.width(), 64);
   ASSERT_EQ(back.height(), 48);
   double sum = 0;
   for (size_t i = 0; i < img.size(); ++i) sum += std::abs(back.data()[i] - img.data()[i]);
   EXPECT_LT(sum / img.size(), 2.0);
-  EXPECT_LT(fs::file_size(Path("lo.jpg")), fs::file_size(Path("hi.jpg")));
+  EXPECT_LT(fs::file_size(scratch_.Path("lo.jpg")), fs::file_size(scratch_.Path("hi.jpg")));
   // Same pixels and quality give the same bytes.
-  WriteJpeg(Path("hi2.jpg"), img, {95});
-  EXPECT_EQ(ReadFile(Path("hi.jpg")), ReadFile(Path("hi2.jpg")));
+  WriteJpeg(scratch_.Path("hi2.jpg"), img, {95});
+  EXPECT_EQ(ReadFile(scratch_.Path("hi.jpg")), ReadFile(scratch_.Path("hi2.jpg")));
 }
 
 TEST_F(ImageIoTest, JpegQualityIsChecked) {
   const Image8 img = Ramp();
-  EXPECT_THROW(WriteJpeg(Path("q.jpg"), img, {0}), IoException);
-  EXPECT_THROW(WriteJpeg(Path("q.jpg"), img, {101}), IoException);
-  EXPECT_FALSE(fs::exists(Path("q.jpg")));
+  EXPECT_THROW(WriteJpeg(scratch_.Path("q.jpg"), img, {0}), IoException);
+  EXPECT_THROW(WriteJpeg(scratch_.Path("q.jpg"), img, {101}), IoException);
+  EXPECT_FALSE(fs::exists(scratch_.Path("q.jpg")));
 }
 
 TEST_F(ImageIoTest, GarbageIsNotADecodableImage) {
-  WriteFileAtomic(Path("junk.jpg"), "this is not an image at all");
+  WriteFileAtomic(scratch_.Path("junk.jpg"), "this is not an image at all");
   try {
-    ReadImage(Path("junk.jpg"));
+    ReadImage(scratch_.Path("junk.jpg"));
     FAIL() << "expected IoException";
   } catch (const IoException& e) {
-    EXPECT_EQ(std::string(e.what()), Path("junk.jpg") + ": not a decodable image");
+    EXPECT_EQ(std::string(e.what()), scratch_.Path("junk.jpg") + ": not a decodable image");
   }
-  WriteFileAtomic(Path("empty.png"), "");
-  EXPECT_THROW(ReadImage(Path("empty.png")), IoException);
+  WriteFileAtomic(scratch_.Path("empty.png"), "");
+  EXPECT_THROW(ReadImage(scratch_.Path("empty.png")), IoException);
 }
 
 TEST_F(ImageIoTest, MissingFileNamesThePath) {
   try {
-    ReadImage(Path("nope.jpg"));
+    ReadImage(scratch_.Path("nope.jpg"));
     FAIL() << "expected IoException";
   } catch (const IoException& e) {
-    EXPECT_NE(std::string(e.what()).find(Path("nope.jpg") + ": cannot open"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find(scratch_.Path("nope.jpg") + ": cannot open"), std::string::npos)
         << e.what();
   }
 }
 
 TEST_F(ImageIoTest, FailedWriteLeavesNothingBehind) {
   const Image8 img = Ramp();
-  EXPECT_THROW(WritePng(Path("no_such_dir/a.png"), img.view()), IoException);
-  EXPECT_THROW(WritePng(Path("two.png"), Image8(4, 4, 2)), IoException);
+  EXPECT_THROW(WritePng(scratch_.Path("no_such_dir/a.png"), img.view()), IoException);
+  EXPECT_THROW(WritePng(scratch_.Path("two.png"), Image8(4, 4, 2)), IoException);
   EXPECT_TRUE(fs::is_empty(dir_));
 }
 
@@ -137,22 +132,22 @@ std::string WithExifOrientation(const std::string& jpeg, int orientation) {
 TEST_F(ImageIoTest, ExifOrientationIsAppliedOnlyWhenAsked) {
   const Image8 img = Ramp(64, 32);
   const std::string jpeg = EncodeJpeg(img.view(), {95});
-  WriteFileAtomic(Path("rot.jpg"), WithExifOrientation(jpeg, 6));  // 6: rotate 90 clockwise.
-  const Image8 stored = ReadImage(Path("rot.jpg"));
+  WriteFileAtomic(scratch_.Path("rot.jpg"), WithExifOrientation(jpeg, 6));  // 6: rotate 90 clockwise.
+  const Image8 stored = ReadImage(scratch_.Path("rot.jpg"));
   EXPECT_EQ(stored.width(), 64);
   EXPECT_EQ(stored.height(), 32);
   ReadImageOptions options;
   options.apply_exif_orientation = true;
-  const Image8 upright = ReadImage(Path("rot.jpg"), options);
+  const Image8 upright = ReadImage(scratch_.Path("rot.jpg"), options);
   EXPECT_EQ(upright.width(), 32);
   EXPECT_EQ(upright.height(), 64);
 }
 
 TEST_F(ImageIoTest, MaxSideIsEnforced) {
-  WritePng(Path("big.png"), Ramp(40, 30));
+  WritePng(scratch_.Path("big.png"), Ramp(40, 30));
   ReadImageOptions options;
   options.max_side = 32;
-  EXPECT_THROW(ReadImage(Path("big.png"), options), IoException);
+  EXPECT_THROW(ReadImage(scratch_.Path("big.png"), options), IoException);
 }
 
 TEST_F(ImageIoTest, TruncatedJpegIsRefusedAndCompleteOnesPass) {
@@ -164,13 +159,13 @@ TEST_F(ImageIoTest, TruncatedJpegIsRefusedAndCompleteOnesPass) {
   EXPECT_EQ(w, 64);
   EXPECT_EQ(h, 48);
   // libjpeg alone decodes a cut file with grey where the data is missing.
-  WriteFileAtomic(Path("cut.jpg"), jpeg.substr(0, jpeg.size() * 2 / 3));
-  EXPECT_FALSE(JpegIsComplete(ReadFile(Path("cut.jpg"))));
+  WriteFileAtomic(scratch_.Path("cut.jpg"), jpeg.substr(0, jpeg.size() * 2 / 3));
+  EXPECT_FALSE(JpegIsComplete(ReadFile(scratch_.Path("cut.jpg"))));
   try {
-    ReadImage(Path("cut.jpg"));
+    ReadImage(scratch_.Path("cut.jpg"));
     FAIL() << "expected IoException";
   } catch (const IoException& e) {
-    EXPECT_NE(std::string(e.what()).find(Path("cut.jpg") + ": truncated JPEG"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find(scratch_.Path("cut.jpg") + ": truncated JPEG"), std::string::npos)
         << e.what();
   }
   // Bytes after the end-of-image marker (phone trailers) are fine.
@@ -180,19 +175,19 @@ TEST_F(ImageIoTest, TruncatedJpegIsRefusedAndCompleteOnesPass) {
 
 TEST_F(ImageIoTest, LargeJpegIsDecodedDownscaled) {
   const Image8 img = Ramp(800, 600);
-  WriteFileAtomic(Path("big.jpg"), WithExifOrientation(EncodeJpeg(std::as_const(img).view(), {90}), 6));
+  WriteFileAtomic(scratch_.Path("big.jpg"), WithExifOrientation(EncodeJpeg(std::as_const(img).view(), {90}), 6));
   ReadImageOptions options;
   options.apply_exif_orientation = true;
   options.min_decoded_pixels = 100 * 75;  // 800x600 / 8 per side still has that many.
   DecodedImageInfo info;
-  const Image8 small = ReadImage(Path("big.jpg"), options, &info);
+  const Image8 small = ReadImage(scratch_.Path("big.jpg"), options, &info);
   EXPECT_EQ(info.reduction, 8);
   EXPECT_EQ(small.width(), 75);  // Turned upright by the orientation.
   EXPECT_EQ(small.height(), 100);
   EXPECT_EQ(info.full_width, 600);
   EXPECT_EQ(info.full_height, 800);
   options.min_decoded_pixels = 300 * 220;  // Only halving keeps that many.
-  EXPECT_EQ(ReadImage(Path("big.jpg"), options, &info).width(), 300);
+  EXPECT_EQ(ReadImage(scratch_.Path("big.jpg"), options, &info).width(), 300);
   EXPECT_EQ(info.reduction, 2);
 }
 
@@ -200,11 +195,11 @@ TEST_F(ImageIoTest, SixteenBitPngAndTiffAreRead) {
   cv::Mat deep(30, 40, CV_16UC3);
   for (int y = 0; y < 30; ++y)
     for (int x = 0; x < 40; ++x) deep.at<cv::Vec3w>(y, x) = cv::Vec3w(0, y * 2000, x * 1600);
-  ASSERT_TRUE(cv::imwrite(Path("deep.png"), deep));
-  ASSERT_TRUE(cv::imwrite(Path("deep.tif"), deep));
+  ASSERT_TRUE(cv::imwrite(scratch_.Path("deep.png"), deep));
+  ASSERT_TRUE(cv::imwrite(scratch_.Path("deep.tif"), deep));
   for (const char* name : {"deep.png", "deep.tif"}) {
     DecodedImageInfo info;
-    const Image8 back = ReadImage(Path(name), {}, &info);
+    const Image8 back = ReadImage(scratch_.Path(name), {}, &info);
     ASSERT_EQ(back.width(), 40) << name;
     // Scaled from 16 to 8 bits: 39 * 1600 / 257 = 242.8 in red (OpenCV's BGR blue).
     EXPECT_NEAR(back.at(39, 0, 0), 243, 1) << name;

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/testing/scratch_dir.h"
 #include "encoder/master_file.h"
 #include "format/equirect.h"
 #include "reconstruct/geometry/colmap_model.h"
@@ -21,17 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class SynthTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("casual3d_synth_test_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
-};
+class SynthTest : public casual3d::testing::TestWithScratchDir {};
 
 SynthOptions Small() {
   SynthOptions o;
@@ -58,9 +49,9 @@ TEST_F(SynthTest, SameSeedGivesSameBytesWhateverTheThreads) {
   a.num_threads = 1;
   SynthOptions b = a;
   b.num_threads = 2;
-  GenerateCapture(a, Path("a"));
-  GenerateCapture(b, Path("b"));
-  const auto fa = Files(Path("a")), fb = Files(Path("b"));
+  GenerateCapture(a, scratch_.Path("a"));
+  GenerateCapture(b, scratch_.Path("b"));
+  const auto fa = Files(scratch_.Path("a")), fb = Files(scratch_.Path("b"));
   // 4 photos + 4 depth maps + 6 model files + panorama + master + capture.json.
   ASSERT_EQ(fa.size(), 17u);
   for (const char* name : {"images/0000.jpg", "images/0003.jpg", "depth/0000.exr",
@@ -75,10 +66,10 @@ TEST_F(SynthTest, SameSeedGivesSameBytesWhateverTheThreads) {
 TEST_F(SynthTest, DifferentSeedGivesDifferentPhotos) {
   SynthOptions a = Small(), b = Small();
   b.seed = 2;
-  GenerateCapture(a, Path("a"));
-  GenerateCapture(b, Path("b"));
+  GenerateCapture(a, scratch_.Path("a"));
+  GenerateCapture(b, scratch_.Path("b"));
   for (const char* name : {"images/0000.jpg", "images/0002.jpg", "depth/0001.exr"}) {
-    EXPECT_NE(io::ReadFile(Path(std::string("a/") + name)), io::ReadFile(Path(std::string("b/") + name)))
+    EXPECT_NE(io::ReadFile(scratch_.Path(std::string("a/") + name)), io::ReadFile(scratch_.Path(std::string("b/") + name)))
         << name;
   }
 }
@@ -87,8 +78,8 @@ TEST_F(SynthTest, OptionsAreChecked) {
   SynthOptions o = Small();
   o.panorama_width = 1001;
   EXPECT_NE(o.Check().message().find("--panorama-width"), std::string::npos);
-  EXPECT_THROW(GenerateCapture(o, Path("bad")), std::invalid_argument);
-  EXPECT_FALSE(fs::exists(Path("bad")));
+  EXPECT_THROW(GenerateCapture(o, scratch_.Path("bad")), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(scratch_.Path("bad")));
   o = Small();
   o.noise_sigma = -1;
   EXPECT_NE(o.Check().message().find("--noise"), std::string::npos);
@@ -129,7 +120,7 @@ TEST_F(SynthTest, GroundTruthIsConsistent) {
   o.exposure_jitter_stops = 0;
   o.panorama_width = 1024;
   o.sparse_step_px = 16;
-  const std::string cap = Path("cap");
+  const std::string cap = scratch_.Path("cap");
   GenerateCapture(o, cap);
   const geometry::SparseModel model = geometry::ReadModel(cap + "/sparse");
   ASSERT_EQ(model.images.size(), 6u);
