@@ -14,7 +14,7 @@ void ThrowIfError(const Status& status, const std::string& path) {
     case StatusCode::kInvalidArgument:
       throw std::invalid_argument(message);
     case StatusCode::kIoError:
-      throw IoError(message);
+      throw IoException(message);
     default:
       throw FormatError(message);
   }
@@ -25,7 +25,7 @@ void RegisterErrors(pybind11::module_& m) {
   pybind11::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
-    } catch (const IoError& e) {
+    } catch (const IoException& e) {
       PyErr_SetString(PyExc_OSError, e.what());
     }
   });

@@ -25,7 +25,7 @@ class FormatError : public std::runtime_error {
 };
 
 // Thrown for kIoError.
-class IoError : public std::runtime_error {
+class IoException : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
