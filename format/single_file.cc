@@ -98,7 +98,8 @@ StatusOr<std::vector<SingleFileEntry>> ParseSingleFileDirectory(const uint8_t* d
     e.size = GetLE(data + pos + 8, 8);
     pos += 16;
     if (!IsSafePackagePath(e.path) && checks.on(ReaderCheck::kPathEscape))
-      return InvalidData(where + ": unsafe path \"" + e.path.substr(0, 80) + "\"");
+      return InvalidData(where + ": \"" + e.path.substr(0, 80) +
+                         "\" is not a safe relative path inside the package");
     if (!seen.insert(e.path).second && checks.on(ReaderCheck::kDuplicateEntry))
       return InvalidData(where + ": duplicate path \"" + e.path + "\"");
     if ((e.offset > size || e.size > size - e.offset) && checks.on(ReaderCheck::kEntryOutsideFile))

@@ -88,7 +88,7 @@ export class Casual3dPackage {
       onFile?.(bytes, file.path);
       const image = await this.decode(bytes, file.path);
       if (image.width !== file.width || image.height !== file.height) {
-        throw new Error(`${file.path}: ${image.width}x${image.height} pixels, expected ${file.width}x${file.height}`);
+        throw new Error(`${file.path}: ${file.kind} image is ${image.width}x${image.height}, expected ${file.width}x${file.height}`);
       }
       this.reader.addImage(level, t, kind, image.data, image.width, image.height, 4);
     });
