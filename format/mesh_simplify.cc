@@ -141,7 +141,8 @@ class LayerPyramid {
   size_t Index(int k, int bx, int by) const { return static_cast<size_t>(by) * nx_[k] + bx; }
   double Error(int k, int bx, int by) const { return error_[k][Index(k, bx, by)]; }
   // Error(k, bx, by) for bx = 0 .. nx(k) - 1.
-  const double* ErrorRow(int k, int by) const { return &error_[k][Index(k, 0, by)]; }
+  // (data() + offset: a level may have rows but no columns, its vector empty.)
+  const double* ErrorRow(int k, int by) const { return error_[k].data() + Index(k, 0, by); }
   // Whether pixel quad (x, y) has four nodes of this layer linked around it.
   bool FullQuad(int x, int y) const { return full_[static_cast<size_t>(y) * nx_[0] + x] != 0; }
   // FullQuad(x, y) for x = 0 .. width - 1 (1 or 0 per quad).
@@ -507,13 +508,13 @@ void AddSavings(const LayerPyramid& py, const StepOf& step_of, int threads,
       std::vector<int64_t>& out = partial[c];
       for (int by = static_cast<int>(row_begin); by < row_end; ++by) {
         const double* error = py.ErrorRow(k, by);
-        int8_t* steps = &block_steps[static_cast<size_t>(by) * nx];
+        int8_t* steps = block_steps.data() + static_cast<size_t>(by) * nx;
         // Blocks with a parent: columns below parent_nx in a row below the
         // parent level's last row.
         const bool parent_row = k < py.levels() && by / 2 < py.ny(k + 1);
         const int parent_nx = parent_row ? py.nx(k + 1) : 0;
         const int8_t* parents =
-            parent_row ? &parent_steps[static_cast<size_t>(by / 2) * parent_nx] : nullptr;
+            parent_row ? parent_steps.data() + static_cast<size_t>(by / 2) * parent_nx : nullptr;
         for (int bx = 0; bx < nx; ++bx) {
           const int last = step_of(error[bx]);
           if (last < 0) continue;

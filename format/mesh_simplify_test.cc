@@ -184,6 +184,30 @@ TEST(MeshSimplifyTest, SphereSimplifiesWithinTheBound) {
   }
 }
 
+// A panorama narrower than the largest block (4 x 32, blocks up to 8 x 8
+// quads by height) has block levels with rows but no columns. Their rows were
+// addressed through element 0 of empty vectors, undefined behaviour that the
+// mesh builder fuzzer found under UndefinedBehaviorSanitizer; this test fails
+// there (the sanitizers of format/fuzz/CMakeLists.txt) if it comes back.
+TEST(MeshSimplifyTest, PanoramaNarrowerThanItsBlockLevels) {
+  const TwoLayerPanorama p = testing::MakeSpherePanorama(4, 32, 2.0f);
+  MeshSimplifyOptions o;
+  o.max_triangles = 0;
+  o.max_relative_error = 0.05;
+  auto s = BuildSimplifiedMesh(p, o);
+  ASSERT_TRUE(s.ok()) << s.status().ToString();
+  auto fine = BuildMesh(p);
+  ASSERT_TRUE(fine.ok());
+  EXPECT_EQ(s->full_triangles, static_cast<int64_t>(fine->num_triangles()));
+  EXPECT_LE(s->mesh.num_triangles(), fine->num_triangles());
+  EXPECT_GT(s->mesh.num_triangles(), 0u);
+  CheckFacesCentre(s->mesh);
+  o.max_triangles = 10;  // The budget search visits every level too.
+  s = BuildSimplifiedMesh(p, o);
+  ASSERT_TRUE(s.ok()) << s.status().ToString();
+  CheckFacesCentre(s->mesh);
+}
+
 TEST(MeshSimplifyTest, PlanarRoomMergesLargeBlocks) {
   const int w = 256, h = 128;
   testing::RoomOptions room;
