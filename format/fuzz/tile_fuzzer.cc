@@ -1,13 +1,34 @@
 // Fuzz target (format/fuzz/CMakeLists.txt): DecodeTileImage of a raw image
-// whose size, kind, quantization, checks and pixels come from the input, then FinishDecodedPanorama and
-// TwoLayerPanorama::Validate; and WebpContainerCoding of the input's bytes.
+// whose size, kind, quantization, checks and pixels come from the input, then FinishDecodedPanorama
+// and TwoLayerPanorama::Validate; and WebpContainerCoding of the input's bytes.
 
 #include <algorithm>
+#include <map>
+#include <memory>
+#include <tuple>
 
 #include "format/tile_codec.h"
 
 namespace casual3d::fuzz {
 namespace {
+
+// The decoder of (depth bits, normal bits, check switched off, or
+// kNumReaderChecks for none). Building one fills two tables of 65536
+// entries, which took most of each input's time (about 60 inputs a second
+// under the sanitizers); a decoder is immutable, so the last 64 built are
+// kept (at most 64 MB).
+const TileDecoder& CachedDecoder(const TileQuantization& q, int check_off) {
+  static std::map<std::tuple<int, int, int>, std::unique_ptr<TileDecoder>> cache;
+  const auto key = std::make_tuple(q.depth.bits, q.normal.bits, check_off);
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    if (cache.size() >= 64) cache.clear();
+    ReaderChecks checks;
+    if (check_off < kNumReaderChecks) checks.Disable(static_cast<ReaderCheck>(check_off));
+    it = cache.emplace(key, std::make_unique<TileDecoder>(q, checks)).first;
+  }
+  return *it->second;
+}
 
 // Input layout: byte 0 kind (mod 4), byte 1 tile width 1..32, byte 2 tile
 // height 1..32, byte 3 channels (3 or 4), byte 4 depth bits, byte 5 normal
@@ -30,9 +51,9 @@ int FuzzTileDecode(const uint8_t* data, size_t size) {
   Image8 image(iw, ih, channels, 0);
   std::copy_n(data + 7, std::min(size - 7, image.size()), image.data());
   TwoLayerPanorama pano(48, 40);
-  ReaderChecks checks;
-  if ((data[6] >> 2) < kNumReaderChecks) checks.Disable(static_cast<ReaderCheck>(data[6] >> 2));
-  const TileDecoder decoder(q, checks);
+  const int check_off = std::min(data[6] >> 2, kNumReaderChecks);
+  const TileDecoder& decoder = CachedDecoder(q, check_off);
+  const ReaderChecks& checks = decoder.checks();
   const Image8& const_image = image;
   Status s = DecodeTileImage(const_image.view(), kind, 8, 4, w, h, decoder, &pano);
   if (s.ok() && FinishDecodedPanorama(&pano, 1, checks).ok()) (void)pano.Validate();
