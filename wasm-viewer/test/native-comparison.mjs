@@ -63,10 +63,13 @@ export function psnr(glRgba, rgb, width, height) {
   return mse === 0 ? Infinity : 10 * Math.log10((255 * 255) / mse);
 }
 
-/** The pixels (RGBA, bottom row first) of the canvas of viewer #v in `page` after its next frame. */
+/**
+ * The pixels (RGBA, bottom row first) of the viewer's canvas in `page` after
+ * its next frame: window.viewer (a viewer-core page), else element #v's.
+ */
 export async function readCanvas(page) {
   const b64 = await page.evaluate(async () => {
-    const v = document.getElementById('v').viewer;
+    const v = window.viewer ?? document.getElementById('v').viewer;
     await v.nextFrame();
     const gl = v.renderer.gl;
     const px = new Uint8Array(gl.drawingBufferWidth * gl.drawingBufferHeight * 4);

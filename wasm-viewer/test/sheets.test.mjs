@@ -15,7 +15,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { after, before, test } from 'node:test';
 
-import { psnr, readPpm } from './native-comparison.mjs';
+import { psnr, readCanvas, readPpm } from './native-comparison.mjs';
 import { BINARY_DIR, DIST_DIR, copyPackageWithView, runTool } from './node-support.mjs';
 import { chromiumArgs, chromiumOrSkip, startServer, viewerCorePage } from './static-server.mjs';
 
@@ -65,21 +65,13 @@ async function frame(name, camera) {
   await page.goto(`${server.url}/${name}.html`);
   await page.waitForFunction(() => window.loaded, null, { timeout: 300000 });
   await page.evaluate(() => window.loaded);
-  const b64 = await page.evaluate(async (c) => {
-    const v = window.viewer;
-    v.setCamera(c);
-    await v.nextFrame();
-    await v.nextFrame();
-    const gl = v.renderer.gl;
-    const px = new Uint8Array(gl.drawingBufferWidth * gl.drawingBufferHeight * 4);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    gl.readPixels(0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight, gl.RGBA, gl.UNSIGNED_BYTE, px);
-    let s = '';
-    for (let i = 0; i < px.length; i += 0x8000) s += String.fromCharCode.apply(null, px.subarray(i, i + 0x8000));
-    return btoa(s);
+  await page.evaluate(async (c) => {
+    window.viewer.setCamera(c);
+    await window.viewer.nextFrame();
   }, camera);
+  const pixels = await readCanvas(page);
   await page.screenshot({ path: path.join(OUT, `${name}_${camera.position[0] === 0 ? 'centre' : 'side'}.png`) });
-  return new Uint8Array(Buffer.from(b64, 'base64'));
+  return pixels;
 }
 
 /** Pixels whose RGB differs by more than 24 levels in some channel. */
