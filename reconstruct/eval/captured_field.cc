@@ -200,7 +200,6 @@ Image8 CapturedField::Mask(const render::PinholeView& view,
   render::RenderOptions o = options;
   o.color_source = render::ColorSource::kVertexColors;
   o.want_triangle_ids = false;
-  o.vertex_colors_from_triangle = UINT64_MAX;
   o.sheet_stretch = 0;  // The field's proxy surface is drawn whole.
   return render::RenderMesh(proxy_, {}, view, o).mask;
 }

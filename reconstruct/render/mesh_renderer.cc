@@ -241,10 +241,10 @@ class Rasterizer {
       ScreenVertex poly[kMaxPolygon];
       const size_t end = std::min(num_triangles, static_cast<size_t>((chunk + 1) * kChunk));
       for (size_t t = static_cast<size_t>(chunk * kChunk); t < end; ++t) {
-        if (HiddenSheet(t)) continue;
         const int count = ClipAndProject(t, poly);
         int first, last;
         if (count < 3 || !RowRange(poly, count, &first, &last)) continue;
+        if (HiddenSheet(t)) continue;  // Tested only for triangles in view.
         for (int band = first / kBandRows; band <= last / kBandRows; ++band) {
           lists[band].push_back(static_cast<uint32_t>(t));
         }

@@ -85,7 +85,12 @@ bool hiddenSheet() {
   return a > 0.0 && big > 2.0 * c * uSheetStretch * uSheetStretch;
 }
 void main() {
-  if (uSheetStretch > 0.0 && vColor.a < 0.5 && hiddenSheet()) discard;
+  // The derivatives are taken in uniform control flow (uSheetStretch is a
+  // uniform), before the per-triangle test of the backdrop's colour.
+  if (uSheetStretch > 0.0) {
+    bool sheet = hiddenSheet();
+    if (sheet && vColor.a < 0.5) discard;
+  }
   vec3 albedo = vColor.a > 0.5 ? vColor.rgb : texture(uAtlas, vUv).rgb;
   vec3 color = albedo;
   // Unlit where the node has no normal (sky): interpolated length drops below 0.5.
