@@ -1,7 +1,7 @@
 // `casual3d evaluate <capture> <3d-photo> [more 3d photos] [-o report.html]
 // [--json out.json] [--width 900] [--photos names...] [--holdout-every N]
 // [--labels names...] [--reference NAME:PSNR:SSIM] [--no-viewer-views] [--no-backdrop]
-// [--viewer-width 640] [--viewer-height 400] [--viewer-images DIR]
+// [--viewer-width 640] [--viewer-height 400] [--viewer-images DIR] [--rephoto-images DIR]
 // [--write-cameras cameras.json] [--rendered DIR]`:
 // virtual rephotography (paper Sec. 6.3) of one or more 3D photos of the same
 // capture and what a viewer sees of each (tears, stretched fill), with a
@@ -21,6 +21,7 @@
 #include "reconstruct/eval/report.h"
 #include "reconstruct/eval/viewer_views_report.h"
 #include "reconstruct/io/file_util.h"
+#include "reconstruct/io/image_io.h"
 
 namespace casual3d::cli {
 
@@ -37,6 +38,7 @@ void AddEvaluateCommand(CLI::App& app) {
     bool no_viewer_views = false;
     bool no_backdrop = false;
     std::string viewer_images;
+    std::string rephoto_images;
     std::string write_cameras;
   };
   auto args = std::make_shared<Args>();
@@ -101,6 +103,10 @@ void AddEvaluateCommand(CLI::App& app) {
   cmd->add_option("--viewer-images", args->viewer_images,
                   "Also write each viewer view's heatmap and their grid as PNG files to this "
                   "folder (prefixed with the 3D photo's number)");
+  cmd->add_option("--rephoto-images", args->rephoto_images,
+                  "Also write each evaluated photo and its rephotograph, at the evaluated size, "
+                  "as PNG files to this folder (<3D photo number>_<photo stem>_photo.png and "
+                  "_render.png)");
   cmd->add_option("--write-cameras", args->write_cameras,
                   "Also write the evaluated photos' cameras as JSON (OpenGL view and projection "
                   "matrices in the panorama frame, which is glTF's) for rendering them elsewhere; "
@@ -165,6 +171,18 @@ void AddEvaluateCommand(CLI::App& app) {
           eval::WriteViewerHeatmaps(*e.viewer, args->viewer_images, std::to_string(k) + "_");
           std::printf("  viewer heatmaps: %s/%zu_viewer_*.png\n", args->viewer_images.c_str(), k);
         }
+      }
+      if (!args->rephoto_images.empty()) {
+        std::filesystem::create_directories(args->rephoto_images);
+        for (const eval::PhotoEvaluation& q : e.photos) {
+          const std::string stem = (std::filesystem::path(args->rephoto_images) /
+                                    (std::to_string(k) + "_" +
+                                     std::filesystem::path(q.name).stem().string()))
+                                       .string();
+          io::WritePng(stem + "_photo.png", q.photo);
+          io::WritePng(stem + "_render.png", q.render);
+        }
+        std::printf("  rephotographs: %s/%zu_*_render.png\n", args->rephoto_images.c_str(), k);
       }
       for (const eval::PhotoEvaluation& q : e.photos)
         std::printf(

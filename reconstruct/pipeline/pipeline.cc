@@ -30,8 +30,9 @@ using Clock = std::chrono::steady_clock;
 // sparse-4, dense-5, panorama-7: the key lists every field of the stage's
 // options from their description (util::FieldsKeyText; pipeline.h, "Cache
 // key"); panorama-7 also takes over the version (panorama-6) the panorama key
-// text used to carry.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-4", "dense-5", "panorama-7",
+// text used to carry. panorama-8: stitched colour and depth blended across
+// the photos that agree (spec/stage-panorama.md, version 7).
+constexpr const char* kStageVersions[kNumStages] = {"sparse-4", "dense-5", "panorama-8",
                                                     "encode-2"};
 
 std::string HashHex(const std::string& text) {

@@ -241,8 +241,29 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
       int lx, ly;
       layer.ToCrop(x, y, W, &lx, &ly);
       out.label.at(x, y) = static_cast<int16_t>(best);
-      out.depth_m.at(x, y) = layer.depth_m.at(lx, ly);
-      for (int c = 0; c < 3; ++c) out.rgb.at(x, y, c) = layer.rgb.at(lx, ly, c);
+      const float depth = layer.depth_m.at(lx, ly);
+      out.depth_m.at(x, y) = depth;
+      // Blending: the mean colour and the geometric mean depth of the warps
+      // that agree with the chosen one, stretched fragments weighing less.
+      if (!(options.blend_depth_tolerance > 0)) {
+        for (int c = 0; c < 3; ++c) out.rgb.at(x, y, c) = layer.rgb.at(lx, ly, c);
+        continue;
+      }
+      double sum[3] = {0, 0, 0}, weight = 0, dsum = 0;
+      for (int l = 0; l < L; ++l) {
+        const warp::WarpedLayer& other = back ? full[l].back : full[l].front;
+        int ox, oy;
+        if (!other.ToCrop(x, y, W, &ox, &oy)) continue;
+        const float d = other.depth_m.at(ox, oy);
+        if (!(d > 0) || std::abs(d - depth) > options.blend_depth_tolerance * depth) continue;
+        const double w = std::exp(-kUpsampleStretchWeight * other.stretch.at(ox, oy));
+        for (int c = 0; c < 3; ++c) sum[c] += w * other.rgb.at(ox, oy, c);
+        dsum += w * std::log(d);
+        weight += w;
+      }
+      out.depth_m.at(x, y) = static_cast<float>(std::exp(dsum / weight));
+      for (int c = 0; c < 3; ++c)
+        out.rgb.at(x, y, c) = static_cast<uint8_t>(std::clamp(std::lround(sum[c] / weight), 0L, 255L));
     }
   });
   return out;

@@ -58,6 +58,13 @@ struct StitchOptions {
   // the (2 r + 1)^2 solve-resolution pixels around it.
   int upsample_radius = 1;
   double upsample_sigma_color = 20.0;  // 8-bit colour units; > 0.
+  // Blending: a pixel's colour is the mean, and its depth the geometric
+  // mean, of the warps (of this layer) whose depth there is within this
+  // relative tolerance of the chosen label's, each weighted by exp(-6 s)
+  // against stretched fragments: exposure differences and seams average
+  // out, and so does the depth maps' independent noise. The label stays the
+  // chosen photo. 0 keeps the chosen label's colour and depth alone.
+  double blend_depth_tolerance = 0.03;
 
   AlphaExpansionOptions solver;
 
@@ -79,6 +86,8 @@ struct StitchOptions {
     v.Field("back_tolerance", o.back_tolerance, R::ClosedOpen(0, 1), "Back may be this much (relative) in front of the front");
     v.Field("upsample_radius", o.upsample_radius, R::Closed(0, 4), "Label upsampling radius, solve-resolution pixels");
     v.Field("upsample_sigma_color", o.upsample_sigma_color, R::Above(0), "Label upsampling colour sigma, 8-bit units");
+    v.Field("blend_depth_tolerance", o.blend_depth_tolerance, R::ClosedOpen(0, 1),
+            "Colour and depth are the means of the warps within this relative depth of the label's; 0: the label's alone");
     v.Struct("solver", o.solver);
     v.Require(o.solve_width == 2 * o.solve_height, "solve_width", "must be 2 * solve_height");
   }

@@ -99,6 +99,63 @@ TEST(StitchTest, FrontAndBackLayersMatchTheScene) {
   EXPECT_GE(front.energy, 0.0);
 }
 
+TEST(StitchTest, BlendingAveragesTheWarpsThatAgreeInDepth) {
+  wt::SquareScene scene;
+  Capture cap = MakeCapture(scene);
+  // Photo i is brighter by 12 i in red (an exposure difference); photo 0 also
+  // has a floater: near depth and red 250 on a patch of the background.
+  for (int i = 0; i < 4; ++i)
+    for (int y = 0; y < 240; ++y)
+      for (int x = 0; x < 320; ++x) cap.rgb[i].at(x, y, 0) += static_cast<uint8_t>(12 * i);
+  for (int y = 30; y < 60; ++y) {
+    for (int x = 250; x < 290; ++x) {
+      cap.depth[0].at(x, y) *= 0.5f;
+      cap.rgb[0].at(x, y, 0) = 250;
+    }
+  }
+  StitchOptions options;
+  options.solve_width = 256;
+  options.solve_height = 128;
+  const int W = 1024;
+  const auto full = Warp(cap, W);
+  const auto coarse = Warp(cap, options.solve_width);
+  options.blend_depth_tolerance = 0;
+  const StitchedLayer single = StitchFront(full, coarse, cap.geometry, W, options);
+  options.blend_depth_tolerance = 0.03;
+  const StitchedLayer blended = StitchFront(full, coarse, cap.geometry, W, options);
+
+  // On the background plane seen by all four photos, away from the square and
+  // the floater, the depth is the plane's and the blended red is the plain scene's (10) plus the mean
+  // offset (18); unblended, it is one photo's (10 + 12 i).
+  int checked = 0, near_mean = 0, single_is_one_photo = 0;
+  for (int y = 230; y < 282; ++y) {
+    for (int x = 440; x < 584; ++x) {
+      const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, W, W / 2);
+      if (wt::SquareSceneRadialDepth(scene, d) < 3.0) continue;
+      const double truth = wt::SquareSceneRadialDepth(scene, d);
+      ASSERT_NEAR(blended.depth_m.at(x, y), truth, 0.01 * truth) << x << "," << y;
+      int seen = 0;
+      for (const warp::WarpedView& v : full) {
+        int cx, cy;
+        seen += v.front.ToCrop(x, y, W, &cx, &cy) && v.front.depth_m.at(cx, cy) > 0;
+      }
+      if (seen < 4) continue;
+      ++checked;
+      near_mean += std::abs(blended.rgb.at(x, y, 0) - 28) <= 3;
+      const int s = single.rgb.at(x, y, 0) - 10;
+      single_is_one_photo += s >= -1 && s <= 37 && (s + 1) % 12 <= 2;
+    }
+  }
+  ASSERT_GT(checked, 500);
+  EXPECT_GT(near_mean, checked * 95 / 100);
+  EXPECT_GT(single_is_one_photo, checked * 95 / 100);
+  // The floater's colour never reaches the blended background: photo 0's
+  // warp there is at half the depth, outside the tolerance.
+  for (int y = 0; y < W / 2; ++y)
+    for (int x = 0; x < W; ++x)
+      if (blended.depth_m.at(x, y) > 3.0f) ASSERT_LT(blended.rgb.at(x, y, 0), 60) << x << "," << y;
+}
+
 TEST(StitchTest, OptionsAreChecked) {
   StitchOptions options;
   EXPECT_TRUE(options.Check().ok());
@@ -106,6 +163,9 @@ TEST(StitchTest, OptionsAreChecked) {
   EXPECT_FALSE(options.Check().ok());
   options = StitchOptions();
   options.gc_depth_tolerance = 0;
+  EXPECT_FALSE(options.Check().ok());
+  options = StitchOptions();
+  options.blend_depth_tolerance = 1;
   EXPECT_FALSE(options.Check().ok());
 }
 

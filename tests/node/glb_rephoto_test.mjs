@@ -39,9 +39,14 @@ const wholeFrame = (out) => {
 casual3d('synth', '--width', '192', '--photos', '4', '--panorama-width', '1024', '-o', 'capture');
 casual3d('encode', 'capture/ground_truth/master.exr', '-o', 'package', '--no-viewer');
 const evaluate = ['evaluate', 'capture', 'package', '--width', '192', '--no-viewer-views'];
-const native = wholeFrame(casual3d(...evaluate, '--write-cameras', 'cameras.json', '-o', 'native.html'));
+const native = wholeFrame(casual3d(...evaluate, '--write-cameras', 'cameras.json', '-o', 'native.html',
+  '--rephoto-images', 'rephotos'));
 const cameras = JSON.parse(fs.readFileSync(path.join(work, 'cameras.json'), 'utf8'));
 assert.equal(cameras.cameras.length, 4);
+// --rephoto-images: each evaluated photo and its rephotograph as PNG.
+const rephotos = fs.readdirSync(path.join(work, 'rephotos')).sort();
+assert.equal(rephotos.filter((f) => /^0_.+_render\.png$/.test(f)).length, 4, rephotos.join(' '));
+assert.equal(rephotos.filter((f) => /^0_.+_photo\.png$/.test(f)).length, 4, rephotos.join(' '));
 console.log(`native: ${JSON.stringify(native)}`);
 
 for (const draco of [false, true]) {
