@@ -11,11 +11,16 @@
 //
 // Also prints the candidate as a row of docs/PERFORMANCE.md's table, and can
 // write the candidate package as a folder (for `casual3d evaluate`).
+// --against OTHER.exr encodes the reference package from another master of
+// the same capture (today's, when the panorama stage changes), so that the
+// errors are those of the new master and its encoding together, over the
+// nodes both have.
 //
 //   build/bench/package_budget MASTER.exr [--normal-bits B] [--depth-bits B]
 //       [--lossless-effort F] [--lossless-method M] [--tile-size T]
 //       [--color-quality Q] [--color-method M] [--no-fill-absent]
 //       [--reference-only] [--shading out.png] [--write-package DIR]
+//       [--against OTHER.exr]
 
 #include <algorithm>
 #include <chrono>
@@ -135,7 +140,10 @@ void PrintErrors(int level, const TwoLayerPanorama& reference, const TwoLayerPan
     const LayerData& R = reference.layer(l);
     const LayerData& C = candidate.layer(l);
     for (size_t i = 0; i < R.present.size(); ++i) {
-      if (!R.present[i]) continue;
+      if (!R.present[i] || !C.present[i]) continue;
+      // The same surface only: depths more than 2% apart happen only against
+      // another master (--against), where the node may be another surface.
+      if (master == nullptr && std::fabs(C.depth_m[i] / R.depth_m[i] - 1.0f) > 0.02f) continue;
       const float* nr = &R.normal[3 * i];
       if (nr[0] != 0 || nr[1] != 0 || nr[2] != 0) {
         normal_deg.push_back(static_cast<float>(AngleDeg(nr, &C.normal[3 * i])));
@@ -180,11 +188,12 @@ int Main(int argc, char** argv) {
     std::fprintf(stderr, "usage: package_budget MASTER.exr [--normal-bits B] [--depth-bits B] "
                          "[--lossless-effort F] [--lossless-method M] [--tile-size T] "
                          "[--color-quality Q] [--color-method M] [--no-fill-absent] "
-                         "[--reference-only] [--shading out.png] [--write-package DIR]\n");
+                         "[--reference-only] [--shading out.png] [--write-package DIR] "
+                         "[--against OTHER.exr]\n");
     return 2;
   }
   encoder::PackageOptions candidate = encoder::DeliveryPackageOptions();
-  std::string shading, package_dir;
+  std::string shading, package_dir, against;
   bool reference_only = false;
   for (int a = 2; a < argc; ++a) {
     const std::string arg = argv[a];
@@ -200,6 +209,7 @@ int Main(int argc, char** argv) {
     else if (arg == "--no-fill-absent") candidate.fill_absent = false;
     else if (arg == "--shading" && has_value) shading = argv[++a];
     else if (arg == "--write-package" && has_value) package_dir = argv[++a];
+    else if (arg == "--against" && has_value) against = argv[++a];
     else {
       std::fprintf(stderr, "package_budget: unknown or incomplete option %s\n", arg.c_str());
       return 2;
@@ -214,7 +224,19 @@ int Main(int argc, char** argv) {
     std::fprintf(stderr, "package_budget: %s\n", master.status().ToString().c_str());
     return 1;
   }
-  const Encoded reference = EncodeAndDecode(*master, encoder::PackageOptions());
+  StatusOr<TwoLayerPanorama> other =
+      against.empty() ? StatusOr<TwoLayerPanorama>(TwoLayerPanorama()) : encoder::ReadMasterFile(against);
+  if (!other.ok()) {
+    std::fprintf(stderr, "package_budget: --against: %s\n", other.status().ToString().c_str());
+    return 1;
+  }
+  if (!against.empty() && (other->width() != master->width() || other->height() != master->height())) {
+    std::fprintf(stderr, "package_budget: --against %s: %dx%d, but the master is %dx%d (give a master of the same size)\n",
+                 against.c_str(), other->width(), other->height(), master->width(), master->height());
+    return 2;
+  }
+  const Encoded reference =
+      EncodeAndDecode(against.empty() ? *master : *other, encoder::PackageOptions());
   if (reference_only) {
     PrintSizes("reference", reference);
     return 0;
@@ -237,7 +259,7 @@ int Main(int argc, char** argv) {
   }
   for (size_t l = 0; l < encoded.levels.size(); ++l)
     PrintErrors(static_cast<int>(l), reference.levels[l], encoded.levels[l],
-                l == 0 ? &*master : nullptr);
+                l == 0 && against.empty() ? &*master : nullptr);
   if (!shading.empty()) {
     const TwoLayerPanorama& a = reference.levels[0];
     Image8 image(2 * (a.width() / 4) + 8, a.height() / 4, 1, 255);

@@ -17,6 +17,7 @@
 #include "reconstruct/pipeline/view_volume.h"
 #include "reconstruct/io/image_io.h"
 #include "reconstruct/sfm/scene_setup.h"
+#include "reconstruct/stitch/smooth_depth.h"
 #include "reconstruct/util/log.h"
 
 namespace casual3d::pipeline {
@@ -282,6 +283,10 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
                                      options.num_threads, &reference_depth);
   if (options.fill_front_gaps)
     report.front_gaps_filled = FillGapsInside(fov, &front.rgb, &front.depth_m, &front.label);
+
+  // The depth maps' pixel-scale noise, smoothed along each layer's surfaces.
+  stitch::SmoothDepthAlongSurfaces(&front.depth_m, options.depth_smooth, options.num_threads);
+  stitch::SmoothDepthAlongSurfaces(&back.depth_m, options.depth_smooth, options.num_threads);
 
   // Fuse and normals.
   fuse::FuseOptions fuse_options = options.fuse;

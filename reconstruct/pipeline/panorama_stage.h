@@ -27,6 +27,7 @@
 #include "reconstruct/normals/normals.h"
 #include "reconstruct/pipeline/coverage.h"
 #include "reconstruct/pipeline/view_volume.h"
+#include "reconstruct/stitch/smooth_depth.h"
 #include "reconstruct/stitch/stitch.h"
 #include "reconstruct/warp/warp.h"
 #include "reconstruct/util/options_fields.h"
@@ -42,6 +43,9 @@ struct PanoramaStageOptions {
   int max_auto_width = 4096;
   warp::WarpOptions warp;        // pano_width/height are set from pano_width.
   stitch::StitchOptions stitch;
+  // Smoothing of the stitched layers' depth along their surfaces, before
+  // fusion (stitch/smooth_depth.h).
+  stitch::DepthSmoothOptions depth_smooth;
   fuse::FuseOptions fuse;
   // Close the quads fusion leaves open (fuse/seal.h); false: the ablation.
   bool seal_tears = true;
@@ -72,6 +76,7 @@ struct PanoramaStageOptions {
     v.Field("max_auto_width", o.max_auto_width, R::Closed(2048, 16384), "Largest automatic width (a multiple of 1024)");
     v.Struct("warp", o.warp);
     v.Struct("stitch", o.stitch);
+    v.Struct("depth_smooth", o.depth_smooth);
     v.Struct("fuse", o.fuse);
     v.Field("seal_tears", o.seal_tears, R::Any(), "Close the quads fusion leaves open");
     v.Struct("seal", o.seal);

@@ -31,7 +31,8 @@ using Clock = std::chrono::steady_clock;
 // options from their description (util::FieldsKeyText; pipeline.h, "Cache
 // key"); panorama-7 also takes over the version (panorama-6) the panorama key
 // text used to carry. panorama-8: stitched colour and depth blended across
-// the photos that agree (spec/stage-panorama.md, version 7).
+// the photos that agree, depth smoothed along surfaces
+// (spec/stage-panorama.md, version 7).
 constexpr const char* kStageVersions[kNumStages] = {"sparse-4", "dense-5", "panorama-8",
                                                     "encode-2"};
 
