@@ -44,6 +44,14 @@ std::vector<warp::WarpedView> Warp(const Capture& cap, int width) {
   return warp::WarpViews(cap.views, PanoramaFrame(), options, 2);
 }
 
+// The labelling solved at 256x128 for the tests' 1024x512 panoramas.
+StitchOptions SmallSolve() {
+  StitchOptions options;
+  options.solve_width = 256;
+  options.solve_height = 128;
+  return options;
+}
+
 TEST(StitchTest, FrontAndBackLayersMatchTheScene) {
   wt::SquareScene scene;
   Capture cap = MakeCapture(scene);
@@ -51,9 +59,7 @@ TEST(StitchTest, FrontAndBackLayersMatchTheScene) {
   for (int y = 30; y < 60; ++y)
     for (int x = 250; x < 290; ++x) cap.depth[0].at(x, y) *= 0.5f;
 
-  StitchOptions options;
-  options.solve_width = 256;
-  options.solve_height = 128;
+  const StitchOptions options = SmallSolve();
   const int W = 1024;
   const auto full = Warp(cap, W);
   const auto coarse = Warp(cap, options.solve_width);
@@ -113,9 +119,7 @@ TEST(StitchTest, BlendingAveragesTheWarpsThatAgreeInDepth) {
       cap.rgb[0].at(x, y, 0) = 250;
     }
   }
-  StitchOptions options;
-  options.solve_width = 256;
-  options.solve_height = 128;
+  StitchOptions options = SmallSolve();
   const int W = 1024;
   const auto full = Warp(cap, W);
   const auto coarse = Warp(cap, options.solve_width);
