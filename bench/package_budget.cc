@@ -34,7 +34,7 @@
 
 #include "encoder/master_file.h"
 #include "encoder/package_writer.h"
-#include "encoder/webp_codec.h"
+#include "encoder/tile_image_codec.h"
 #include "format/file_source.h"
 #include "format/package_reader.h"
 #include "reconstruct/io/image_io.h"
@@ -61,12 +61,11 @@ Encoded EncodeAndDecode(const TwoLayerPanorama& master, const encoder::PackageOp
   e.files = std::move(*files);
   MemoryFileSource source;
   for (const auto& [path, bytes] : e.files) source.Add(path, bytes);
-  encoder::WebpImageDecoder decoder;
   ReadOptions read;
   read.num_threads = std::max(1u, std::thread::hardware_concurrency());
   for (size_t l = 0; l < e.stats.level_bytes.size(); ++l) {
     read.level = static_cast<int>(l);
-    StatusOr<TwoLayerPanorama> pano = ReadPackage(source, decoder, read);
+    StatusOr<TwoLayerPanorama> pano = ReadPackage(source, encoder::TileImageDecoders(), read);
     if (!pano.ok()) {
       std::fprintf(stderr, "package_budget: level %zu: %s\n", l, pano.status().ToString().c_str());
       std::exit(1);
@@ -76,10 +75,11 @@ Encoded EncodeAndDecode(const TwoLayerPanorama& master, const encoder::PackageOp
   return e;
 }
 
-// Bytes of the tile files of `level` whose name ends in ".<kind>.webp".
+// Bytes of the tile files of `level` whose name ends in ".<kind>.webp" (the
+// names EncodePackage gives, TileFileName).
 uint64_t KindBytes(const encoder::PackageFiles& files, int level, const char* kind) {
   const std::string prefix = "l" + std::to_string(level) + "/";
-  const std::string suffix = std::string(".") + kind + ".webp";
+  const std::string suffix = std::string(".") + kind + WebpTileImageFormat().extension;
   uint64_t sum = 0;
   for (const auto& [path, bytes] : files)
     if (path.compare(0, prefix.size(), prefix) == 0 && path.size() > suffix.size() &&

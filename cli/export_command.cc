@@ -21,7 +21,7 @@
 #include "cli/command.h"
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
-#include "encoder/webp_codec.h"
+#include "encoder/tile_image_codec.h"
 #include "format/file_source.h"
 #include "format/mesh_builder.h"
 #include "format/mesh_simplify.h"
@@ -74,11 +74,10 @@ TwoLayerPanorama LoadPanorama(const ExportOptions& opts) {
   read.level = opts.level;
   read.num_threads = base::ResolveThreads(opts.num_threads);
   if (read.num_threads > 256) read.num_threads = 256;
-  const encoder::WebpImageDecoder decoder;
 
   auto read_package = [&](const FileSource& source) {
     Manifest manifest;
-    auto pano = ReadPackage(source, decoder, read, &manifest);
+    auto pano = ReadPackage(source, encoder::TileImageDecoders(), read, &manifest);
     if (!pano.ok()) Fail(input + ": " + pano.status().ToString());
     return std::move(pano).value();
   };

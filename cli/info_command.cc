@@ -7,6 +7,7 @@
 #include "cli/command.h"
 #include "format/file_source.h"
 #include "format/manifest.h"
+#include "format/tile_image_format.h"
 
 namespace casual3d::cli {
 namespace {
@@ -43,7 +44,10 @@ void RunInfo(const std::string& path) {
   } else {
     std::printf("view         none (version 1.0): viewers choose\n");
   }
-  std::printf("tiles        %d px\n", m->tile_size);
+  StatusOr<const TileImageFormat*> images = TileImageFormatOf(*m);
+  if (!images.ok()) throw std::runtime_error(path + ": " + images.status().message());
+  std::printf("tiles        %d px, %s images (%s)\n", m->tile_size, (*images)->label,
+              (*images)->mime_type);
   for (size_t l = 0; l < m->levels.size(); ++l) {
     const LevelEntry& L = m->levels[l];
     std::printf("level %zu      %dx%d, %dx%d tiles, %.1f KB\n", l, L.width, L.height, L.columns,

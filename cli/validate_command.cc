@@ -1,6 +1,6 @@
 // `casual3d validate <package>`: checks a package (folder or .c3d) completely:
-// the manifest, every tile file's size, SHA-256 and WebP coding (lossless for
-// depth, normal and graph), every tile image decodes, and every level's
+// the manifest, every tile file's size, SHA-256 and image coding (lossless for
+// depth, normal and graph; format/tile_image_format.h), every tile image decodes, and every level's
 // panorama passes TwoLayerPanorama::Validate(). Prints one line
 // per level; on the first problem, throws with one clear line (exit code 1).
 
@@ -11,7 +11,7 @@
 
 #include "base/parallel_for.h"
 #include "cli/command.h"
-#include "encoder/webp_codec.h"
+#include "encoder/tile_image_codec.h"
 #include "format/file_source.h"
 #include "format/package_reader.h"
 
@@ -21,7 +21,6 @@ namespace {
 void RunValidate(const std::string& path, int threads) {
   StatusOr<std::unique_ptr<FileSource>> source = OpenPackage(path);
   if (!source.ok()) throw std::runtime_error(source.status().message());
-  encoder::WebpImageDecoder decoder;
   ReadOptions options;
   options.num_threads = base::ResolveThreads(threads);
   options.max_pixels = int64_t{kMaxPackageWidth} * kMaxPackageHeight;
@@ -30,7 +29,7 @@ void RunValidate(const std::string& path, int threads) {
   for (int level = 0; level < levels; ++level) {
     options.level = level;
     const auto start = std::chrono::steady_clock::now();
-    StatusOr<TwoLayerPanorama> pano = ReadPackage(**source, decoder, options, &manifest);
+    StatusOr<TwoLayerPanorama> pano = ReadPackage(**source, encoder::TileImageDecoders(), options, &manifest);
     if (!pano.ok())
       throw std::runtime_error(path + ": level " + std::to_string(level) + ": " +
                                pano.status().message());

@@ -30,6 +30,7 @@
 
 #include "cli/command.h"
 #include "cli/viewer_assets.h"
+#include "format/tile_image_format.h"
 #include "reconstruct/util/log.h"
 
 namespace casual3d::cli {
@@ -55,7 +56,6 @@ std::string MimeType(const fs::path& path) {
       {".mjs", "text/javascript; charset=utf-8"},
       {".json", "application/json"},
       {".wasm", "application/wasm"},
-      {".webp", "image/webp"},
       {".png", "image/png"},
       {".jpg", "image/jpeg"},
       {".jpeg", "image/jpeg"},
@@ -70,6 +70,7 @@ std::string MimeType(const fs::path& path) {
   };
   std::string ext = path.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (const TileImageFormat* tiles = TileImageFormatByExtension(ext)) return tiles->mime_type;
   for (const auto& [e, type] : kTypes) {
     if (ext == e) return type;
   }

@@ -44,6 +44,7 @@ set(CASUAL3D_PUBLIC_FORMAT_HEADERS
   format/single_file.h
   format/status.h
   format/tile_codec.h
+  format/tile_image_format.h
   format/two_layer.h
   format/version.h
   format/view_hints.h
@@ -52,6 +53,7 @@ set(CASUAL3D_PUBLIC_ENCODER_HEADERS
   encoder/gltf_export.h
   encoder/master_file.h
   encoder/package_writer.h
+  encoder/tile_image_codec.h
   encoder/webp_codec.h
 )
 set(CASUAL3D_SDK_LIBRARIES casual3d_format)

@@ -12,7 +12,7 @@
 
 #include "encoder/absent_fill.h"
 #include "encoder/level_of_detail.h"
-#include "encoder/webp_codec.h"
+#include "encoder/tile_image_codec.h"
 #include "format/sha256.h"
 #include "format/single_file.h"
 #include "format/tile_codec.h"
@@ -21,11 +21,6 @@ namespace casual3d::encoder {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string TilePath(int level, int row, int column, TileImageKind kind) {
-  return "l" + std::to_string(level) + "/" + std::to_string(row) + "-" + std::to_string(column) +
-         "." + TileImageKindName(kind) + ".webp";
-}
 
 // Number of levels for `options.levels` == 0.
 int AutomaticLevels(int width, int height) {
@@ -140,6 +135,8 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
   manifest.depth = DepthRange(pano);
   manifest.depth.bits = options.depth_bits;
   manifest.normal.bits = options.normal_bits;
+  CASUAL3D_ASSIGN_OR_RETURN(const TileImageFormat* image_format, TileImageFormatOf(manifest));
+  CASUAL3D_ASSIGN_OR_RETURN(const TileImageCodec* codec, TileImageCodecFor(*image_format));
 
   struct Job {
     int level, tile;
@@ -163,7 +160,8 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
     for (int t = 0; t < L.columns * L.rows; ++t) {
       for (int k = 0; k < kNumTileImageKinds; ++k) {
         const TileImageKind kind = static_cast<TileImageKind>(k);
-        const std::string path = TilePath(l, t / L.columns, t % L.columns, kind);
+        const std::string path =
+            TileFileName(l, t / L.columns, t % L.columns, kind, *image_format);
         L.tiles[t].files[k] = path;
         jobs.push_back({l, t, kind, path, {}});
       }
@@ -186,12 +184,12 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
     if (options.fill_absent &&
         (job.kind == TileImageKind::kDepth || job.kind == TileImageKind::kNormal))
       FillAbsentCodes(*level_pano[job.level], x, y, w, h, &image);
-    WebpEncodeOptions webp;
-    webp.lossless = TileImageIsLossless(job.kind);
-    webp.quality = webp.lossless ? options.lossless_effort : options.color_quality;
-    webp.method = webp.lossless ? options.lossless_method : options.color_method;
+    TileEncodeSettings settings;
+    settings.lossless = TileImageIsLossless(job.kind);
+    settings.quality = settings.lossless ? options.lossless_effort : options.color_quality;
+    settings.method = settings.lossless ? options.lossless_method : options.color_method;
     StatusOr<std::vector<uint8_t>> bytes =
-        EncodeWebp(static_cast<const Image8&>(image).view(), webp);
+        codec->Encode(static_cast<const Image8&>(image).view(), settings);
     if (!bytes.ok()) {
       job_status[j] = Status(bytes.status().code(), job.path + ": " + bytes.status().message());
       failed.store(true);

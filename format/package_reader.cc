@@ -12,6 +12,7 @@ namespace casual3d {
 PackageReader::PackageReader(Manifest manifest, const ReaderChecks& checks)
     : manifest_(std::move(manifest)),
       checks_(checks),
+      image_format_(&WebpTileImageFormat()),
       file_kinds_(manifest_.files.size(), -1),
       tile_decoder_(std::make_shared<TileDecoder>(manifest_.quantization(), checks)) {
   for (const LevelEntry& L : manifest_.levels)
@@ -19,6 +20,10 @@ PackageReader::PackageReader(Manifest manifest, const ReaderChecks& checks)
       for (int k = 0; k < kNumTileImageKinds; ++k)
         if (const FileEntry* f = manifest_.FindFile(t.files[k]))
           file_kinds_[f - manifest_.files.data()] = static_cast<int8_t>(k);
+  // A manifest of another major gets here only with the unknown-major check
+  // off: its tiles are read as those of 1.x.
+  if (StatusOr<const TileImageFormat*> format = TileImageFormatOf(manifest_); format.ok())
+    image_format_ = *format;
 }
 
 StatusOr<PackageReader> PackageReader::Create(std::string_view manifest_bytes,
@@ -47,14 +52,8 @@ Status PackageReader::VerifyFile(const std::string& path, const uint8_t* data,
   const int kind = file_kinds_[f - manifest_.files.data()];
   if (kind >= 0 && TileImageIsLossless(static_cast<TileImageKind>(kind)) &&
       checks_.on(ReaderCheck::kLossyDataTile)) {
-    const WebpCoding coding = WebpContainerCoding(data, size);
-    const char* name = TileImageKindName(static_cast<TileImageKind>(kind));
-    if (coding == WebpCoding::kLossy)
-      return InvalidData(path + ": a " + name +
-                         " image must be lossless WebP (VP8L); this one is lossy (VP8)");
-    if (coding == WebpCoding::kNotStill)
-      return InvalidData(path + ": a " + name + " image must be a still lossless WebP image; "
-                                                "this one is animated");
+    CASUAL3D_RETURN_IF_ERROR(image_format_->check_lossless(
+        path, TileImageKindName(static_cast<TileImageKind>(kind)), data, size));
   }
   return Status::Ok();
 }
@@ -145,7 +144,29 @@ Status ReadOptions::Check() const {
   return Status::Ok();
 }
 
+namespace {
+
+// One decoder whatever the format.
+class SingleDecoder : public ImageDecoderFactory {
+ public:
+  explicit SingleDecoder(const ImageDecoder& decoder) : decoder_(decoder) {}
+  StatusOr<const ImageDecoder*> DecoderFor(const TileImageFormat&) const override {
+    return &decoder_;
+  }
+
+ private:
+  const ImageDecoder& decoder_;
+};
+
+}  // namespace
+
 StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source, const ImageDecoder& decoder,
+                                       const ReadOptions& options, Manifest* manifest_out) {
+  return ReadPackage(source, SingleDecoder(decoder), options, manifest_out);
+}
+
+StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source,
+                                       const ImageDecoderFactory& decoders,
                                        const ReadOptions& options, Manifest* manifest_out) {
   CASUAL3D_RETURN_IF_ERROR(options.Check());
   CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> manifest_bytes,
@@ -158,6 +179,7 @@ StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source, const ImageDeco
                                              manifest_bytes.size()),
                             checks));
   if (manifest_out != nullptr) *manifest_out = reader.manifest();
+  CASUAL3D_ASSIGN_OR_RETURN(const ImageDecoder* decoder, decoders.DecoderFor(reader.image_format()));
   CASUAL3D_RETURN_IF_ERROR(reader.BeginLevel(options.level, options.max_pixels));
   const size_t num_tiles = reader.manifest().levels[options.level].tiles.size();
   const size_t num_jobs = num_tiles * kNumTileImageKinds;
@@ -181,7 +203,7 @@ StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source, const ImageDeco
         s = bytes.status();
       } else {
         s = reader.VerifyFile(path, bytes->data(), bytes->size());
-        if (s.ok()) s = reader.AddTileFile(tile, kind, bytes->data(), bytes->size(), decoder);
+        if (s.ok()) s = reader.AddTileFile(tile, kind, bytes->data(), bytes->size(), *decoder);
       }
       if (!s.ok()) {
         std::lock_guard<std::mutex> lock(error_mutex);

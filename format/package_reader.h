@@ -5,13 +5,14 @@
 // every entry point takes untrusted bytes and returns a Status.
 //
 // Two ways to use it:
-//  - ReadPackage(): one call with a FileSource and an ImageDecoder (native
-//    tools: FolderFileSource or SingleFileSource and the libwebp decoder of
-//    encoder/webp_codec.h).
+//  - ReadPackage(): one call with a FileSource and an ImageDecoderFactory,
+//    which gives the decoder of the package's tile image format (native
+//    tools: FolderFileSource or SingleFileSource and encoder::TileImageDecoders()
+//    of encoder/tile_image_codec.h).
 //  - PackageReader: step by step, for callers that fetch and decode files
 //    themselves (the WebAssembly viewer: JavaScript fetches the files the
-//    reader names, decodes them with the browser's decoder and hands in the
-//    RGBA pixels).
+//    reader names, decodes them with the browser's decoder for the MIME type of
+//    image_format() and hands in the RGBA pixels).
 
 #include <cstdint>
 #include <memory>
@@ -24,6 +25,7 @@
 #include "format/manifest.h"
 #include "format/status.h"
 #include "format/tile_codec.h"
+#include "format/tile_image_format.h"
 #include "format/two_layer.h"
 
 namespace casual3d {
@@ -36,6 +38,17 @@ class ImageDecoder {
   virtual StatusOr<Image8> Decode(const uint8_t* data, size_t size) const = 0;
 };
 
+// Gives the decoder of a tile image format: how ReadPackage picks the decoder
+// from the manifest (TileImageFormatOf). Must be safe to call from several
+// threads.
+class ImageDecoderFactory {
+ public:
+  virtual ~ImageDecoderFactory() = default;
+  // The decoder of `format`, living as long as the factory; a Status naming
+  // the format if there is none.
+  virtual StatusOr<const ImageDecoder*> DecoderFor(const TileImageFormat& format) const = 0;
+};
+
 // Step-by-step reader of one package.
 class PackageReader {
  public:
@@ -45,6 +58,8 @@ class PackageReader {
                                         const ReaderChecks& checks = ReaderChecks());
 
   const Manifest& manifest() const { return manifest_; }
+  // The format of the tile images (TileImageFormatOf(manifest())).
+  const TileImageFormat& image_format() const { return *image_format_; }
   int num_levels() const { return static_cast<int>(manifest_.levels.size()); }
 
   // Paths of the files needed to assemble `level` (tile by tile, in the order
@@ -52,8 +67,8 @@ class PackageReader {
   std::vector<std::string> FilesForLevel(int level) const;
 
   // Checks a fetched file against the manifest: its size, its SHA-256 and,
-  // for the depth, normal and graph images, that it is lossless WebP
-  // (WebpContainerCoding). Call it for every file before decoding it.
+  // for the depth, normal and graph images, that it is lossless
+  // (image_format().check_lossless). Call it for every file before decoding it.
   Status VerifyFile(const std::string& path, const uint8_t* data, size_t size) const;
 
   // Starts assembling `level`: allocates its (empty) panorama. Fails with
@@ -84,6 +99,7 @@ class PackageReader {
 
   Manifest manifest_;
   ReaderChecks checks_;
+  const TileImageFormat* image_format_;
   // Per entry of manifest_.files: the TileImageKind of the tile image using
   // it, or -1 for an entry no tile uses.
   std::vector<int8_t> file_kinds_;
@@ -107,8 +123,15 @@ struct ReadOptions {
 };
 
 // Reads manifest.json and all tiles of `options.level` from `source`, decodes
-// them with `decoder` and returns the level's panorama. If `manifest_out` is
-// not null it receives the manifest.
+// them with the decoder `decoders` gives for the package's tile image format
+// and returns the level's panorama. If `manifest_out` is not null it receives
+// the manifest.
+StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source,
+                                       const ImageDecoderFactory& decoders,
+                                       const ReadOptions& options = ReadOptions(),
+                                       Manifest* manifest_out = nullptr);
+
+// The same with one decoder for whatever format the package holds.
 StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source, const ImageDecoder& decoder,
                                        const ReadOptions& options = ReadOptions(),
                                        Manifest* manifest_out = nullptr);

@@ -98,6 +98,8 @@ TEST_F(PackageCliTest, EncodeInfoValidate) {
   CommandResult info = Casual3d("info " + c3d);
   ASSERT_EQ(info.exit_code, 0) << info.output;
   EXPECT_NE(info.output.find("level 2      64x32, 1x1 tiles"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("tiles        64 px, WebP images (image/webp)"), std::string::npos)
+      << info.output;
   for (const std::string& p : {pkg, c3d}) {
     CommandResult validate = Casual3d("validate " + p);
     EXPECT_EQ(validate.exit_code, 0) << validate.output;

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include <casual3d/encoder/package_writer.h>
-#include <casual3d/encoder/webp_codec.h>
+#include <casual3d/encoder/tile_image_codec.h>
 #include <casual3d/format/file_source.h>
 #include <casual3d/format/mesh_builder.h>
 #include <casual3d/format/package_reader.h>
@@ -33,7 +33,7 @@ StatusOr<TwoLayerPanorama> ReadLevel(const std::string& path, int level,
   casual3d::ReadOptions options;
   options.level = level;
   options.num_threads = 4;
-  return casual3d::ReadPackage(**source, casual3d::encoder::WebpImageDecoder(), options,
+  return casual3d::ReadPackage(**source, casual3d::encoder::TileImageDecoders(), options,
                                manifest);
 }
 

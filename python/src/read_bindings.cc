@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "encoder/master_file.h"
-#include "encoder/webp_codec.h"
+#include "encoder/tile_image_codec.h"
 #include "format/file_source.h"
 #include "format/manifest.h"
 #include "format/package_reader.h"
@@ -65,7 +65,7 @@ class NativePackage {
     StatusOr<TwoLayerPanorama> pano = Status();
     {
       py::gil_scoped_release release;
-      pano = ReadPackage(*source_, encoder::WebpImageDecoder(), options);
+      pano = ReadPackage(*source_, encoder::TileImageDecoders(), options);
     }
     ThrowIfError(pano.status(), path_ + ": level " + std::to_string(level));
     return PanoramaToPython(std::move(pano).value());
@@ -108,7 +108,7 @@ py::list Validate(const std::string& path, int threads) {
     StatusOr<TwoLayerPanorama> pano = Status();
     {
       py::gil_scoped_release release;
-      pano = ReadPackage(**source, encoder::WebpImageDecoder(), options, &manifest);
+      pano = ReadPackage(**source, encoder::TileImageDecoders(), options, &manifest);
     }
     if (!pano.ok()) {
       throw FormatError(path + ": level " + std::to_string(level) + ": " + pano.status().message());

@@ -13,7 +13,7 @@
 #include "base/parallel_for.h"
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
-#include "encoder/webp_codec.h"
+#include "encoder/tile_image_codec.h"
 #include "format/backdrop.h"
 #include "format/file_source.h"
 #include "format/mesh_builder.h"
@@ -102,10 +102,9 @@ struct LoadedPhoto3d {
 TwoLayerPanorama ReadPackageOrThrow(const std::string& path, int num_threads) {
   auto source = OpenPackage(path);
   if (!source.ok()) throw std::runtime_error(source.status().message());
-  encoder::WebpImageDecoder decoder;
   ReadOptions read;
   read.num_threads = num_threads;
-  auto pano = ReadPackage(**source, decoder, read);
+  auto pano = ReadPackage(**source, encoder::TileImageDecoders(), read);
   if (!pano.ok()) throw std::runtime_error(path + ": " + pano.status().message());
   return std::move(*pano);
 }

@@ -308,6 +308,11 @@ export class PackageReader {
     return this.format.m._c3d_reader_depth_far_m(this.ptr);
   }
 
+  /** MIME type of the tile images ('image/webp' in packages 1.x). */
+  get tileImageType() {
+    return this.format.m.UTF8ToString(this.format.m._c3d_reader_tile_image_type(this.ptr));
+  }
+
   /** {width, height, tiles: [{x, y, w, h, files: [{kind, path, bytes, sha256, width, height}]}]} */
   level(level) {
     const p = this.format.m._c3d_reader_level_json(this.ptr, level);

@@ -1,7 +1,8 @@
 // casual3d-viewer/format under Node: the API of format.js, reading packages
 // from the file system (a folder, its manifest.json or a .c3d file, read in
 // ranges with positioned reads) as well as URLs, with the wasm format library
-// and a wasm WebP decoder (@jsquash/webp) in place of the browser's.
+// and wasm decoders of the tile images (@jsquash/webp for WebP) in place of the
+// browser's.
 //
 //   import { openPackage } from 'casual3d-viewer/format';
 //   const pkg = await openPackage('photo.c3d');
@@ -73,6 +74,16 @@ async function decodeWebp(bytes, name) {
   }
 }
 
+/** Node's tile image decoders, by the MIME type the reader names (tileImageType). */
+const DECODERS = { 'image/webp': decodeWebp };
+
+/** Decodes a tile image of MIME type `type` to RGBA. */
+async function decodeTile(bytes, name, type) {
+  const decode = DECODERS[type];
+  if (!decode) throw new Error(`${name}: no decoder for ${type} tile images under Node (known: ${Object.keys(DECODERS).join(', ')})`);
+  return decode(bytes, name);
+}
+
 /** Byte ranges of a file, read with positioned reads. */
 function fileRanges(file) {
   return {
@@ -122,5 +133,5 @@ export async function openPackage(input, { format, fetch: fetchFn = globalThis.f
   format ??= await createFormat();
   const source = (await openInMemory(format, input)) ??
     (/^https?:/i.test(String(input)) ? await openUrl(format, String(input), { fetch: fetchFn }) : await openPath(format, input));
-  return new Casual3dPackage(format, source, decodeWebp);
+  return new Casual3dPackage(format, source, decodeTile);
 }

@@ -30,7 +30,8 @@ export class Casual3dPackage {
   /**
    * @param format a FormatModule
    * @param source {kind, manifestBytes, read(path)} (package-source.js)
-   * @param decode (bytes, name) => Promise<{width, height, data}> RGBA pixels of a tile image
+   * @param decode (bytes, name, type) => Promise<{width, height, data}> RGBA pixels of a tile
+   *   image of MIME type `type` (the reader's tileImageType)
    */
   constructor(format, source, decode) {
     this.format = format;
@@ -57,6 +58,11 @@ export class Casual3dPackage {
     return this.reader.depthFarM;
   }
 
+  /** MIME type of the tile images ('image/webp' in packages 1.x). */
+  get tileImageType() {
+    return this.reader.tileImageType;
+  }
+
   /** {width, height, tiles: [{x, y, w, h, files: [{kind, path, bytes, sha256, width, height}]}]} */
   levelInfo(level) {
     return this.reader.level(level);
@@ -78,6 +84,7 @@ export class Casual3dPackage {
   async _readLevel(level, tiles, onFile, concurrency) {
     if (!this.reader) throw new Error('the package is closed');
     const info = this.reader.level(level);
+    const type = this.reader.tileImageType;
     const jobs = [];
     for (const t of tiles ?? info.tiles.map((_, i) => i)) {
       info.tiles[t].files.forEach((file, kind) => jobs.push({ t, kind, file }));
@@ -86,7 +93,7 @@ export class Casual3dPackage {
       const bytes = await this.source.read(file.path);
       this.reader.checkFile(file.path, bytes);
       onFile?.(bytes, file.path);
-      const image = await this.decode(bytes, file.path);
+      const image = await this.decode(bytes, file.path, type);
       if (image.width !== file.width || image.height !== file.height) {
         throw new Error(`${file.path}: ${file.kind} image is ${image.width}x${image.height}, expected ${file.width}x${file.height}`);
       }

@@ -1,5 +1,6 @@
-// Decodes a package's tile images with the browser's own image decoder (WebP
-// included) into exact RGBA pixels, off the main thread (works in workers).
+// Decodes a package's tile images with the browser's own image decoder (for the
+// MIME type the reader names: WebP in packages 1.x) into exact RGBA pixels, off
+// the main thread (works in workers).
 // createImageBitmap with colour-space conversion and premultiplication off, and
 // an OffscreenCanvas 2D readback: the package's images are opaque RGB (alpha is
 // ignored by the format), so the readback returns the decoded values unchanged.
@@ -10,9 +11,10 @@ let context = null;
 /**
  * @param {Uint8Array} bytes the encoded image
  * @param {string} name used in error messages (the file's path)
+ * @param {string} type its MIME type (PackageReader.tileImageType)
  * @returns {Promise<{width: number, height: number, data: Uint8ClampedArray}>} RGBA
  */
-export async function decodeImage(bytes, name, type = 'image/webp') {
+export async function decodeImage(bytes, name, type) {
   let bitmap;
   try {
     bitmap = await createImageBitmap(new Blob([bytes], { type }), {

@@ -245,6 +245,12 @@ EMSCRIPTEN_KEEPALIVE double c3d_reader_depth_far_m(const Reader* r) {
   return r->reader->manifest().depth.far_m;
 }
 
+// The MIME type of the package's tile images ("image/webp"; format/
+// tile_image_format.h): what the JavaScript decoder decodes them as.
+EMSCRIPTEN_KEEPALIVE const char* c3d_reader_tile_image_type(const Reader* r) {
+  return r->reader->image_format().mime_type;
+}
+
 // What a level needs, as JSON: {"width", "height", "tiles": [{"x", "y", "w",
 // "h", "files": [{"kind", "path", "bytes", "sha256", "width", "height"}]}]},
 // kinds in TileImageKind order. Owned by the reader until the next call.

@@ -40,13 +40,14 @@ test('the threaded build uses more than one thread where the machine has them', 
   assert.equal(formatThreaded.numThreads, Math.max(1, Math.min(4, cores)));
 });
 
-test('the reader gives the depth range of the manifest', () => {
+test('the reader gives the depth range and the tile image type of the manifest', () => {
   const bytes = fs.readFileSync(path.join(pkg, 'manifest.json'));
   const manifest = JSON.parse(new TextDecoder().decode(bytes));
   const reader = format.openPackage(bytes);
   try {
     assert.ok(manifest.depth_encoding.far_m > 0);
     assert.equal(reader.depthFarM, manifest.depth_encoding.far_m);
+    assert.equal(reader.tileImageType, 'image/webp');
   } finally {
     reader.free();
   }

@@ -10,7 +10,7 @@
 //     depth step, as the sealing makes where three surfaces meet.
 //   viewer_test_tool render [--viewer] <package_dir> <level> <width> <height> <out_prefix>
 //                           <yaw,pitch,fov,x,y,z>...
-//     Reads the package natively (libwebp), builds the mesh of `level` and
+//     Reads the package natively (encoder/tile_image_codec.h), builds the mesh of `level` and
 //     renders it with the native software renderer (reconstruct/render/) from
 //     each WebGL-style camera (degrees, metres): <out_prefix>_<i>.ppm (binary
 //     RGB, for comparisons) and <out_prefix>_<i>.png (for looking at).
@@ -34,7 +34,7 @@
 #include <vector>
 
 #include "encoder/package_writer.h"
-#include "encoder/webp_codec.h"
+#include "encoder/tile_image_codec.h"
 #include "format/backdrop.h"
 #include "format/colour_atlas.h"
 #include "format/file_source.h"
@@ -159,8 +159,7 @@ int DumpMesh(int argc, char** argv) {
   casual3d::ReadOptions read;
   read.level = std::atoi(argv[3]);
   casual3d::FolderFileSource source(argv[2]);
-  casual3d::encoder::WebpImageDecoder decoder;
-  auto pano = casual3d::ReadPackage(source, decoder, read);
+  auto pano = casual3d::ReadPackage(source, casual3d::encoder::TileImageDecoders(), read);
   if (!pano.ok()) return Fail(std::string(argv[2]) + ": " + pano.status().ToString());
   auto mesh = casual3d::BuildMesh(*pano);
   if (!mesh.ok()) return Fail(mesh.status().ToString());
@@ -191,8 +190,7 @@ int Render(int argc, char** argv) {
   const int width = std::atoi(argv[4]), height = std::atoi(argv[5]);
   const std::string prefix = argv[6];
   casual3d::FolderFileSource source(argv[2]);
-  casual3d::encoder::WebpImageDecoder decoder;
-  auto pano = casual3d::ReadPackage(source, decoder, read);
+  auto pano = casual3d::ReadPackage(source, casual3d::encoder::TileImageDecoders(), read);
   if (!pano.ok()) return Fail(std::string(argv[2]) + ": " + pano.status().ToString());
   auto mesh = casual3d::BuildMesh(*pano);
   if (!mesh.ok()) return Fail(mesh.status().ToString());
