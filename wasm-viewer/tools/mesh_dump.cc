@@ -12,10 +12,9 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <string>
-#include <vector>
 
+#include "base/atomic_file.h"
 #include "format/backdrop.h"
 #include "format/mesh_builder.h"
 #include "format/mesh_simplify.h"
@@ -24,17 +23,6 @@
 #include "wasm-viewer/src/panorama_blob.h"
 
 namespace {
-
-bool WriteFile(const std::string& path, const std::vector<uint8_t>& bytes) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
-    if (!out) return false;
-  }
-  return std::rename(tmp.c_str(), path.c_str()) == 0;
-}
 
 int Fail(const std::string& message) {
   std::fprintf(stderr, "viewer_mesh_dump: error: %s\n", message.c_str());
@@ -80,12 +68,14 @@ int main(int argc, char** argv) {
   if (!backdrop.ok()) return Fail(kind + ": " + backdrop.status().ToString());
   const std::string base =
       out_dir + "/" + kind + "_" + std::to_string(width) + "x" + std::to_string(height);
-  if (!WriteFile(base + ".pano", casual3d::viewer::SerializePanorama(pano)) ||
-      !WriteFile(base + ".mesh", casual3d::viewer::SerializeMesh(*mesh)) ||
-      !WriteFile(base + ".smesh", casual3d::viewer::SerializeMesh(simplified->mesh)) ||
-      !WriteFile(base + ".bmesh", casual3d::viewer::SerializeMesh(*backdrop))) {
-    return Fail(out_dir + ": cannot write the blobs (does the folder exist?)");
-  }
+  using casual3d::base::WriteFileAtomic;
+  casual3d::Status written = WriteFileAtomic(base + ".pano", casual3d::viewer::SerializePanorama(pano));
+  if (written.ok()) written = WriteFileAtomic(base + ".mesh", casual3d::viewer::SerializeMesh(*mesh));
+  if (written.ok())
+    written = WriteFileAtomic(base + ".smesh", casual3d::viewer::SerializeMesh(simplified->mesh));
+  if (written.ok())
+    written = WriteFileAtomic(base + ".bmesh", casual3d::viewer::SerializeMesh(*backdrop));
+  if (!written.ok()) return Fail(written.message() + " (does the folder exist?)");
   std::printf(
       "{\"vertices\": %zu, \"triangles\": %zu, \"budget\": %lld, \"simplified_triangles\": %zu}\n",
       mesh->num_vertices(), mesh->num_triangles(), static_cast<long long>(simplify.max_triangles),
