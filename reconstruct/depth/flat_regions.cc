@@ -12,9 +12,11 @@
 
 #include <Eigen/Dense>
 
+#include "reconstruct/depth/flat_region_steps.h"
 #include "reconstruct/util/union_find.h"
 
 namespace casual3d::depth {
+namespace flat {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -66,27 +68,6 @@ void EstimateGain(const ImageF& color, const ImageF& photo_weight, const ImageF&
     nb->gain[c] = std::min(2.0f, std::max(0.5f, *mid));
   }
 }
-
-// Offsets (pixels along the outward normal) of the colour profile across an
-// edge that the edge test matches.
-constexpr int kProfile = 11;
-constexpr float kProfileStart = -2.5f, kProfileStep = 0.5f;
-
-struct EdgePoint {
-  float x = 0, y = 0;    // The colour edge (pixel-index coordinates).
-  float profile[kProfile] = {};  // min(1, colour difference to the region / scale) across it.
-  float scale = 1;       // The colour difference that saturates the profile.
-  float nx = 0, ny = 0;  // Outward unit normal.
-  float label = 0;       // Edge depth as a fractional label.
-  // Whose edge it is, from the surface just beyond it (Classify).
-  enum class Kind { kUnknown, kOwned, kAtBeyond, kThin } kind = Kind::kUnknown;
-  bool owned() const { return kind == Kind::kOwned; }
-};
-
-struct Plane {
-  double a = 0, b = 0, c = 0;  // label = a x + b y + c.
-  double At(double x, double y) const { return a * x + b * y + c; }
-};
 
 // Depth of the colour edge at e (as a fractional label, into e->label): for
 // each label, e and its normal are projected into every neighbour, whose
@@ -216,11 +197,6 @@ struct GroupShape {
   std::array<float, 3> colour = {0, 0, 0};
   std::vector<std::pair<float, float>> samples;  // A subset of the group's pixels.
   bool touches_top = false;                      // Reaches the image's top row.
-};
-
-struct PlaneFit {
-  bool ok = false;
-  Plane plane;
 };
 
 // The plane fitting of FitPlane over the points `use` accepts (violations
@@ -412,137 +388,256 @@ PlaneFit FitPlane(const std::vector<EdgePoint>& pts, const GroupShape& shape, co
 
 }  // namespace
 
-std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_weight,
-                                    const PinholeCamera& camera, const ImageF& anchors,
-                                    const std::vector<FlatRegionNeighbor>& neighbors,
-                                    const CostVolume& grid, const FlatRegionOptions& options,
-                                    FlatRegionStats* stats) {
-  const Status st = options.Check();
-  if (!st.ok()) throw std::invalid_argument(st.message());
+
+namespace {
+
+// Regions of nearly constant colour among the flat pixels: region id per
+// pixel (-1 not flat, -2 in a region too small to keep), its mean colour
+// and area (0 for a dropped region).
+void GrowRegions(const ImageF& color, const ImageF& photo_weight, const FlatRegionOptions& options,
+                 std::vector<int>* region_out, std::vector<std::array<double, 3>>* mean_out,
+                 std::vector<int>* area_out) {
   const int w = color.width(), h = color.height();
-  if (color.channels() != 3 || photo_weight.width() != w || photo_weight.height() != h ||
-      anchors.width() != w || anchors.height() != h || camera.width != w || camera.height != h)
-    throw std::invalid_argument("flat regions: colour, w_photo, anchors and camera differ in size");
-  for (const FlatRegionNeighbor& nb : neighbors)
-    if (!nb.color || nb.color->channels() != 3 || nb.color->width() != nb.camera.width ||
-        nb.color->height() != nb.camera.height)
-      throw std::invalid_argument("flat regions: a neighbour's colour image and camera differ in size");
   const size_t n = static_cast<size_t>(w) * h;
-  std::vector<float> prior(n, kNaN);
-  FlatRegionStats local;
-  if (!options.enabled || neighbors.empty() || grid.num_labels < 2) {
-    if (stats) *stats = local;
-    return prior;
-  }
-  const int L = grid.num_labels;
-
-  // 1. Regions of nearly constant colour among the flat pixels.
-  std::vector<int> region(n, -1);
-  std::vector<std::array<double, 3>> mean;
-  std::vector<int> area;
-  {
-    const float step2 = static_cast<float>(options.color_step * options.color_step);
-    const float spread2 = static_cast<float>(options.color_spread * options.color_spread);
-    std::vector<int> stack, members;
-    const float max_w = static_cast<float>(options.max_photo_weight);
-    for (size_t s = 0; s < n; ++s) {
-      if (region[s] != -1 || photo_weight.data()[s] >= max_w) continue;
-      const int id = static_cast<int>(mean.size());
-      double sum[3] = {0, 0, 0};
-      members.clear();
-      stack.assign(1, static_cast<int>(s));
-      region[s] = id;
-      while (!stack.empty()) {
-        const int p = stack.back();
-        stack.pop_back();
-        members.push_back(p);
-        const float* cp = color.data() + 3 * static_cast<size_t>(p);
-        for (int c = 0; c < 3; ++c) sum[c] += cp[c];
-        const float m[3] = {static_cast<float>(sum[0] / members.size()), static_cast<float>(sum[1] / members.size()),
-                            static_cast<float>(sum[2] / members.size())};
-        const int px = p % w, py = p / w;
-        const int nbr[4][2] = {{px - 1, py}, {px + 1, py}, {px, py - 1}, {px, py + 1}};
-        for (const auto& q : nbr) {
-          if (q[0] < 0 || q[1] < 0 || q[0] >= w || q[1] >= h) continue;
-          const size_t qi = static_cast<size_t>(q[1]) * w + q[0];
-          if (region[qi] != -1 || photo_weight.data()[qi] >= max_w) continue;
-          const float* cq = color.data() + 3 * qi;
-          if (Dist2(cp, cq) > step2 || Dist2(m, cq) > spread2) continue;
-          region[qi] = id;
-          stack.push_back(static_cast<int>(qi));
-        }
+  std::vector<int>& region = *region_out;
+  std::vector<std::array<double, 3>>& mean = *mean_out;
+  std::vector<int>& area = *area_out;
+  region.assign(n, -1);
+  const float step2 = static_cast<float>(options.color_step * options.color_step);
+  const float spread2 = static_cast<float>(options.color_spread * options.color_spread);
+  std::vector<int> stack, members;
+  const float max_w = static_cast<float>(options.max_photo_weight);
+  for (size_t s = 0; s < n; ++s) {
+    if (region[s] != -1 || photo_weight.data()[s] >= max_w) continue;
+    const int id = static_cast<int>(mean.size());
+    double sum[3] = {0, 0, 0};
+    members.clear();
+    stack.assign(1, static_cast<int>(s));
+    region[s] = id;
+    while (!stack.empty()) {
+      const int p = stack.back();
+      stack.pop_back();
+      members.push_back(p);
+      const float* cp = color.data() + 3 * static_cast<size_t>(p);
+      for (int c = 0; c < 3; ++c) sum[c] += cp[c];
+      const float m[3] = {static_cast<float>(sum[0] / members.size()), static_cast<float>(sum[1] / members.size()),
+                          static_cast<float>(sum[2] / members.size())};
+      const int px = p % w, py = p / w;
+      const int nbr[4][2] = {{px - 1, py}, {px + 1, py}, {px, py - 1}, {px, py + 1}};
+      for (const auto& q : nbr) {
+        if (q[0] < 0 || q[1] < 0 || q[0] >= w || q[1] >= h) continue;
+        const size_t qi = static_cast<size_t>(q[1]) * w + q[0];
+        if (region[qi] != -1 || photo_weight.data()[qi] >= max_w) continue;
+        const float* cq = color.data() + 3 * qi;
+        if (Dist2(cp, cq) > step2 || Dist2(m, cq) > spread2) continue;
+        region[qi] = id;
+        stack.push_back(static_cast<int>(qi));
       }
-      if (static_cast<int>(members.size()) < options.min_region_pixels) {
-        for (int p : members) region[p] = -2;  // Too small: no region, not revisited.
-        mean.push_back({0, 0, 0});
-        area.push_back(0);
-        continue;
-      }
-      mean.push_back({sum[0] / members.size(), sum[1] / members.size(), sum[2] / members.size()});
-      area.push_back(static_cast<int>(members.size()));
     }
+    if (static_cast<int>(members.size()) < options.min_region_pixels) {
+      for (int p : members) region[p] = -2;  // Too small: no region, not revisited.
+      mean.push_back({0, 0, 0});
+      area.push_back(0);
+      continue;
+    }
+    mean.push_back({sum[0] / members.size(), sum[1] / members.size(), sum[2] / members.size()});
+    area.push_back(static_cast<int>(members.size()));
   }
-  const int num_regions = static_cast<int>(mean.size());
-  if (num_regions == 0) {
-    if (stats) *stats = local;
-    return prior;
-  }
+}
 
-  // Join regions of similar colour that a thin occluder separates: from
-  // each region pixel, look along the four axes across at most merge_gap
-  // pixels of other content for another region.
-  util::UnionFind uf(num_regions);
-  {
-    const double mc2 = options.merge_color * options.merge_color;
-    auto similar = [&](int a, int b) {
-      double d = 0;
-      for (int c = 0; c < 3; ++c) d += (mean[a][c] - mean[b][c]) * (mean[a][c] - mean[b][c]);
-      return d <= mc2;
-    };
-    const int dirs[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const int a = region[static_cast<size_t>(y) * w + x];
-        if (a < 0) continue;
-        for (const auto& d : dirs) {
-          const int x1 = x + d[0], y1 = y + d[1];
-          if (x1 < 0 || y1 < 0 || x1 >= w || y1 >= h || region[static_cast<size_t>(y1) * w + x1] == a) continue;
-          for (int s = 1; s <= options.merge_gap + 1; ++s) {
-            const int xs = x + s * d[0], ys = y + s * d[1];
-            if (xs < 0 || ys < 0 || xs >= w || ys >= h) break;
-            const int b = region[static_cast<size_t>(ys) * w + xs];
-            if (b == a) break;
-            if (b >= 0) {
-              if (similar(a, b)) uf.Union(a, b);
-              break;
-            }
+// Joins regions of similar colour that a thin occluder separates: from each
+// region pixel, look along the four axes across at most merge_gap pixels of
+// other content for another region.
+void JoinRegions(const std::vector<int>& region, const std::vector<std::array<double, 3>>& mean, int w,
+                 int h, const FlatRegionOptions& options, util::UnionFind* uf) {
+  const double mc2 = options.merge_color * options.merge_color;
+  auto similar = [&](int a, int b) {
+    double d = 0;
+    for (int c = 0; c < 3; ++c) d += (mean[a][c] - mean[b][c]) * (mean[a][c] - mean[b][c]);
+    return d <= mc2;
+  };
+  const int dirs[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int a = region[static_cast<size_t>(y) * w + x];
+      if (a < 0) continue;
+      for (const auto& d : dirs) {
+        const int x1 = x + d[0], y1 = y + d[1];
+        if (x1 < 0 || y1 < 0 || x1 >= w || y1 >= h || region[static_cast<size_t>(y1) * w + x1] == a) continue;
+        for (int s = 1; s <= options.merge_gap + 1; ++s) {
+          const int xs = x + s * d[0], ys = y + s * d[1];
+          if (xs < 0 || ys < 0 || xs >= w || ys >= h) break;
+          const int b = region[static_cast<size_t>(ys) * w + xs];
+          if (b == a) break;
+          if (b >= 0) {
+            if (similar(a, b)) uf->Union(a, b);
+            break;
           }
         }
       }
+    }
+}
+
+// The colour edge outward of the boundary pixel (x, y) of a region of colour
+// `region_colour` along e's normal: the first pixel outward (within
+// kMaxMarch) that looks different from the region. The flat pixels can stop
+// short of it, where the colour-weighted texture measure sees texture
+// beyond. Its position to a fraction of a pixel: where the colour difference
+// to the region, sampled along the normal in quarter pixels, first reaches
+// half of its value 1.5 pixels further out (an error of half a pixel there
+// is an error of half a pixel of disparity). Sets e's position, scale and
+// profile; false when there is no clear edge or the profile leaves the image.
+bool LocateColourEdge(const ImageF& color, int x, int y, const float* region_colour,
+                      const FlatRegionOptions& options, EdgePoint* e) {
+  constexpr float kMaxMarch = 6.0f, kStep = 0.25f;
+  auto diff_at = [&](float t, float* d) {
+    float s[3];
+    if (!SampleRgb(color, x + t * e->nx, y + t * e->ny, s)) return false;
+    *d = std::abs(s[0] - region_colour[0]) + std::abs(s[1] - region_colour[1]) + std::abs(s[2] - region_colour[2]);
+    return true;
+  };
+  float t_out = -1.0f, d_out = 0.0f;
+  for (float t = 0.5f; t <= kMaxMarch; t += kStep) {
+    float d;
+    if (!diff_at(t, &d)) break;
+    if (d >= options.edge_contrast) {
+      float d2;
+      if (diff_at(t + 1.5f, &d2) && d2 >= options.edge_contrast) {
+        t_out = t;
+        d_out = std::max(d, d2);
+      }
+      break;
+    }
   }
-  std::vector<int> group(n, -1);
-  std::vector<long long> group_area(num_regions, 0);
+  if (t_out < 0) return false;
+  const float half = 0.5f * d_out;
+  float prev_t = 0.0f, prev_d = 0.0f;
+  diff_at(0.0f, &prev_d);
+  bool found = false;
+  for (float t = kStep; t <= t_out + 1.5f; t += kStep) {
+    float d;
+    if (!diff_at(t, &d)) break;
+    if (d >= half) {
+      const float f = d > prev_d ? (half - prev_d) / (d - prev_d) : 0.0f;
+      const float te = prev_t + f * (t - prev_t);
+      e->x = x + te * e->nx;
+      e->y = y + te * e->ny;
+      found = true;
+      break;
+    }
+    prev_t = t;
+    prev_d = d;
+  }
+  if (!found) return false;
+  e->scale = std::max(static_cast<float>(options.edge_contrast), 0.8f * d_out);
+  bool inside_image = true;
+  for (int i = 0; i < kProfile && inside_image; ++i) {
+    float s3[3];
+    const float o = kProfileStart + i * kProfileStep;
+    inside_image = SampleRgb(color, e->x + o * e->nx, e->y + o * e->ny, s3);
+    const float d = std::abs(s3[0] - region_colour[0]) + std::abs(s3[1] - region_colour[1]) +
+                    std::abs(s3[2] - region_colour[2]);
+    e->profile[i] = std::min(1.0f, d / e->scale);
+  }
+  return inside_image;
+}
+
+// Step 2: the depth and ownership of each group's edges (at most
+// max_edge_points per group, evenly subsampled), the points with a clear
+// minimum only.
+std::vector<std::vector<EdgePoint>> MeasureGroupEdges(
+    const FlatGroups& groups, std::vector<std::vector<EdgePoint>>* points,
+    const std::vector<Neighbor>& nbs, const std::vector<float>& inv_of, const ImageF& anchors,
+    const ImageF& photo_weight, const CostVolume& grid, long long min_area,
+    const FlatRegionOptions& options, FlatRegionStats* stats) {
+  std::vector<std::vector<EdgePoint>> measured(groups.size());
+  for (int g = 0; g < groups.size(); ++g) {
+    if (groups.area[g] < min_area) continue;
+    ++stats->groups;
+    std::vector<EdgePoint>& pts = (*points)[g];
+    if (pts.size() > static_cast<size_t>(options.max_edge_points)) {
+      std::vector<EdgePoint> kept;
+      const double stride = static_cast<double>(pts.size()) / options.max_edge_points;
+      for (int i = 0; i < options.max_edge_points; ++i) kept.push_back(pts[static_cast<size_t>(i * stride)]);
+      pts.swap(kept);
+    }
+    for (const EdgePoint& e : pts) {
+      EdgePoint m = e;
+      if (!MeasureEdge(nbs, groups.colour[g].data(), inv_of, &m)) continue;
+      m.kind = Classify(m, g, groups.group, anchors, photo_weight, grid, options);
+      measured[g].push_back(m);
+    }
+    stats->edge_points += static_cast<int>(measured[g].size());
+  }
+  return measured;
+}
+
+// Step 3: a plane per group of at least `min_area` pixels from its own
+// edges (FitPlane); the groups with and without one.
+std::vector<PlaneFit> FitGroupPlanes(const FlatGroups& groups, int w,
+                                     const std::vector<std::vector<EdgePoint>>& measured,
+                                     long long min_area, int num_labels,
+                                     const FlatRegionOptions& options,
+                                     std::vector<int>* fitted_groups,
+                                     std::vector<int>* unfitted_groups) {
+  const size_t n = groups.group.size();
+  std::vector<PlaneFit> fits(groups.size());
+  for (int g = 0; g < groups.size(); ++g) {
+    if (groups.area[g] < min_area) continue;
+    GroupShape shape;
+    shape.colour = groups.colour[g];
+    for (size_t p = 0; p < n; p += 7)
+      if (groups.group[p] == g) shape.samples.emplace_back(static_cast<float>(p % w), static_cast<float>(p / w));
+    for (int x = 0; x < w && !shape.touches_top; ++x) shape.touches_top = groups.group[x] == g;
+    fits[g] = FitPlane(measured[g], shape, options, num_labels, 0x9E3779B97F4A7C15ull + g);
+    (fits[g].ok ? fitted_groups : unfitted_groups)->push_back(g);
+  }
+  return fits;
+}
+
+}  // namespace
+
+FlatGroups SegmentFlatGroups(const ImageF& color, const ImageF& photo_weight,
+                             const FlatRegionOptions& options) {
+  const int w = color.width(), h = color.height();
+  const size_t n = static_cast<size_t>(w) * h;
+  std::vector<int> region;
+  std::vector<std::array<double, 3>> mean;
+  std::vector<int> area;
+  GrowRegions(color, photo_weight, options, &region, &mean, &area);
+  const int num_regions = static_cast<int>(mean.size());
+  FlatGroups groups;
+  if (num_regions == 0) return groups;
+  util::UnionFind uf(num_regions);
+  JoinRegions(region, mean, w, h, options, &uf);
+  groups.group.assign(n, -1);
+  groups.area.assign(num_regions, 0);
   std::vector<std::array<double, 3>> group_sum(num_regions, {0, 0, 0});
   for (size_t p = 0; p < n; ++p) {
     if (region[p] < 0) continue;
     const int g = uf.Find(region[p]);
-    group[p] = g;
-    ++group_area[g];
+    groups.group[p] = g;
+    ++groups.area[g];
     for (int c = 0; c < 3; ++c) group_sum[g][c] += color.data()[3 * p + c];
   }
-  std::vector<std::array<float, 3>> group_colour(num_regions, {0, 0, 0});  // Mean colour.
+  groups.colour.assign(num_regions, {0, 0, 0});
   for (int g = 0; g < num_regions; ++g)
-    if (group_area[g] > 0)
-      for (int c = 0; c < 3; ++c) group_colour[g][c] = static_cast<float>(group_sum[g][c] / group_area[g]);
+    if (groups.area[g] > 0)
+      for (int c = 0; c < 3; ++c) groups.colour[g][c] = static_cast<float>(group_sum[g][c] / groups.area[g]);
+  return groups;
+}
 
-  // Outward normals from the smoothed group masks, and boundary points.
-  std::vector<std::vector<EdgePoint>> points(num_regions);
-  const long long min_area = std::max<long long>(1, std::llround(options.min_area_fraction * n));
+std::vector<std::vector<EdgePoint>> FindEdgePoints(const ImageF& color, const FlatGroups& groups,
+                                                   long long min_area,
+                                                   const FlatRegionOptions& options) {
+  const int w = color.width(), h = color.height();
+  const std::vector<int>& group = groups.group;
+  std::vector<std::vector<EdgePoint>> points(groups.size());
   for (int y = 1; y + 1 < h; ++y)
     for (int x = 1; x + 1 < w; ++x) {
       const size_t p = static_cast<size_t>(y) * w + x;
       const int g = group[p];
-      if (g < 0 || group_area[g] < min_area) continue;
+      if (g < 0 || groups.area[g] < min_area) continue;
       bool boundary = false;
       for (const auto& q : {p - 1, p + 1, p - w, p + w}) boundary |= group[q] != g;
       if (!boundary) continue;
@@ -560,160 +655,66 @@ std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_wei
       EdgePoint e;
       e.nx = -gx / len;
       e.ny = -gy / len;
-      // The colour edge: the first pixel outward (within kMaxMarch) that
-      // looks different from the region. The flat pixels can stop short of
-      // it, where the colour-weighted texture measure sees texture beyond.
-      // Its position to a fraction of a pixel: where the colour difference
-      // to the region, sampled along the normal in quarter pixels, first
-      // reaches half of its value 1.5 pixels further out (an error of half a
-      // pixel there is an error of half a pixel of disparity).
-      constexpr float kMaxMarch = 6.0f, kStep = 0.25f;
-      const float* region_colour = group_colour[g].data();
-      auto diff_at = [&](float t, float* d) {
-        float s[3];
-        if (!SampleRgb(color, x + t * e.nx, y + t * e.ny, s)) return false;
-        *d = std::abs(s[0] - region_colour[0]) + std::abs(s[1] - region_colour[1]) + std::abs(s[2] - region_colour[2]);
-        return true;
-      };
-      float t_out = -1.0f, d_out = 0.0f;
-      for (float t = 0.5f; t <= kMaxMarch; t += kStep) {
-        float d;
-        if (!diff_at(t, &d)) break;
-        if (d >= options.edge_contrast) {
-          float d2;
-          if (diff_at(t + 1.5f, &d2) && d2 >= options.edge_contrast) {
-            t_out = t;
-            d_out = std::max(d, d2);
-          }
-          break;
-        }
-      }
-      if (t_out < 0) continue;
-      const float half = 0.5f * d_out;
-      float prev_t = 0.0f, prev_d = 0.0f;
-      diff_at(0.0f, &prev_d);
-      bool found = false;
-      for (float t = kStep; t <= t_out + 1.5f; t += kStep) {
-        float d;
-        if (!diff_at(t, &d)) break;
-        if (d >= half) {
-          const float f = d > prev_d ? (half - prev_d) / (d - prev_d) : 0.0f;
-          const float te = prev_t + f * (t - prev_t);
-          e.x = x + te * e.nx;
-          e.y = y + te * e.ny;
-          found = true;
-          break;
-        }
-        prev_t = t;
-        prev_d = d;
-      }
-      if (!found) continue;
-      e.scale = std::max(static_cast<float>(options.edge_contrast), 0.8f * d_out);
-      bool inside_image = true;
-      for (int i = 0; i < kProfile && inside_image; ++i) {
-        float s3[3];
-        const float o = kProfileStart + i * kProfileStep;
-        inside_image = SampleRgb(color, e.x + o * e.nx, e.y + o * e.ny, s3);
-        const float d = std::abs(s3[0] - region_colour[0]) + std::abs(s3[1] - region_colour[1]) +
-                        std::abs(s3[2] - region_colour[2]);
-        e.profile[i] = std::min(1.0f, d / e.scale);
-      }
-      if (inside_image) points[g].push_back(e);
+      if (LocateColourEdge(color, x, y, groups.colour[g].data(), options, &e)) points[g].push_back(e);
     }
+  return points;
+}
 
-  // Neighbours' homographies and gains.
-  std::vector<Neighbor> nbs(neighbors.size());
-  for (size_t j = 0; j < neighbors.size(); ++j) {
-    nbs[j].color = neighbors[j].color;
-    nbs[j].hom = ComputePlaneHomography(camera, neighbors[j].camera);
-    EstimateGain(color, photo_weight, anchors, &nbs[j]);
+void AdoptPlanes(const FlatGroups& groups, int w, int h,
+                 const std::vector<std::vector<EdgePoint>>& measured,
+                 const std::vector<int>& fitted_groups, const std::vector<int>& unfitted_groups,
+                 const FlatRegionOptions& options, std::vector<PlaneFit>* fits) {
+  const std::vector<std::array<float, 3>>& colour = groups.colour;
+  std::vector<std::array<int, 4>> box(groups.size(), {w, h, -1, -1});
+  for (size_t p = 0; p < groups.group.size(); ++p) {
+    const int g = groups.group[p];
+    if (g < 0) continue;
+    const int x = static_cast<int>(p % w), y = static_cast<int>(p / w);
+    box[g] = {std::min(box[g][0], x), std::min(box[g][1], y), std::max(box[g][2], x), std::max(box[g][3], y)};
   }
-  std::vector<float> inv_of(L);
-  for (int k = 0; k < L; ++k) inv_of[k] = static_cast<float>(grid.InvDepthOfLabel(k));
-
-  // 2. Edge depths and ownership, per group.
-  std::vector<std::vector<EdgePoint>> measured(num_regions);
-  std::vector<int> fitted_groups, unfitted_groups;
-  for (int g = 0; g < num_regions; ++g) {
-    if (group_area[g] < min_area) continue;
-    ++local.groups;
-    std::vector<EdgePoint>& pts = points[g];
-    if (pts.size() > static_cast<size_t>(options.max_edge_points)) {
-      std::vector<EdgePoint> kept;
-      const double stride = static_cast<double>(pts.size()) / options.max_edge_points;
-      for (int i = 0; i < options.max_edge_points; ++i) kept.push_back(pts[static_cast<size_t>(i * stride)]);
-      pts.swap(kept);
-    }
-    for (const EdgePoint& e : pts) {
-      EdgePoint m = e;
-      if (!MeasureEdge(nbs, group_colour[g].data(), inv_of, &m)) continue;
-      m.kind = Classify(m, g, group, anchors, photo_weight, grid, options);
-      measured[g].push_back(m);
-    }
-    local.edge_points += static_cast<int>(measured[g].size());
-  }
-
-  // 3. A plane per group from its own edges.
-  std::vector<PlaneFit> fits(num_regions);
-  for (int g = 0; g < num_regions; ++g) {
-    if (group_area[g] < min_area) continue;
-    GroupShape shape;
-    shape.colour = group_colour[g];
-    for (size_t p = 0; p < n; p += 7)
-      if (group[p] == g) shape.samples.emplace_back(static_cast<float>(p % w), static_cast<float>(p / w));
-    for (int x = 0; x < w && !shape.touches_top; ++x) shape.touches_top = group[x] == g;
-    fits[g] = FitPlane(measured[g], shape, options, L, 0x9E3779B97F4A7C15ull + g);
-    (fits[g].ok ? fitted_groups : unfitted_groups).push_back(g);
-  }
-
-  // 4. A group without a plane of its own takes that of a fitted group of the
-  // same colour close by (the parts of a wall that poles cut apart), when
-  // its own edges agree: (nearly) none in front of the plane.
-  {
-    std::vector<std::array<int, 4>> box(num_regions, {w, h, -1, -1});
-    for (size_t p = 0; p < n; ++p) {
-      const int g = group[p];
-      if (g < 0) continue;
-      const int x = static_cast<int>(p % w), y = static_cast<int>(p / w);
-      box[g] = {std::min(box[g][0], x), std::min(box[g][1], y), std::max(box[g][2], x), std::max(box[g][3], y)};
-    }
-    const double adopt2 = 4.0 * options.merge_color * options.merge_color;
-    for (int g : unfitted_groups) {
-      int best = -1, best_touching = -1;
-      for (int f : fitted_groups) {
-        double d2 = 0;
-        for (int c = 0; c < 3; ++c) d2 += (group_colour[g][c] - group_colour[f][c]) * (group_colour[g][c] - group_colour[f][c]);
-        if (d2 > adopt2) continue;
-        const int gap = std::max({box[f][0] - box[g][2], box[g][0] - box[f][2], box[f][1] - box[g][3],
-                                  box[g][1] - box[f][3], 0});
-        if (gap > options.adopt_distance) continue;
-        int touching, violations;
-        Score(fits[f].plane, measured[g], options.touch_labels, &touching, &violations);
-        const int np = static_cast<int>(measured[g].size());
-        if (violations > static_cast<int>(std::floor((1.0 - options.behind_fraction) * np))) continue;
-        if (touching > best_touching) {
-          best_touching = touching;
-          best = f;
-        }
+  const double adopt2 = 4.0 * options.merge_color * options.merge_color;
+  for (int g : unfitted_groups) {
+    int best = -1, best_touching = -1;
+    for (int f : fitted_groups) {
+      double d2 = 0;
+      for (int c = 0; c < 3; ++c) d2 += (colour[g][c] - colour[f][c]) * (colour[g][c] - colour[f][c]);
+      if (d2 > adopt2) continue;
+      const int gap = std::max({box[f][0] - box[g][2], box[g][0] - box[f][2], box[f][1] - box[g][3],
+                                box[g][1] - box[f][3], 0});
+      if (gap > options.adopt_distance) continue;
+      int touching, violations;
+      Score((*fits)[f].plane, measured[g], options.touch_labels, &touching, &violations);
+      const int np = static_cast<int>(measured[g].size());
+      if (violations > static_cast<int>(std::floor((1.0 - options.behind_fraction) * np))) continue;
+      if (touching > best_touching) {
+        best_touching = touching;
+        best = f;
       }
-      if (best >= 0) fits[g] = fits[best];
     }
+    if (best >= 0) (*fits)[g] = (*fits)[best];
   }
+}
 
-  // 5. Priors: the plane over the group's pixels and the pixels of its
-  // colour connected to it that the flat test left out (a strip of wall
-  // between two close poles, whose windows hold the poles' texture).
+std::vector<float> AssignPriors(const ImageF& color, const ImageF& photo_weight,
+                                const FlatGroups& groups, const std::vector<PlaneFit>& fits,
+                                int num_labels, const FlatRegionOptions& options,
+                                FlatRegionStats* stats) {
+  const int w = color.width(), h = color.height();
+  const size_t n = static_cast<size_t>(w) * h;
+  const int L = num_labels;
+  const std::vector<int>& group = groups.group;
+  std::vector<float> prior(n, kNaN);
   const float spread2 = static_cast<float>(options.color_spread * options.color_spread);
   const float extend_w = static_cast<float>(options.extend_max_photo_weight);
-  for (int g = 0; g < num_regions; ++g) {
+  for (int g = 0; g < groups.size(); ++g) {
     if (!fits[g].ok) continue;
-    ++local.fitted;
+    ++stats->fitted;
     const Plane& pl = fits[g].plane;
     std::vector<int> stack;
     auto assign = [&](size_t p) {
       const double k = pl.At(static_cast<double>(p % w), static_cast<double>(p / w));
       prior[p] = static_cast<float>(std::min<double>(L - 1, std::max(0.0, k)));
-      ++local.pixels;
+      ++stats->pixels;
     };
     for (size_t p = 0; p < n; ++p)
       if (group[p] == g) {
@@ -729,12 +730,71 @@ std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_wei
         if (q[0] < 0 || q[1] < 0 || q[0] >= w || q[1] >= h) continue;
         const size_t qi = static_cast<size_t>(q[1]) * w + q[0];
         if (!std::isnan(prior[qi]) || group[qi] >= 0 || photo_weight.data()[qi] >= extend_w) continue;
-        if (Dist2(group_colour[g].data(), color.data() + 3 * qi) > spread2) continue;
+        if (Dist2(groups.colour[g].data(), color.data() + 3 * qi) > spread2) continue;
         assign(qi);
         stack.push_back(static_cast<int>(qi));
       }
     }
   }
+  return prior;
+}
+
+}  // namespace flat
+
+std::vector<float> FlatRegionPriors(const ImageF& color, const ImageF& photo_weight,
+                                    const PinholeCamera& camera, const ImageF& anchors,
+                                    const std::vector<FlatRegionNeighbor>& neighbors,
+                                    const CostVolume& grid, const FlatRegionOptions& options,
+                                    FlatRegionStats* stats) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument(st.message());
+  const int w = color.width(), h = color.height();
+  if (color.channels() != 3 || photo_weight.width() != w || photo_weight.height() != h ||
+      anchors.width() != w || anchors.height() != h || camera.width != w || camera.height != h)
+    throw std::invalid_argument("flat regions: colour, w_photo, anchors and camera differ in size");
+  for (const FlatRegionNeighbor& nb : neighbors)
+    if (!nb.color || nb.color->channels() != 3 || nb.color->width() != nb.camera.width ||
+        nb.color->height() != nb.camera.height)
+      throw std::invalid_argument("flat regions: a neighbour's colour image and camera differ in size");
+  const size_t n = static_cast<size_t>(w) * h;
+  FlatRegionStats local;
+  if (stats) *stats = local;
+  if (!options.enabled || neighbors.empty() || grid.num_labels < 2)
+    return std::vector<float>(n, flat::kNaN);
+  const int L = grid.num_labels;
+
+  // 1. Groups of flat pixels, and their boundary points.
+  const flat::FlatGroups groups = flat::SegmentFlatGroups(color, photo_weight, options);
+  if (groups.size() == 0) return std::vector<float>(n, flat::kNaN);
+  const long long min_area = std::max<long long>(1, std::llround(options.min_area_fraction * n));
+  std::vector<std::vector<flat::EdgePoint>> points =
+      flat::FindEdgePoints(color, groups, min_area, options);
+
+  // Neighbours' homographies and gains.
+  std::vector<flat::Neighbor> nbs(neighbors.size());
+  for (size_t j = 0; j < neighbors.size(); ++j) {
+    nbs[j].color = neighbors[j].color;
+    nbs[j].hom = ComputePlaneHomography(camera, neighbors[j].camera);
+    flat::EstimateGain(color, photo_weight, anchors, &nbs[j]);
+  }
+  std::vector<float> inv_of(L);
+  for (int k = 0; k < L; ++k) inv_of[k] = static_cast<float>(grid.InvDepthOfLabel(k));
+
+  // 2. Edge depths and ownership, per group.
+  const std::vector<std::vector<flat::EdgePoint>> measured = flat::MeasureGroupEdges(
+      groups, &points, nbs, inv_of, anchors, photo_weight, grid, min_area, options, &local);
+  // 3. A plane per group from its own edges.
+  std::vector<int> fitted_groups, unfitted_groups;
+  std::vector<flat::PlaneFit> fits = flat::FitGroupPlanes(groups, w, measured, min_area, L, options,
+                                                          &fitted_groups, &unfitted_groups);
+  // 4. A group without a plane of its own takes that of a fitted group of the
+  // same colour close by (the parts of a wall that poles cut apart), when
+  // its own edges agree: (nearly) none in front of the plane.
+  flat::AdoptPlanes(groups, w, h, measured, fitted_groups, unfitted_groups, options, &fits);
+  // 5. Priors: the plane over the group's pixels and the pixels of its
+  // colour connected to it that the flat test left out (a strip of wall
+  // between two close poles, whose windows hold the poles' texture).
+  std::vector<float> prior = flat::AssignPriors(color, photo_weight, groups, fits, L, options, &local);
   if (stats) *stats = local;
   return prior;
 }
