@@ -24,16 +24,17 @@ void RunValidate(const std::string& path, int threads) {
   ReadOptions options;
   options.num_threads = base::ResolveThreads(threads);
   options.max_pixels = int64_t{kMaxPackageWidth} * kMaxPackageHeight;
-  Manifest manifest;
-  int levels = 1;
-  for (int level = 0; level < levels; ++level) {
+  // The manifest first, so that its problems are not reported as level 0's.
+  StatusOr<Manifest> parsed = ReadManifest(**source);
+  if (!parsed.ok()) throw std::runtime_error(path + ": " + parsed.status().message());
+  const Manifest& manifest = *parsed;
+  for (int level = 0; level < static_cast<int>(manifest.levels.size()); ++level) {
     options.level = level;
     const auto start = std::chrono::steady_clock::now();
-    StatusOr<TwoLayerPanorama> pano = ReadPackage(**source, encoder::TileImageDecoders(), options, &manifest);
+    StatusOr<TwoLayerPanorama> pano = ReadPackage(**source, encoder::TileImageDecoders(), options);
     if (!pano.ok())
       throw std::runtime_error(path + ": level " + std::to_string(level) + ": " +
                                pano.status().message());
-    levels = static_cast<int>(manifest.levels.size());
     size_t nodes[2] = {0, 0};
     for (int l = 0; l < kNumLayers; ++l)
       for (uint8_t p : pano->layer(l).present) nodes[l] += p;

@@ -58,6 +58,12 @@ Status PackageReader::VerifyFile(const std::string& path, const uint8_t* data,
   return Status::Ok();
 }
 
+const std::string& PackageReader::TileFileAt(int x, int y, TileImageKind kind) const {
+  const LevelEntry& L = manifest_.levels[level_];
+  const int tile = y / manifest_.tile_size * L.columns + x / manifest_.tile_size;
+  return L.tiles[tile].files[static_cast<int>(kind)];
+}
+
 Status PackageReader::BeginLevel(int level, int64_t max_pixels) {
   if (level < 0 || level >= num_levels())
     return InvalidArgument("level " + std::to_string(level) + " does not exist (the package has " +
@@ -111,23 +117,31 @@ StatusOr<TwoLayerPanorama> PackageReader::FinishLevel(int num_threads) {
   const LevelEntry& L = manifest_.levels[level_];
   for (size_t i = 0; i < received_.size(); ++i) {
     if (!received_[i])
-      return InvalidArgument("level " + std::to_string(level_) + ": " +
-                             L.tiles[i / kNumTileImageKinds].files[i % kNumTileImageKinds] +
-                             " was not added");
+      return InvalidArgument(L.tiles[i / kNumTileImageKinds].files[i % kNumTileImageKinds] +
+                             ": not added; the level needs every image of every tile");
   }
   DecodedNodeProblem problem;
   Status nodes = FinishDecodedPanorama(&pano_, num_threads, checks_, &problem);
-  if (!nodes.ok()) {
-    const int tile = problem.y / manifest_.tile_size * L.columns + problem.x / manifest_.tile_size;
-    return Status(nodes.code(),
-                  L.tiles[tile].files[static_cast<int>(problem.kind)] + ": " + nodes.message());
-  }
+  if (!nodes.ok())
+    return Status(nodes.code(), TileFileAt(problem.x, problem.y, problem.kind) + ": " +
+                                    nodes.message());
   // FinishDecodedPanorama leaves only valid node values, so the links are
-  // what remains to check.
+  // what remains to check. A link is stored in the graph image of its node's
+  // tile; one to a node of another tile also names that tile's graph image.
   if (checks_.on(ReaderCheck::kLinkNotMutual)) {
-    Status valid = pano_.ValidateLinks(num_threads);
-    if (!valid.ok())
-      return InvalidData("the graph images' links are invalid: " + valid.message());
+    NodeProblem where;
+    Status valid = pano_.ValidateLinks(num_threads, &where);
+    if (!valid.ok() && where.link) {
+      const std::string& file = TileFileAt(where.x, where.y, TileImageKind::kGraph);
+      std::string message = file + ": " + valid.message();
+      if (where.target_x >= 0) {
+        const std::string& target =
+            TileFileAt(where.target_x, where.target_y, TileImageKind::kGraph);
+        if (target != file) message += " (the node it points at is in " + target + ")";
+      }
+      return Status(valid.code(), std::move(message));
+    }
+    if (!valid.ok()) return valid;
   }
   level_ = -1;
   received_.clear();
@@ -142,6 +156,13 @@ Status ReadOptions::Check() const {
     return InvalidArgument("num_threads " + std::to_string(num_threads) + " is outside [1, 256]");
   if (max_pixels < 1) return InvalidArgument("max_pixels must be positive");
   return Status::Ok();
+}
+
+StatusOr<Manifest> ReadManifest(const FileSource& source, const ReaderChecks& checks) {
+  CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> bytes,
+                            source.Read(kManifestFileName, kMaxManifestBytes));
+  return ParseManifest(
+      std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), checks);
 }
 
 namespace {
@@ -169,15 +190,10 @@ StatusOr<TwoLayerPanorama> ReadPackage(const FileSource& source,
                                        const ImageDecoderFactory& decoders,
                                        const ReadOptions& options, Manifest* manifest_out) {
   CASUAL3D_RETURN_IF_ERROR(options.Check());
-  CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> manifest_bytes,
-                            source.Read(kManifestFileName, kMaxManifestBytes));
   ReaderChecks checks = options.checks;
   if (!options.verify_checksums) checks.Disable(ReaderCheck::kChecksumMismatch);
-  CASUAL3D_ASSIGN_OR_RETURN(
-      PackageReader reader,
-      PackageReader::Create(std::string_view(reinterpret_cast<const char*>(manifest_bytes.data()),
-                                             manifest_bytes.size()),
-                            checks));
+  CASUAL3D_ASSIGN_OR_RETURN(Manifest manifest, ReadManifest(source, checks));
+  PackageReader reader(std::move(manifest), checks);
   if (manifest_out != nullptr) *manifest_out = reader.manifest();
   CASUAL3D_ASSIGN_OR_RETURN(const ImageDecoder* decoder, decoders.DecoderFor(reader.image_format()));
   CASUAL3D_RETURN_IF_ERROR(reader.BeginLevel(options.level, options.max_pixels));

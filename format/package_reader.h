@@ -49,6 +49,8 @@ class ImageDecoderFactory {
   virtual StatusOr<const ImageDecoder*> DecoderFor(const TileImageFormat& format) const = 0;
 };
 
+struct ReadOptions;
+
 // Step-by-step reader of one package.
 class PackageReader {
  public:
@@ -89,13 +91,21 @@ class PackageReader {
 
   // After every image of every tile was added: checks present nodes and
   // clears absent ones (FinishDecodedPanorama; a message names the tile file
-  // of a bad value), validates the links (TwoLayerPanorama::ValidateLinks)
-  // and returns the panorama. The reader can then begin another level.
-  // Up to `num_threads` threads share the passes over the nodes.
+  // of a bad value), validates the links (TwoLayerPanorama::ValidateLinks; a
+  // message names the graph file of the node whose link is wrong, and that of
+  // the node it points at when another tile holds it) and returns the
+  // panorama. The reader can then begin another level. Its messages do not
+  // name the level: the caller does. Up to `num_threads` threads share the
+  // passes over the nodes.
   StatusOr<TwoLayerPanorama> FinishLevel(int num_threads = 1);
 
  private:
   PackageReader(Manifest manifest, const ReaderChecks& checks);
+  friend StatusOr<TwoLayerPanorama> ReadPackage(const FileSource&, const ImageDecoderFactory&,
+                                                const ReadOptions&, Manifest*);
+  // The path of the `kind` image of the tile holding pixel (x, y) of the
+  // level being assembled.
+  const std::string& TileFileAt(int x, int y, TileImageKind kind) const;
 
   Manifest manifest_;
   ReaderChecks checks_;
@@ -121,6 +131,13 @@ struct ReadOptions {
 
   Status Check() const;
 };
+
+// Reads manifest.json from `source` and parses it (ParseManifest, enforcing
+// `checks`); every message names manifest.json. ReadPackage does this first;
+// a caller that reports problems per level calls it once before the levels,
+// so that a problem of the manifest is not reported as one of a level.
+StatusOr<Manifest> ReadManifest(const FileSource& source,
+                                const ReaderChecks& checks = ReaderChecks());
 
 // Reads manifest.json and all tiles of `options.level` from `source`, decodes
 // them with the decoder `decoders` gives for the package's tile image format

@@ -259,10 +259,15 @@ bool TwoLayerPanorama::ScanIsValid(int num_threads) const {
   return valid.load();
 }
 
-Status TwoLayerPanorama::Validate(int num_threads) const { return Check(true, num_threads); }
-Status TwoLayerPanorama::ValidateLinks(int num_threads) const { return Check(false, num_threads); }
+Status TwoLayerPanorama::Validate(int num_threads, NodeProblem* where) const {
+  return Check(true, num_threads, where);
+}
+Status TwoLayerPanorama::ValidateLinks(int num_threads, NodeProblem* where) const {
+  return Check(false, num_threads, where);
+}
 
-Status TwoLayerPanorama::Check(bool nodes, int num_threads) const {
+Status TwoLayerPanorama::Check(bool nodes, int num_threads, NodeProblem* where) const {
+  if (where != nullptr) *where = NodeProblem();
   if (width_ < 1 || height_ < 1) {
     return InvalidData("panorama size " + std::to_string(width_) + "x" + std::to_string(height_) +
                        " is empty");
@@ -291,15 +296,18 @@ Status TwoLayerPanorama::Check(bool nodes, int num_threads) const {
   // fast scan; only a rejected one is scanned again, node by node, to name its
   // first problem in the order documented below.
   if (nodes ? ScanIsValid<true>(num_threads) : ScanIsValid<false>(num_threads)) return Status::Ok();
-  return FirstNodeOrLinkProblem();
+  return FirstNodeOrLinkProblem(where);
 }
 
-Status TwoLayerPanorama::FirstNodeOrLinkProblem() const {
+Status TwoLayerPanorama::FirstNodeOrLinkProblem(NodeProblem* where) const {
+  NodeProblem unused;
+  if (where == nullptr) where = &unused;
   // Per-node values first, so that the link pass can rely on `present` being 0 or 1.
   for (int l = 0; l < kNumLayers; ++l) {
     const LayerData& d = layers_[l];
     for (int y = 0; y < height_; ++y) {
       for (int x = 0; x < width_; ++x) {
+        *where = NodeProblem{l, x, y};
         const size_t i = index(x, y);
         const float* nrm = &d.normal[3 * i];
         if (d.present[i] > 1) {
@@ -344,6 +352,7 @@ Status TwoLayerPanorama::FirstNodeOrLinkProblem() const {
           const Direction dir = static_cast<Direction>(di);
           const Link link = GetLink(d.links[i], dir);
           if (link == Link::kNone) continue;
+          *where = NodeProblem{l, x, y, true};
           if (static_cast<int>(link) > static_cast<int>(Link::kBack)) {
             return InvalidData(Where(l, x, y) + ": " + DirectionName(di) +
                                " link has the reserved value 3");
@@ -353,6 +362,8 @@ Status TwoLayerPanorama::FirstNodeOrLinkProblem() const {
             return InvalidData(Where(l, x, y) + ": " + DirectionName(di) +
                                " link points outside the panorama (rows do not wrap)");
           }
+          where->target_x = nx;
+          where->target_y = ny;
           const int target_layer = link == Link::kFront ? kFront : kBack;
           const LayerData& t = layers_[target_layer];
           const size_t j = index(nx, ny);
@@ -370,6 +381,7 @@ Status TwoLayerPanorama::FirstNodeOrLinkProblem() const {
       }
     }
   }
+  *where = NodeProblem();
   return Status::Ok();
 }
 

@@ -79,6 +79,15 @@ struct LayerData {
   NodeArray<uint8_t> links;    // 4 Links packed as above.
 };
 
+// Where Validate() or ValidateLinks() found the problem they report, when it
+// is at a node.
+struct NodeProblem {
+  int layer = -1, x = -1, y = -1;  // The node; layer -1: not at a node (sizes, frame).
+  bool link = false;               // One of the node's links is wrong.
+  // The pixel the wrong link points at; -1 when it points outside the panorama.
+  int target_x = -1, target_y = -1;
+};
+
 class TwoLayerPanorama {
  public:
   TwoLayerPanorama() = default;
@@ -113,16 +122,17 @@ class TwoLayerPanorama {
   const std::optional<ViewHints>& view_hints() const { return view_hints_; }
 
   // Checks sizes, value ranges, and that every link is mutual and points at an
-  // existing node. Returns the first problem found, naming layer and pixel.
+  // existing node. Returns the first problem found, naming layer and pixel,
+  // and, if `where` is not null, stores where it is.
   // Rows are scanned on up to `num_threads` threads (format/parallel.h; 0: all
   // hardware threads); the result does not depend on it.
-  Status Validate(int num_threads = 1) const;
+  Status Validate(int num_threads = 1, NodeProblem* where = nullptr) const;
   // Validate() for a panorama whose node values are valid by construction,
   // such as the output of FinishDecodedPanorama (format/tile_codec.h): checks
   // sizes, the frame and every link, but not each node's values. A panorama
   // that fails is scanned node by node, naming its first problem exactly as
   // Validate() would.
-  Status ValidateLinks(int num_threads = 1) const;
+  Status ValidateLinks(int num_threads = 1, NodeProblem* where = nullptr) const;
 
   bool operator==(const TwoLayerPanorama& o) const;
 
@@ -131,11 +141,11 @@ class TwoLayerPanorama {
   // size and frame checks, then a single branch-light scan that only says
   // whether every node (if `nodes`) and link is valid, and the node-by-node
   // scan that names the first problem (run only when the first one fails).
-  Status Check(bool nodes, int num_threads) const;
+  Status Check(bool nodes, int num_threads, NodeProblem* where) const;
   // The single scan; kCheckNodes false checks the links only.
   template <bool kCheckNodes>
   bool ScanIsValid(int num_threads) const;
-  Status FirstNodeOrLinkProblem() const;
+  Status FirstNodeOrLinkProblem(NodeProblem* where = nullptr) const;
   friend struct TwoLayerPanoramaTestAccess;  // two_layer_test.cc compares the two scans.
 
   int width_ = 0;

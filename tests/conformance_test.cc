@@ -9,7 +9,8 @@
 // present nodes, graph_sha256; the CLI prints sizes and node counts), and
 // refuse every invalid vector with a message holding the words
 // spec/vectors/refusals.json gives for it (the rule it breaks and the file at
-// fault), without a doubled "level N:" prefix. Before that, the spec's table,
+// fault), naming a file of the package, without a doubled "level N:" prefix
+// and without any for a problem of manifest.json. Before that, the spec's table,
 // the vectors on disk, refusals.json and the reader checks
 // (format/reader_checks.h) must name the same rules.
 
@@ -125,6 +126,16 @@ void Judge(const std::string& reader, const Vector& v, const json::Value& expect
       std::distance(std::sregex_iterator(got.message.begin(), got.message.end(), level_prefix),
                     std::sregex_iterator());
   EXPECT_LE(count, 1) << "the level is named twice: " << got.message;
+  // A problem of manifest.json is the manifest's, not a level's.
+  if (got.message.find("manifest.json: ") != std::string::npos) {
+    EXPECT_EQ(count, 0) << "a manifest problem reported as a level's: " << got.message;
+  }
+  // The file at fault is named (spec/package.md Sec. 9.1): a tile file,
+  // manifest.json, or the .c3d container's directory.
+  static const std::regex file_named(
+      R"((^|[ "])(manifest\.json|single file|[A-Za-z0-9_./-]+\.webp): )");
+  EXPECT_TRUE(std::regex_search(got.message, file_named))
+      << "names no file of the package: " << got.message;
 }
 
 // --- The readers ------------------------------------------------------------

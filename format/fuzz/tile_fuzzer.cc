@@ -1,6 +1,7 @@
 // Fuzz target (format/fuzz/CMakeLists.txt): DecodeTileImage of a raw image
 // whose size, kind, quantization, checks and pixels come from the input, then FinishDecodedPanorama
-// and TwoLayerPanorama::Validate; and WebpContainerCoding of the input's bytes.
+// and TwoLayerPanorama::Validate (and ValidateLinks, where it finds a wrong link); and
+// WebpContainerCoding of the input's bytes.
 
 #include <algorithm>
 #include <map>
@@ -56,7 +57,19 @@ int FuzzTileDecode(const uint8_t* data, size_t size) {
   const ReaderChecks& checks = decoder.checks();
   const Image8& const_image = image;
   Status s = DecodeTileImage(const_image.view(), kind, 8, 4, w, h, decoder, &pano);
-  if (s.ok() && FinishDecodedPanorama(&pano, 1, checks).ok()) (void)pano.Validate();
+  if (!s.ok() || !FinishDecodedPanorama(&pano, 1, checks).ok()) return 0;
+  (void)pano.Validate();
+  // PackageReader names the graph images of a wrong link from where
+  // ValidateLinks found it: the node and the pixel it points at lie inside.
+  NodeProblem where;
+  if (!pano.ValidateLinks(1, &where).ok() && where.link) {
+    auto inside = [&](int x, int y) {
+      return x >= 0 && x < pano.width() && y >= 0 && y < pano.height();
+    };
+    if (!inside(where.x, where.y) ||
+        (where.target_x >= 0 && !inside(where.target_x, where.target_y)))
+      __builtin_trap();
+  }
   return 0;
 }
 

@@ -43,7 +43,7 @@ class NativePackage {
     ThrowIfError(manifest.status(), path_);
     manifest_json_.assign(manifest->begin(), manifest->end());
     StatusOr<Manifest> parsed = ParseManifest(manifest_json_);
-    ThrowIfError(parsed.status(), path_ + ": " + kManifestFileName);
+    ThrowIfError(parsed.status(), path_);  // Its messages name manifest.json.
     num_levels_ = static_cast<int>(parsed->levels.size());
     source_ = std::move(source).value();
   }
@@ -89,7 +89,8 @@ py::dict ReadMaster(const std::string& path) {
 }
 
 // What `casual3d validate` checks (cli/validate_command.cc), with its
-// messages: the package opens, then every level reads with every file's size
+// messages: the package opens, its manifest parses (a problem of it named as
+// manifest.json's, not a level's), then every level reads with every file's size
 // and SHA-256 verified, every tile decoded and the panorama validated.
 py::list Validate(const std::string& path, int threads) {
   StatusOr<std::unique_ptr<FileSource>> source = Status();
@@ -98,22 +99,27 @@ py::list Validate(const std::string& path, int threads) {
     source = OpenPackage(path);
   }
   if (!source.ok()) throw FormatError(source.status().message());
+  StatusOr<Manifest> parsed = Status();
+  {
+    py::gil_scoped_release release;
+    parsed = ReadManifest(**source);
+  }
+  if (!parsed.ok()) throw FormatError(path + ": " + parsed.status().message());
+  const Manifest& manifest = *parsed;
   ReadOptions options;
   options.num_threads = ReadThreads(threads);
   options.max_pixels = int64_t{kMaxPackageWidth} * kMaxPackageHeight;
   py::list levels;
-  Manifest manifest;
-  for (int level = 0, count = 1; level < count; ++level) {
+  for (int level = 0; level < static_cast<int>(manifest.levels.size()); ++level) {
     options.level = level;
     StatusOr<TwoLayerPanorama> pano = Status();
     {
       py::gil_scoped_release release;
-      pano = ReadPackage(**source, encoder::TileImageDecoders(), options, &manifest);
+      pano = ReadPackage(**source, encoder::TileImageDecoders(), options);
     }
     if (!pano.ok()) {
       throw FormatError(path + ": level " + std::to_string(level) + ": " + pano.status().message());
     }
-    count = static_cast<int>(manifest.levels.size());
     py::dict summary;
     summary["level"] = level;
     summary["width"] = pano->width();
