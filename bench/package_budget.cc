@@ -131,19 +131,26 @@ double AngleDeg(const float* a, const float* b) {
 }
 
 // Errors of level `level` of the candidate against the reference package and
-// the master's values (the master's level 0 only).
+// the master's values (the master's level 0 only). `other_master`: the
+// reference comes from another master (--against), whose node at a pixel may
+// be another surface or missing; only nodes present in both within 2% of
+// each other's depth are compared, and the count of the others is printed.
 void PrintErrors(int level, const TwoLayerPanorama& reference, const TwoLayerPanorama& candidate,
-                 const TwoLayerPanorama* master) {
+                 const TwoLayerPanorama* master, bool other_master) {
   std::vector<float> normal_deg, depth_rel;
   double normal_sum = 0, normal_to_master = 0;
+  int64_t compared = 0, skipped = 0;
   for (int l = 0; l < kNumLayers; ++l) {
     const LayerData& R = reference.layer(l);
     const LayerData& C = candidate.layer(l);
     for (size_t i = 0; i < R.present.size(); ++i) {
-      if (!R.present[i] || !C.present[i]) continue;
-      // The same surface only: depths more than 2% apart happen only against
-      // another master (--against), where the node may be another surface.
-      if (master == nullptr && std::fabs(C.depth_m[i] / R.depth_m[i] - 1.0f) > 0.02f) continue;
+      if (!R.present[i]) continue;
+      if (other_master &&
+          (!C.present[i] || std::fabs(C.depth_m[i] / R.depth_m[i] - 1.0f) > 0.02f)) {
+        ++skipped;
+        continue;
+      }
+      ++compared;
       const float* nr = &R.normal[3 * i];
       if (nr[0] != 0 || nr[1] != 0 || nr[2] != 0) {
         normal_deg.push_back(static_cast<float>(AngleDeg(nr, &C.normal[3 * i])));
@@ -162,8 +169,12 @@ void PrintErrors(int level, const TwoLayerPanorama& reference, const TwoLayerPan
   std::printf("  level %d normals vs reference: mean %.2f, p99 %.2f, max %.2f deg", level, mean,
               Percentile(&normal_deg, 0.99), normal_max);
   if (master != nullptr) std::printf("; vs master: max %.2f deg", normal_to_master);
-  std::printf("; depth vs %s: p99 %.4f%%, max %.4f%%\n", master != nullptr ? "master" : "reference",
+  std::printf("; depth vs %s: p99 %.4f%%, max %.4f%%", master != nullptr ? "master" : "reference",
               100 * Percentile(&depth_rel, 0.99), 100 * depth_max);
+  if (other_master)
+    std::printf(" (%lld nodes of both, %lld of the reference's left out: absent from or another surface in the candidate)",
+                static_cast<long long>(compared), static_cast<long long>(skipped));
+  std::printf("\n");
 }
 
 // Lambert shading (ambient 0.25, one light from the upper left in front of
@@ -259,7 +270,7 @@ int Main(int argc, char** argv) {
   }
   for (size_t l = 0; l < encoded.levels.size(); ++l)
     PrintErrors(static_cast<int>(l), reference.levels[l], encoded.levels[l],
-                l == 0 && against.empty() ? &*master : nullptr);
+                l == 0 && against.empty() ? &*master : nullptr, !against.empty());
   if (!shading.empty()) {
     const TwoLayerPanorama& a = reference.levels[0];
     Image8 image(2 * (a.width() / 4) + 8, a.height() / 4, 1, 255);

@@ -149,6 +149,18 @@ void AddEvaluateCommand(CLI::App& app) {
     if (!html.parent_path().empty() && !std::filesystem::is_directory(html.parent_path()))
       throw std::runtime_error(args->html + ": the folder " + html.parent_path().string() +
                                " does not exist (create it or choose another -o)");
+    // Image folders are made before the (long) evaluation, so that a wrong
+    // path fails at once.
+    for (const auto& [flag, dir] : {std::pair{"--viewer-images", &args->viewer_images},
+                                    std::pair{"--rephoto-images", &args->rephoto_images}}) {
+      if (dir->empty()) continue;
+      std::error_code ec;
+      std::filesystem::create_directories(*dir, ec);
+      if (ec || !std::filesystem::is_directory(*dir))
+        throw std::runtime_error(std::string(flag) + " " + *dir + ": cannot make this folder (" +
+                                 (ec ? ec.message() : "a file of that name exists") +
+                                 "; choose another)");
+    }
     std::vector<eval::PhotoModelEvaluation> evals;
     for (size_t k = 0; k < args->photo3d.size(); ++k) {
       const std::string& p = args->photo3d[k];
@@ -167,13 +179,11 @@ void AddEvaluateCommand(CLI::App& app) {
       if (e.viewer) {
         std::printf("  %s\n", eval::ViewerViewsSummary(*e.viewer).c_str());
         if (!args->viewer_images.empty()) {
-          std::filesystem::create_directories(args->viewer_images);
           eval::WriteViewerHeatmaps(*e.viewer, args->viewer_images, std::to_string(k) + "_");
           std::printf("  viewer heatmaps: %s/%zu_viewer_*.png\n", args->viewer_images.c_str(), k);
         }
       }
       if (!args->rephoto_images.empty()) {
-        std::filesystem::create_directories(args->rephoto_images);
         for (const eval::PhotoEvaluation& q : e.photos) {
           const std::string stem = (std::filesystem::path(args->rephoto_images) /
                                     (std::to_string(k) + "_" +

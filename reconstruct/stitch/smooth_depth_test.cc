@@ -1,6 +1,8 @@
 #include "reconstruct/stitch/smooth_depth.h"
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -36,6 +38,44 @@ TEST(SmoothDepthTest, NoiseFallsAndStepsStay) {
   }
   EXPECT_LT(std::sqrt(after / n), 0.3 * std::sqrt(before / n));
   EXPECT_EQ(smoothed.at(10, 10), 0.0f);
+}
+
+// Each pass smooths further; threads do not change the result; depths
+// that are not positive and finite stay as they are and count for nothing.
+TEST(SmoothDepthTest, PassesThreadsAndInvalidDepths) {
+  const int W = 48, H = 24;
+  ImageF depth(W, H, 1, 0.0f);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> noise(-0.01f, 0.01f);
+  for (float& d : depth.vector()) d = 3.0f * (1.0f + noise(rng));
+  depth.at(5, 5) = std::nanf("");
+  depth.at(6, 5) = -1.0f;
+  depth.at(7, 5) = std::numeric_limits<float>::infinity();
+  auto spread = [&](const ImageF& image) {
+    double sq = 0;
+    int n = 0;
+    for (int y = 4; y < H - 4; ++y)
+      for (int x = 10; x < W; ++x, ++n) sq += std::pow(image.at(x, y) / 3.0 - 1, 2);
+    return std::sqrt(sq / n);
+  };
+  DepthSmoothOptions options;
+  options.iterations = 1;
+  ImageF one = depth;
+  SmoothDepthAlongSurfaces(&one, options, 1);
+  options.iterations = 2;
+  ImageF two = depth, two_threads = depth;
+  SmoothDepthAlongSurfaces(&two, options, 1);
+  SmoothDepthAlongSurfaces(&two_threads, options, 3);
+  EXPECT_LT(spread(two), 0.8 * spread(one));
+  EXPECT_LT(spread(one), 0.5 * spread(depth));
+  // Bit for bit (the NaN included, so not with ==).
+  EXPECT_EQ(std::memcmp(two.vector().data(), two_threads.vector().data(),
+                        two.vector().size() * sizeof(float)),
+            0);
+  EXPECT_TRUE(std::isnan(two.at(5, 5)));
+  EXPECT_EQ(two.at(6, 5), -1.0f);
+  EXPECT_TRUE(std::isinf(two.at(7, 5)));
+  EXPECT_TRUE(std::isfinite(two.at(8, 5)) && std::abs(two.at(8, 5) - 3.0f) < 0.03f);
 }
 
 TEST(SmoothDepthTest, ColumnsWrapAndRadiusZeroKeepsTheDepth) {

@@ -253,9 +253,11 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
       for (int l = 0; l < L; ++l) {
         const warp::WarpedLayer& other = back ? full[l].back : full[l].front;
         int ox, oy;
-        if (!other.ToCrop(x, y, W, &ox, &oy)) continue;
+        // The same tests the chosen photo passed (on the back layer, not in
+        // front of the front), then the depth agreement.
+        if (!usable(l, x, y, front_depth, &ox, &oy)) continue;
         const float d = other.depth_m.at(ox, oy);
-        if (!(d > 0) || std::abs(d - depth) > options.blend_depth_tolerance * depth) continue;
+        if (std::abs(d - depth) > options.blend_depth_tolerance * depth) continue;
         const double w = std::exp(-kUpsampleStretchWeight * other.stretch.at(ox, oy));
         for (int c = 0; c < 3; ++c) sum[c] += w * other.rgb.at(ox, oy, c);
         dsum += w * std::log(d);
