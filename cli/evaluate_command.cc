@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli/command.h"
+#include "cli/described_option.h"
 #include "reconstruct/eval/evaluate.h"
 #include "reconstruct/eval/external_renders.h"
 #include "reconstruct/eval/report.h"
@@ -57,20 +58,13 @@ void AddEvaluateCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->html, "HTML report to write (one self-contained file)")
       ->capture_default_str();
   cmd->add_option("--json", args->json, "Also write the figures as JSON to this file");
-  cmd->add_option("--width", args->options.width,
-                  "Width of the rephotographs in pixels (the camera is scaled); 0 = photo size")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--width", args->options, args->options.width);
   cmd->add_option("--photos", args->options.photos,
                   "Photos to evaluate, by file name or index in the sorted model (default: the "
                   "3D photo's held-out photos, else all)");
-  cmd->add_option("--holdout-every", args->options.holdout_every,
-                  "Evaluate photos 0, N, 2N, ... (LLFF protocol: 8) when --photos is not given")
-      ->capture_default_str();
-  cmd->add_option("--shift", args->options.metrics.shift_radius_px,
-                  "Half-size of the shiftable window, pixels")
-      ->capture_default_str();
-  cmd->add_option("--threads", args->options.num_threads, "Worker threads; 0 = all cores")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--holdout-every", args->options, args->options.holdout_every);
+  AddDescribedOption(cmd, "--shift", args->options, args->options.metrics.shift_radius_px);
+  AddDescribedOption(cmd, "--threads", args->options, args->options.num_threads);
   cmd->add_option("--labels", args->labels,
                   "Names of the 3D photos in the report, one per 3D photo (default: their paths)");
   cmd->add_option("--reference", args->references,
@@ -80,23 +74,13 @@ void AddEvaluateCommand(CLI::App& app) {
   cmd->add_flag("--no-backdrop", args->no_backdrop,
                  "Viewer views: the mesh alone, without the backdrop the viewer draws behind "
                  "it (format/backdrop.h); the photos are always rendered without it");
-  cmd->add_option("--sheet-stretch", args->options.viewer.sheet_stretch,
-                  "Viewer views with the backdrop: triangles that look more than this many "
-                  "times larger from the eye than from the centre (sheets across depth steps) "
-                  "are left out, as the viewer does (format/sheet_stretch.h); 0 draws them")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--sheet-stretch", args->options, args->options.viewer.sheet_stretch);
   cmd->add_flag("--no-viewer-views", args->no_viewer_views,
                 "Skip the viewer-side measure (tears and stretched fill seen from 17 eyes over "
                 "the viewing volume)");
-  cmd->add_option("--viewer-width", args->options.viewer.width, "Width of the viewer views, pixels")
-      ->capture_default_str();
-  cmd->add_option("--viewer-height", args->options.viewer.height,
-                  "Height of the viewer views, pixels")
-      ->capture_default_str();
-  cmd->add_option("--stretch-factor", args->options.viewer.stretch_factor,
-                  "A triangle is stretched when longer on screen than this many times the "
-                  "view's median triangle")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--viewer-width", args->options, args->options.viewer.width);
+  AddDescribedOption(cmd, "--viewer-height", args->options, args->options.viewer.height);
+  AddDescribedOption(cmd, "--stretch-factor", args->options, args->options.viewer.stretch_factor);
   cmd->add_flag("--derive-view-hints", args->options.viewer.derive_hints,
                 "Viewer views: derive the view hints from the panorama even when the 3D photo "
                 "carries its own");
@@ -111,15 +95,12 @@ void AddEvaluateCommand(CLI::App& app) {
                   "Also write the evaluated photos' cameras as JSON (OpenGL view and projection "
                   "matrices in the panorama frame, which is glTF's) for rendering them elsewhere; "
                   "one 3D photo only");
-  cmd->add_option("--rendered", args->options.rendered_dir,
-                  "Score renderings made elsewhere instead of rendering here: one PNG per photo "
-                  "(<photo stem>.png, RGBA, alpha 0 = nothing drawn) from the cameras of "
-                  "--write-cameras");
+  AddDescribedOption(cmd, "--rendered", args->options, args->options.rendered_dir);
   cmd->callback([args] {
     args->options.viewer_views = !args->no_viewer_views;
     args->options.backdrop = !args->no_backdrop;
     if (const Status st = args->options.Check(); !st.ok())
-      throw std::invalid_argument("evaluate: --" + st.message());
+      throw std::invalid_argument("evaluate: " + st.message());
     if (!args->labels.empty() && args->labels.size() != args->photo3d.size())
       throw std::invalid_argument("--labels: " + std::to_string(args->labels.size()) +
                                   " names for " + std::to_string(args->photo3d.size()) +

@@ -2,10 +2,12 @@
 // (reconstruct/synth/synth.h; layout in spec/capture-folder.md).
 
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
 #include "cli/command.h"
+#include "cli/described_option.h"
 #include "reconstruct/synth/synth.h"
 
 namespace casual3d::cli {
@@ -20,24 +22,23 @@ void AddSynthCommand(CLI::App& app) {
                  "on a 90-degree arc around a subject 1.3 m ahead: a capture 3D photos are not made from)")
       ->capture_default_str();
   cmd->add_option("-o,--output", *out_dir, "Capture folder to write")->capture_default_str();
-  cmd->add_option("--width", options->width, "Photo width in pixels (default: 1152)");
-  cmd->add_option("--height", options->height, "Photo height in pixels (default: width * 3 / 4)");
-  cmd->add_option("--photos", options->num_photos, "Number of photos (default: partial 16, sphere 50, walk-around 12)");
-  cmd->add_option("--noise", options->noise_sigma, "Sensor noise sigma, 8-bit code values")
-      ->capture_default_str();
-  cmd->add_option("--exposure-jitter", options->exposure_jitter_stops,
-                  "Per-photo exposure jitter, +- stops")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--width", *options, options->width);
+  AddDescribedOption(cmd, "--height", *options, options->height);
+  AddDescribedOption(cmd, "--photos", *options, options->num_photos);
+  AddDescribedOption(cmd, "--noise", *options, options->noise_sigma);
+  AddDescribedOption(cmd, "--exposure-jitter", *options, options->exposure_jitter_stops);
   cmd->add_flag("--moving-object", options->moving_object,
                 "Move the blue ball by 1 cm between photos");
-  cmd->add_option("--seed", options->seed, "Seed (textures, jitter, noise)")->capture_default_str();
-  cmd->add_option("--panorama-width", options->panorama_width,
-                  "Ground-truth panorama width (height = width / 2)")
-      ->capture_default_str();
-  cmd->add_option("--jpeg-quality", options->jpeg_quality, "JPEG quality, 1..100")
-      ->capture_default_str();
-  cmd->add_option("--threads", options->num_threads, "Worker threads (0: all cores)")
-      ->capture_default_str();
+  AddDescribedOption(cmd, "--seed", *options, options->seed);
+  AddDescribedOption(cmd, "--panorama-width", *options, options->panorama_width)
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            if (std::atoi(text.c_str()) % 2 == 0) return std::string();
+            return text + " is odd; it must be even (height = width / 2)";
+          },
+          "", "even"));
+  AddDescribedOption(cmd, "--jpeg-quality", *options, options->jpeg_quality);
+  AddDescribedOption(cmd, "--threads", *options, options->num_threads);
   cmd->callback([options, rig_name, out_dir] {
     if (!synth::RigKindFromName(*rig_name, &options->rig)) {
       throw std::invalid_argument("--rig '" + *rig_name + "' is not partial, sphere or walk-around");

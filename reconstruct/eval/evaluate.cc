@@ -31,20 +31,6 @@ namespace casual3d::eval {
 
 namespace fs = std::filesystem;
 
-Status EvaluateOptions::Check() const {
-  if (width != 0 && (width < 16 || width > 8192))
-    return InvalidArgument("width: " + std::to_string(width) + " is outside [16, 8192] (or 0 for the photos' size)");
-  if (holdout_every < 0 || holdout_every > 1000)
-    return InvalidArgument("holdout_every: " + std::to_string(holdout_every) + " is outside [0, 1000]");
-  if (!(depth_tolerance > 0 && depth_tolerance <= 1))
-    return InvalidArgument("depth_tolerance: " + std::to_string(depth_tolerance) + " is outside (0, 1]");
-  if (num_threads < 0 || num_threads > 256)
-    return InvalidArgument("num_threads: " + std::to_string(num_threads) + " is outside [0, 256]");
-  if (const Status s = metrics.Check(); !s.ok()) return InvalidArgument("metrics." + s.message());
-  if (const Status s = viewer.Check(); !s.ok()) return InvalidArgument("viewer." + s.message());
-  return Status::Ok();
-}
-
 std::vector<int> SelectPhotos(const std::vector<std::string>& names,
                               const std::vector<std::string>& requested, int every,
                               const std::vector<std::string>& holdout) {

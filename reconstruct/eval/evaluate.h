@@ -37,6 +37,7 @@
 #include "format/image.h"
 #include "reconstruct/eval/rephoto_metrics.h"
 #include "reconstruct/eval/viewer_views.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::eval {
 
@@ -76,7 +77,33 @@ struct EvaluateOptions {
   // Needs cameras without lens distortion (the undistorted workspace).
   std::string rendered_dir;
 
-  Status Check() const;  // Names the field and its range.
+  // `photos`, a list, is not described (options_fields.h describes single
+  // values); any list is valid.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("width", o.width, R::ZeroOr(R::Closed(16, 8192)),
+            "Width of the rephotographs in pixels (the camera is scaled); 0 = photo size");
+    v.Field("holdout_every", o.holdout_every, R::Closed(0, 1000),
+            "Evaluate photos 0, N, 2N, ... (LLFF protocol: 8) when --photos is not given");
+    v.Struct("metrics", o.metrics);
+    v.Field("keep_images", o.keep_images, R::Any(),
+            "Keep the per-photo images (render, error map) for the HTML report");
+    v.Field("depth_tolerance", o.depth_tolerance, R::OpenClosed(0, 1),
+            "Relative depth error threshold of \"within\" in the ground-truth comparison");
+    v.Field("num_threads", o.num_threads, R::Closed(0, 256), "Worker threads; 0 = all cores",
+            util::Keyed::kNo);
+    v.Field("viewer_views", o.viewer_views, R::Any(),
+            "Measure what a viewer sees (tears and stretched fill from 17 views)");
+    v.Struct("viewer", o.viewer);
+    v.Field("backdrop", o.backdrop, R::Any(),
+            "Draw the 3D photo's backdrop with its mesh in the viewer views");
+    v.Field("rendered_dir", o.rendered_dir, R::Any(),
+            "Score renderings made elsewhere instead of rendering here: one PNG per photo "
+            "(<photo stem>.png, RGBA, alpha 0 = nothing drawn) from the cameras of "
+            "--write-cameras");
+  }
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
 
 // Depth of the rephotograph against a synthetic capture's ground truth

@@ -13,6 +13,7 @@
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/pipeline/panorama_stage.h"
 #include "reconstruct/synth/synth.h"
+#include "reconstruct/util/options_fields_testing.h"
 
 namespace casual3d::eval {
 namespace {
@@ -48,6 +49,17 @@ TEST(EvaluateOptionsTest, CheckNamesTheField) {
   options.width = 900;
   options.metrics.psnr_cap_db = -1;
   EXPECT_NE(options.Check().message().find("metrics.psnr_cap_db"), std::string::npos);
+  options.metrics.psnr_cap_db = 100;
+  options.viewer.width = 8;
+  EXPECT_EQ(options.Check().message(), "viewer.width 8 outside [16, 4096]");
+}
+
+TEST(EvaluateOptionsTest, EveryFieldButThePhotoListIsDescribed) {
+  util::testing::ExpectEveryFieldDescribed<RephotoMetricOptions>("metrics");
+  util::testing::ExpectEveryFieldDescribed<ViewerViewsOptions>("viewer");
+  // `photos` is a list, which options_fields.h does not describe.
+  EXPECT_EQ(util::DescribedFieldCount<EvaluateOptions>() + 1,
+            util::AggregateFieldCount<EvaluateOptions>());
 }
 
 // End to end on a tiny synthetic capture: the 3D photo is built by the

@@ -10,16 +10,6 @@
 
 namespace casual3d::eval {
 
-Status RephotoMetricOptions::Check() const {
-  if (shift_radius_px < 0 || shift_radius_px > 8)
-    return InvalidArgument("shift_radius_px: " + std::to_string(shift_radius_px) + " is outside [0, 8]");
-  if (!(psnr_cap_db > 0.0 && psnr_cap_db <= 1000.0))
-    return InvalidArgument("psnr_cap_db: " + std::to_string(psnr_cap_db) + " is outside (0, 1000]");
-  if (histogram_bins < 8 || histogram_bins > 4096)
-    return InvalidArgument("histogram_bins: " + std::to_string(histogram_bins) + " is outside [8, 4096]");
-  return Status::Ok();
-}
-
 namespace {
 
 // Mean SSIM map of one channel (Wang et al. 2004) with a Gaussian window.

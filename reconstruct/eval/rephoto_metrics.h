@@ -31,6 +31,7 @@
 
 #include "format/status.h"
 #include "format/image.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::eval {
 
@@ -42,8 +43,17 @@ struct RephotoMetricOptions {
   // Bins of the per-pixel error histogram over [0, 1]; [8, 4096].
   int histogram_bins = 256;
 
-  // Empty if valid, else "field: reason".
-  Status Check() const;  // Names the field and its range.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("shift_radius_px", o.shift_radius_px, R::Closed(0, 8),
+            "Half-size of the shiftable window, pixels");
+    v.Field("psnr_cap_db", o.psnr_cap_db, R::OpenClosed(0, 1000),
+            "PSNR reported for a covered area without any difference, dB");
+    v.Field("histogram_bins", o.histogram_bins, R::Closed(8, 4096),
+            "Bins of the per-pixel error histogram over [0, 1]");
+  }
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
 
 struct RephotoMetrics {

@@ -48,22 +48,6 @@ double TriangleScreenSize(const Mesh& mesh, size_t t, const Eigen::Vector3d& eye
 
 }  // namespace
 
-Status ViewerViewsOptions::Check() const {
-  if (width < 16 || width > 4096)
-    return InvalidArgument("width: " + std::to_string(width) + " is outside [16, 4096]");
-  if (height < 16 || height > 4096)
-    return InvalidArgument("height: " + std::to_string(height) + " is outside [16, 4096]");
-  if (!(stretch_factor >= 1 && stretch_factor <= 1000))
-    return InvalidArgument("stretch_factor: " + std::to_string(stretch_factor) + " is outside [1, 1000]");
-  if (!(sheet_stretch >= 0 && sheet_stretch <= 1000))
-    return InvalidArgument("sheet_stretch: " + std::to_string(sheet_stretch) + " is outside [0, 1000]");
-  if (!(closing_deg >= 0 && closing_deg <= 45))
-    return InvalidArgument("closing_deg: " + std::to_string(closing_deg) + " is outside [0, 45]");
-  if (num_threads < 0 || num_threads > 256)
-    return InvalidArgument("num_threads: " + std::to_string(num_threads) + " is outside [0, 256]");
-  return Status::Ok();
-}
-
 std::vector<render::GlCamera> ViewerCameras(const ViewHints& hints) {
   render::GlCamera base;
   base.yaw_deg = hints.yaw_deg;

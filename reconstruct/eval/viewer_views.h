@@ -51,6 +51,7 @@
 #include "format/two_layer.h"
 #include "format/view_hints.h"
 #include "reconstruct/render/mesh_renderer.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::eval {
 
@@ -77,7 +78,30 @@ struct ViewerViewsOptions {
   // does (format/sheet_stretch.h); 0 draws them all. [0, 1000].
   double sheet_stretch = kDefaultSheetStretch;
 
-  Status Check() const;  // Names the field and its range.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("width", o.width, R::Closed(16, 4096), "Width of the viewer views, pixels");
+    v.Field("height", o.height, R::Closed(16, 4096), "Height of the viewer views, pixels");
+    v.Field("stretch_factor", o.stretch_factor, R::Closed(1, 1000),
+            "A triangle is stretched when longer on screen than this many times the view's "
+            "median triangle");
+    v.Field("closing_deg", o.closing_deg, R::Closed(0, 45),
+            "Closing radius of the captured field's content mask, degrees");
+    v.Field("derive_hints", o.derive_hints, R::Any(),
+            "Derive the view hints from the panorama even when the 3D photo carries its own");
+    v.Field("keep_images", o.keep_images, R::Any(),
+            "Keep the rendering and the heatmap of each view (for the report)");
+    v.Field("num_threads", o.num_threads, R::Closed(0, 256), "Rendering threads; 0 = all cores",
+            util::Keyed::kNo);
+    v.Field("vertex_colors_from_triangle", o.vertex_colors_from_triangle, R::Any(),
+            "Triangles from this index on are a backdrop drawn in its vertex colours");
+    v.Field("sheet_stretch", o.sheet_stretch, R::Closed(0, 1000),
+            "Viewer views with the backdrop: triangles that look more than this many times "
+            "larger from the eye than from the centre (sheets across depth steps) are left out, "
+            "as the viewer does (format/sheet_stretch.h); 0 draws them");
+  }
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
 
 // The 17 viewer cameras of `hints` (index 0 the centre), and their names

@@ -60,33 +60,7 @@ RigOptions SynthOptions::ResolvedRig() const {
 }
 
 Status SynthOptions::Check() const {
-  if (width != 0 && (width < 16 || width > 16384)) {
-    return InvalidArgument("--width " + std::to_string(width) + " is outside 16..16384");
-  }
-  if (height != 0 && (height < 16 || height > 16384)) {
-    return InvalidArgument("--height " + std::to_string(height) + " is outside 16..16384");
-  }
-  if (num_photos != 0 && (num_photos < 2 || num_photos > 1000)) {
-    return InvalidArgument("--photos " + std::to_string(num_photos) + " is outside 2..1000");
-  }
-  if (!(noise_sigma >= 0 && noise_sigma <= 50)) return InvalidArgument("--noise must be in [0, 50] (8-bit code values)");
-  if (!(exposure_jitter_stops >= 0 && exposure_jitter_stops <= 3)) {
-    return InvalidArgument("--exposure-jitter must be in [0, 3] stops");
-  }
-  if (!(moving_step_m >= 0 && moving_step_m <= 0.2)) return InvalidArgument("moving_step_m must be in [0, 0.2] metres");
-  if (panorama_width < 16 || panorama_width > 16384 || panorama_width % 2 != 0) {
-    return InvalidArgument("--panorama-width " + std::to_string(panorama_width) + " must be even and in 16..16384");
-  }
-  if (jpeg_quality < 1 || jpeg_quality > 100) {
-    return InvalidArgument("--jpeg-quality " + std::to_string(jpeg_quality) + " is outside 1..100");
-  }
-  if (num_threads < 0) return InvalidArgument("--threads must be >= 0");
-  RenderOptions render;
-  render.edge_samples = edge_samples;
-  if (Status s = render.Check(); !s.ok()) return s;
-  SparsePointOptions sparse;
-  sparse.step_px = sparse_step_px;
-  if (Status s = sparse.Check(); !s.ok()) return s;
+  CASUAL3D_RETURN_IF_ERROR(util::CheckFields(*this));
   return ResolvedRig().Check();
 }
 

@@ -16,6 +16,7 @@
 
 #include "format/status.h"
 #include "reconstruct/synth/rig.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::synth {
 
@@ -36,7 +37,36 @@ struct SynthOptions {
   bool write_master = true;       // Also write ground_truth/master.exr.
   int num_threads = 0;            // 0: all cores.
 
-  // Empty if valid; otherwise one line naming the option and its valid range.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("rig", o.rig, R::Closed(0, 2), "Capture rig: partial, sphere or walk-around");
+    v.Field("width", o.width, R::ZeroOr(R::Closed(16, 16384)),
+            "Photo width in pixels; 0 = the rig's default (1152)");
+    v.Field("height", o.height, R::ZeroOr(R::Closed(16, 16384)),
+            "Photo height in pixels; 0 = width * 3 / 4");
+    v.Field("num_photos", o.num_photos, R::ZeroOr(R::Closed(2, 1000)),
+            "Number of photos; 0 = the rig's default (partial 16, sphere 50, walk-around 12)");
+    v.Field("noise_sigma", o.noise_sigma, R::Closed(0, 50), "Sensor noise sigma, 8-bit code values");
+    v.Field("exposure_jitter_stops", o.exposure_jitter_stops, R::Closed(0, 3),
+            "Per-photo exposure jitter, +- stops");
+    v.Field("moving_object", o.moving_object, R::Any(), "Move the blue ball between photos");
+    v.Field("moving_step_m", o.moving_step_m, R::Closed(0, 0.2),
+            "Ball displacement per photo when moving, metres");
+    v.Field("seed", o.seed, R::Any(), "Seed (textures, jitter, noise)");
+    v.Field("panorama_width", o.panorama_width, R::Closed(16, 16384),
+            "Ground-truth panorama width (height = width / 2)");
+    v.Require(o.panorama_width % 2 == 0, "panorama_width", "must be even (height = width / 2)");
+    v.Field("jpeg_quality", o.jpeg_quality, R::Closed(1, 100), "JPEG quality");
+    v.Field("edge_samples", o.edge_samples, R::Closed(1, 8),
+            "Anti-aliasing rays per axis at edge pixels");
+    v.Field("sparse_step_px", o.sparse_step_px, R::Closed(2, 4096),
+            "Grid spacing of sampled 3D points in each photo, pixels");
+    v.Field("write_master", o.write_master, R::Any(), "Also write ground_truth/master.exr");
+    v.Field("num_threads", o.num_threads, R::AtLeast(0), "Worker threads (0: all cores)",
+            util::Keyed::kNo);
+  }
+  // The described ranges, then the rig these options resolve to (rig.h).
   Status Check() const;  // Names the field and its range.
   // The rig these options describe (defaults filled in).
   RigOptions ResolvedRig() const;

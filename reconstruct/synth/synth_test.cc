@@ -16,6 +16,7 @@
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/image_io.h"
 #include "reconstruct/synth/ground_truth_panorama.h"
+#include "reconstruct/util/options_fields_testing.h"
 
 namespace casual3d::synth {
 namespace {
@@ -77,16 +78,20 @@ TEST_F(SynthTest, DifferentSeedGivesDifferentPhotos) {
 TEST_F(SynthTest, OptionsAreChecked) {
   SynthOptions o = Small();
   o.panorama_width = 1001;
-  EXPECT_NE(o.Check().message().find("--panorama-width"), std::string::npos);
+  EXPECT_NE(o.Check().message().find("panorama_width"), std::string::npos);
   EXPECT_THROW(GenerateCapture(o, scratch_.Path("bad")), std::invalid_argument);
   EXPECT_FALSE(fs::exists(scratch_.Path("bad")));
   o = Small();
   o.noise_sigma = -1;
-  EXPECT_NE(o.Check().message().find("--noise"), std::string::npos);
+  EXPECT_NE(o.Check().message().find("noise_sigma"), std::string::npos);
   o = Small();
   o.num_photos = 1;
-  EXPECT_NE(o.Check().message().find("--photos"), std::string::npos);
+  EXPECT_NE(o.Check().message().find("num_photos"), std::string::npos);
   EXPECT_TRUE(Small().Check().ok());
+}
+
+TEST(SynthOptionsTest, EveryFieldIsDescribed) {
+  util::testing::ExpectEveryFieldDescribed<SynthOptions>("SynthOptions");
 }
 
 double Median(std::vector<double> v) {

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <system_error>
 
@@ -12,10 +13,13 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// A bound as people write it: 0.5, 100, 1e+06.
+// A bound as people write it: 0.5, 100, 1e+06; an integer %g would round
+// (2147483648) in full.
 std::string BoundText(double v) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%g", v);
+  if (std::strtod(buf, nullptr) != v && v == std::floor(v) && std::fabs(v) < 1e15)
+    std::snprintf(buf, sizeof(buf), "%.0f", v);
   return buf;
 }
 

@@ -81,6 +81,13 @@ TEST(OptionsFields, ChecksRangesAndRequirementsNamingThePath) {
   EXPECT_EQ(CheckFields(o).message(), "num_threads -1 outside >= 0");
 }
 
+TEST(OptionsFields, BoundsReadAsWritten) {
+  EXPECT_EQ(Rule::Closed(0, 0.5).Text(), "[0, 0.5]");
+  EXPECT_EQ(Rule::ZeroOr(Rule::Closed(1, 1e6)).Text(), "0 or [1, 1e+06]");
+  // An integer that %g would round is written in full.
+  EXPECT_EQ(Rule::Closed(0, 2147483648.0).Text(), "[0, 2147483648]");
+}
+
 TEST(OptionsFields, KeyTextListsEveryKeyedFieldExactly) {
   Outer o;
   o.inner.search = 0.1;
