@@ -8,6 +8,8 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/described_option.h"
+#include "cli/encode_options.h"
 #include "cli/viewer_assets.h"
 #include "encoder/master_file.h"
 #include "encoder/package_writer.h"
@@ -17,22 +19,10 @@
 namespace casual3d::cli {
 namespace {
 
-struct EncodeCommandOptions {
-  std::string master;        // Input master file (OpenEXR).
-  std::string output;        // Output package folder.
-  std::string single_file;   // Optional .c3d output.
-  bool viewer = true;        // Add index.html and the viewer to the folder.
-  std::string capture;       // Optional sparse stage output whose advice the page shows.
-  std::string title;         // The page's title; empty: the output folder's name.
-  // Web delivery settings; --depth-bits 12 --normal-bits 8 keep each node's
-  // value as closely as PackageOptions' defaults.
-  encoder::PackageOptions package = encoder::DeliveryPackageOptions();
-};
-
 void RunEncode(const EncodeCommandOptions& o) {
   if (o.output.empty() && o.single_file.empty())
     throw std::runtime_error("encode: give an output folder with -o (and/or --single-file)");
-  Status check = o.package.Check();
+  Status check = o.Check();
   if (!check.ok()) throw std::runtime_error("encode: " + check.message());
   // The capture's advice for the page's info panel, as reconstruct gives it;
   // measured before anything is written so that a wrong folder leaves nothing.
@@ -88,19 +78,12 @@ void AddEncodeCommand(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", options->output, "Output package folder");
   cmd->add_option("--single-file", options->single_file, "Also write the package as one .c3d file");
-  cmd->add_option("--quality", options->package.color_quality,
-                  "Colour WebP quality, 0..100 (default 90)");
-  cmd->add_option("--tile-size", options->package.tile_size,
-                  "Tile side in pixels, 16..4096 (default 512)");
-  cmd->add_option("--levels", options->package.levels,
-                  "Levels of detail, 1..8; 0 = automatic (default)");
-  cmd->add_option("--depth-bits", options->package.depth_bits,
-                  "Bits of the log-depth code, 8..16 (default 10: relative error at most "
-                  "0.34% for far/near 1000; 12 for 0.084%)");
-  cmd->add_option("--normal-bits", options->package.normal_bits,
-                  "Bits per octahedral normal coordinate, 4..8 (default 5: angular error at "
-                  "most 8.1 degrees; 8 for 1 degree)");
-  cmd->add_option("--threads", options->package.num_threads, "Encoding threads; 0 = all cores");
+  AddDescribedOption(cmd, "--quality", *options, options->package.color_quality);
+  AddDescribedOption(cmd, "--tile-size", *options, options->package.tile_size);
+  AddDescribedOption(cmd, "--levels", *options, options->package.levels);
+  AddDescribedOption(cmd, "--depth-bits", *options, options->package.depth_bits);
+  AddDescribedOption(cmd, "--normal-bits", *options, options->package.normal_bits);
+  AddDescribedOption(cmd, "--threads", *options, options->package.num_threads);
   cmd->add_flag("!--no-viewer", options->viewer, "Do not add index.html and the viewer");
   cmd->add_option("--title", options->title,
                   "Title of the viewer page (default: the output folder's name)");

@@ -19,6 +19,8 @@
 
 #include "base/parallel_for.h"
 #include "cli/command.h"
+#include "cli/described_option.h"
+#include "cli/export_options.h"
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
 #include "encoder/tile_image_codec.h"
@@ -35,19 +37,6 @@ namespace {
 
 // The largest single-file package read into memory.
 constexpr uint64_t kMaxSingleFileBytes = uint64_t{4} << 30;
-
-struct ExportOptions {
-  std::string input;         // Package folder, single-file package or master file.
-  std::string glb;           // Output .glb path.
-  int level = 0;             // Package level of detail (0 = full resolution).
-  bool no_simplify = false;  // true: the full mesh of BuildMesh.
-  MeshSimplifyOptions simplify_options;
-  std::string texture = "jpeg";  // "jpeg" or "png".
-  encoder::GltfExportOptions gltf;
-  bool lit = false;  // Use a lit (PBR) material instead of KHR_materials_unlit.
-  bool no_normals = false;
-  int num_threads = 0;  // Tile decoding threads; 0 = all cores.
-};
 
 [[noreturn]] void Fail(const std::string& message) { throw std::runtime_error(message); }
 
@@ -132,8 +121,7 @@ void RunExport(ExportOptions& opts) {
   opts.gltf.unlit = !opts.lit;
   opts.gltf.normals = !opts.no_normals;
   // Options first, so that a bad value fails before any work.
-  if (Status s = opts.gltf.Check(); !s.ok()) Fail(s.message());
-  if (Status s = opts.simplify_options.Check(); !s.ok()) Fail(s.message());
+  if (Status s = opts.Check(); !s.ok()) Fail(s.message());
   const fs::path out_dir = fs::absolute(opts.glb).parent_path();
   if (!fs::is_directory(out_dir)) {
     Fail(opts.glb + ": the folder " + out_dir.string() + " does not exist; create it first");
@@ -220,53 +208,23 @@ void AddExportCommand(CLI::App& app) {
   cmd->add_option("--glb", opts->glb, "Output GLB file (written atomically)")->required();
   cmd->add_flag("--draco", opts->gltf.draco,
                 "Compress the mesh with Draco (KHR_draco_mesh_compression)");
-  cmd->add_option("--max-triangles", opts->simplify_options.max_triangles,
-                  "Triangle budget of the simplified mesh (0: only --max-error limits it)")
-      ->capture_default_str()
-      ->check(CLI::Range(int64_t{0}, int64_t{1} << 31));
-  cmd->add_option("--max-error", opts->simplify_options.max_relative_error,
-                  "Largest relative depth error of the simplification (0.01 = 1%)")
-      ->capture_default_str()
-      ->check(CLI::Range(1e-6, 0.5));
+  AddDescribedOption(cmd, "--max-triangles", *opts, opts->simplify_options.max_triangles);
+  AddDescribedOption(cmd, "--max-error", *opts, opts->simplify_options.max_relative_error);
   cmd->add_flag("--no-simplify", opts->no_simplify, "Export the full mesh, one vertex per node");
-  cmd->add_option("--level", opts->level, "Package level of detail to read (0 = full resolution)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 64));
-  cmd->add_option("--texture", opts->texture, "Texture format")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"jpeg", "png"}));
-  cmd->add_option("--jpeg-quality", opts->gltf.jpeg_quality, "JPEG quality (1..100)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 100));
-  cmd->add_option("--max-texture-size", opts->gltf.max_texture_size,
-                  "Longest texture side in pixels; larger atlases are shrunk (16..16384)")
-      ->capture_default_str()
-      ->check(CLI::Range(16, 16384));
+  AddDescribedOption(cmd, "--level", *opts, opts->level);
+  AddDescribedOption(cmd, "--texture", *opts, opts->texture);
+  AddDescribedOption(cmd, "--jpeg-quality", *opts, opts->gltf.jpeg_quality);
+  AddDescribedOption(cmd, "--max-texture-size", *opts, opts->gltf.max_texture_size);
   cmd->add_flag("--no-normals", opts->no_normals, "Leave out the NORMAL attribute");
   cmd->add_flag("--lit", opts->lit,
                 "Lit PBR material instead of KHR_materials_unlit (the photo's colours already "
                 "hold the scene's lighting)");
   cmd->add_flag("--double-sided", opts->gltf.double_sided, "Render both sides of triangles");
-  cmd->add_option("--draco-position-bits", opts->gltf.draco_position_bits,
-                  "Draco position quantization bits (1..30); 0 = enough for 0.1% of the nearest "
-                  "vertex's distance over the mesh's extent")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 30));
-  cmd->add_option("--draco-normal-bits", opts->gltf.draco_normal_bits,
-                  "Draco normal quantization bits (1..30)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 30));
-  cmd->add_option("--draco-texcoord-bits", opts->gltf.draco_texcoord_bits,
-                  "Draco texture coordinate quantization bits (1..30)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 30));
-  cmd->add_option("--draco-level", opts->gltf.draco_compression_level,
-                  "Draco compression level, 0 (fast) .. 10 (small)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 10));
-  cmd->add_option("--threads", opts->num_threads, "Tile decoding threads (0 = all cores)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 256));
+  AddDescribedOption(cmd, "--draco-position-bits", *opts, opts->gltf.draco_position_bits);
+  AddDescribedOption(cmd, "--draco-normal-bits", *opts, opts->gltf.draco_normal_bits);
+  AddDescribedOption(cmd, "--draco-texcoord-bits", *opts, opts->gltf.draco_texcoord_bits);
+  AddDescribedOption(cmd, "--draco-level", *opts, opts->gltf.draco_compression_level);
+  AddDescribedOption(cmd, "--threads", *opts, opts->num_threads);
   cmd->callback([opts]() { RunExport(*opts); });
 }
 

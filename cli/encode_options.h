@@ -1,0 +1,55 @@
+#pragma once
+
+// The options of `casual3d encode` (cli/encode_command.cc), described once
+// (reconstruct/util/options_fields.h) for the flags' help and range checks.
+//
+// encoder::PackageOptions lives in encoder/, below reconstruct/util, so it
+// keeps its own Check(); the fields the flags set are described here with
+// the same ranges (cli/command_options_test.cc holds them to it).
+
+#include <string>
+
+#include "encoder/package_writer.h"
+#include "format/manifest.h"
+#include "format/status.h"
+#include "reconstruct/util/options_fields.h"
+
+namespace casual3d::cli {
+
+struct EncodeCommandOptions {
+  std::string master;        // Input master file (OpenEXR).
+  std::string output;        // Output package folder.
+  std::string single_file;   // Optional .c3d output.
+  bool viewer = true;        // Add index.html and the viewer to the folder.
+  std::string capture;       // Optional sparse stage output whose advice the page shows.
+  std::string title;         // The page's title; empty: the output folder's name.
+  // Web delivery settings; --depth-bits 12 --normal-bits 8 keep each node's
+  // value as closely as PackageOptions' defaults.
+  encoder::PackageOptions package = encoder::DeliveryPackageOptions();
+
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("package.color_quality", o.package.color_quality, R::Closed(0, 100),
+            "Colour WebP quality");
+    v.Field("package.tile_size", o.package.tile_size, R::Closed(kMinTileSize, kMaxTileSize),
+            "Tile side in pixels");
+    v.Field("package.levels", o.package.levels, R::ZeroOr(R::Closed(1, kMaxLevels)),
+            "Levels of detail; 0 = automatic");
+    v.Field("package.depth_bits", o.package.depth_bits, R::Closed(8, 16),
+            "Bits of the log-depth code (10: relative error at most 0.34% for far/near 1000; "
+            "12 for 0.084%)");
+    v.Field("package.normal_bits", o.package.normal_bits, R::Closed(4, 8),
+            "Bits per octahedral normal coordinate (5: angular error at most 8.1 degrees; 8 for "
+            "1 degree)");
+    v.Field("package.num_threads", o.package.num_threads, R::Closed(0, 256),
+            "Encoding threads; 0 = all cores", util::Keyed::kNo);
+  }
+  // The described ranges, then encoder::PackageOptions::Check.
+  Status Check() const {
+    CASUAL3D_RETURN_IF_ERROR(util::CheckFields(*this));
+    return package.Check();
+  }
+};
+
+}  // namespace casual3d::cli
