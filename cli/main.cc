@@ -81,6 +81,10 @@ int main(int argc, char** argv) {
   });
   try {
     app.parse(argc, argv);
+  } catch (const CLI::ValidationError& e) {
+    // A value outside its option's range: one line naming the flag and the range.
+    std::fprintf(stderr, "casual3d: error: %s\n", e.what());
+    return 1;
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const std::exception& e) {
