@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "base/testing/scratch_dir.h"
 #include "format/tile_image_format.h"
@@ -98,20 +99,23 @@ class StaticServerTest : public casual3d::testing::TestWithScratchDir {
 
 TEST(MimeTypeTest, TileFormatsAndUsualWebTypes) {
   EXPECT_EQ(MimeType("l0/0-0.color.webp"), WebpTileImageFormat().mime_type);
-  EXPECT_EQ(MimeType("a/index.html"), "text/html; charset=utf-8");
-  EXPECT_EQ(MimeType("INDEX.HTML"), "text/html; charset=utf-8");
-  EXPECT_EQ(MimeType("casual3d-viewer.js"), "text/javascript; charset=utf-8");
-  EXPECT_EQ(MimeType("m.mjs"), "text/javascript; charset=utf-8");
-  EXPECT_EQ(MimeType("manifest.json"), "application/json");
-  EXPECT_EQ(MimeType("casual3d-format.wasm"), "application/wasm");
-  EXPECT_EQ(MimeType("a.png"), "image/png");
-  EXPECT_EQ(MimeType("a.jpeg"), "image/jpeg");
-  EXPECT_EQ(MimeType("a.css"), "text/css; charset=utf-8");
-  EXPECT_EQ(MimeType("a.svg"), "image/svg+xml");
-  EXPECT_EQ(MimeType("photo.glb"), "model/gltf-binary");
-  EXPECT_EQ(MimeType("master.exr"), "image/x-exr");
-  EXPECT_EQ(MimeType("photo.c3d"), "application/octet-stream");
-  EXPECT_EQ(MimeType("README"), "application/octet-stream");
+  const std::pair<const char*, const char*> kCases[] = {
+      {"a/index.html", "text/html; charset=utf-8"},
+      {"INDEX.HTML", "text/html; charset=utf-8"},
+      {"casual3d-viewer.js", "text/javascript; charset=utf-8"},
+      {"m.mjs", "text/javascript; charset=utf-8"},
+      {"manifest.json", "application/json"},
+      {"casual3d-format.wasm", "application/wasm"},
+      {"a.png", "image/png"},
+      {"a.jpeg", "image/jpeg"},
+      {"a.css", "text/css; charset=utf-8"},
+      {"a.svg", "image/svg+xml"},
+      {"photo.glb", "model/gltf-binary"},
+      {"master.exr", "image/x-exr"},
+      {"photo.c3d", "application/octet-stream"},
+      {"README", "application/octet-stream"},
+  };
+  for (const auto& [path, type] : kCases) EXPECT_EQ(MimeType(path), type) << path;
 }
 
 TEST_F(StaticServerTest, ServesFilesWithTheirTypes) {
