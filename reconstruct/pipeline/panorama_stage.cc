@@ -9,13 +9,13 @@
 #include <stdexcept>
 
 #include "encoder/master_file.h"
-#include "reconstruct/depth/workspace.h"
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/io/colour_map.h"
-#include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/pipeline/view_volume.h"
 #include "reconstruct/io/image_io.h"
+#include "reconstruct/pipeline/panorama_inputs.h"
+#include "reconstruct/pipeline/panorama_report.h"
 #include "reconstruct/sfm/scene_setup.h"
 #include "reconstruct/stitch/smooth_depth.h"
 #include "reconstruct/util/log.h"
@@ -102,6 +102,21 @@ void WriteHolesPreview(const Image8& fov, const Image8& holes, const std::string
   io::WritePng(path, out);
 }
 
+// The panorama's width: options.pano_width, or when 0 the one the photos'
+// angular resolution asks for (AutoPanoramaWidth).
+int PanoramaWidth(const geometry::SparseModel& model, const PanoramaStageOptions& options) {
+  if (options.pano_width != 0) return options.pano_width;
+  std::vector<geometry::Camera> cameras;
+  for (const auto& [id, image] : model.images) {
+    const auto cam = model.cameras.find(image.camera_id);
+    if (cam != model.cameras.end()) cameras.push_back(cam->second);
+  }
+  const int width = AutoPanoramaWidth(cameras, options.max_auto_width);
+  util::LogInfo("panorama: " + std::to_string(width) + "x" + std::to_string(width / 2) +
+                " from the photos' angular resolution");
+  return width;
+}
+
 }  // namespace
 
 int AutoPanoramaWidth(const std::vector<geometry::Camera>& cameras, int max_width) {
@@ -150,17 +165,7 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   auto t = Clock::now();
   const geometry::SparseModel model =
       geometry::ReadModel((fs::path(sparse_dir) / "sparse").string());
-  int W = options.pano_width;
-  if (W == 0) {
-    std::vector<geometry::Camera> cameras;
-    for (const auto& [id, image] : model.images) {
-      const auto cam = model.cameras.find(image.camera_id);
-      if (cam != model.cameras.end()) cameras.push_back(cam->second);
-    }
-    W = AutoPanoramaWidth(cameras, options.max_auto_width);
-    util::LogInfo("panorama: " + std::to_string(W) + "x" + std::to_string(W / 2) +
-                  " from the photos' angular resolution");
-  }
+  const int W = PanoramaWidth(model, options);
   if (options.stitch.solve_width > W)
     throw std::invalid_argument("panorama options: stitch.solve_width " +
                                 std::to_string(options.stitch.solve_width) +
@@ -169,60 +174,12 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   report.width = W;
   report.height = H;
   const PanoramaFrame frame = LoadOrComputeFrame(sparse_dir);
-  struct Loaded {
-    Image8 rgb;
-    ImageF depth;
-    geometry::Camera camera;
-    geometry::Pose pose;
-  };
-  std::vector<Loaded> photos;
+  std::vector<PanoramaPhoto> photos = LoadPanoramaPhotos(model, sparse_dir, depth_dir);
   std::vector<CoverageView> coverage_views;
-  {
-    util::Progress progress("panorama: loading photos", static_cast<int64_t>(model.images.size()));
-    for (const auto& [id, image] : model.images) {
-      Loaded p;
-      const auto cam = model.cameras.find(image.camera_id);
-      if (cam == model.cameras.end()) {
-        throw std::runtime_error(sparse_dir + "/sparse: image " + image.name +
-                                 " names a missing camera " + std::to_string(image.camera_id));
-      }
-      if (cam->second.HasDistortion()) {
-        throw std::runtime_error(sparse_dir + "/sparse: camera " + std::to_string(image.camera_id) +
-                                 " has lens distortion; the panorama stage needs undistorted "
-                                 "photos (run the sparse stage)");
-      }
-      p.camera = cam->second;
-      p.pose = image.pose;
-      coverage_views.push_back({p.camera, p.pose});
-      p.rgb = io::ReadImage((fs::path(sparse_dir) / "images" / image.name).string());
-      const std::string depth_path =
-          (fs::path(depth_dir) / "depth" / (depth::OutputStem(image.name) + ".exr")).string();
-      if (!fs::exists(depth_path)) {
-        throw std::runtime_error(depth_path + ": missing depth map for photo " + image.name +
-                                 " (run the dense stage first)");
-      }
-      p.depth = io::ReadExrChannels(depth_path, {"Z"});
-      photos.push_back(std::move(p));
-      progress.Advance();
-    }
-  }
-  if (photos.empty()) throw std::runtime_error(sparse_dir + "/sparse: the model has no photos");
+  for (const PanoramaPhoto& p : photos) coverage_views.push_back({p.camera, p.pose});
   report.num_photos = static_cast<int>(photos.size());
-
   // Sky (non-finite depth) gets a finite depth beyond everything else.
-  double sky = options.sky_depth_m;
-  if (sky <= 0) {
-    float far = 0;
-    for (const Loaded& p : photos)
-      for (float d : p.depth.vector())
-        if (std::isfinite(d) && d > far) far = d;
-    sky = far > 0 ? 1.5 * far : 1000.0;
-  }
-  report.sky_depth_m = sky;
-  for (Loaded& p : photos) {
-    for (float& d : p.depth.vector())
-      if (!std::isfinite(d) || d <= 0) d = static_cast<float>(sky);
-  }
+  report.sky_depth_m = FillSkyDepth(options.sky_depth_m, &photos);
   report.seconds_load = Seconds(t);
 
   // Warp at the output and at the solve resolution.
@@ -233,7 +190,7 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) R(r, c) = frame.rotation[3 * r + c];
   const Eigen::Vector3d centre(frame.centre[0], frame.centre[1], frame.centre[2]);
-  for (const Loaded& p : photos) {
+  for (const PanoramaPhoto& p : photos) {
     views.push_back({&p.rgb, &p.depth, p.camera, p.pose});
     const Eigen::Vector3d c = R * (p.pose.Center() - centre);
     geometry.push_back({{c.x(), c.y(), c.z()}});
@@ -350,54 +307,8 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   report.seconds_write = Seconds(t);
   report.seconds_total = Seconds(start);
 
-  nlohmann::json j;
-  j["photos"] = report.num_photos;
-  j["width"] = W;
-  j["height"] = H;
-  j["back_layer"] = options.back_layer;
-  j["sky_depth_m"] = report.sky_depth_m;
-  j["front_coverage"] = report.front_coverage;
-  auto coverage_json = [](const CoverageStats& c) {
-    return nlohmann::json{{"fov_pixels", c.fov_pixels},
-                          {"fov_steradians", c.fov_steradians},
-                          {"covered_fraction", c.covered_fraction},
-                          {"holes", c.num_holes},
-                          {"hole_pixels", c.hole_pixels},
-                          {"largest_hole_pixels", c.largest_hole_pixels},
-                          {"largest_hole_fraction", c.largest_hole_fraction},
-                          {"interior_holes", c.num_interior_holes},
-                          {"largest_interior_hole_fraction", c.largest_interior_hole_fraction},
-                          {"reference_depth_m", c.reference_depth_m}};
-  };
-  j["front_fov"] = coverage_json(report.front_fov);
-  j["view"] = nlohmann::json::parse(SerializeViewHints(*pano.view_hints()));
-  j["front_gaps_filled"] = report.front_gaps_filled;
-  j["front_footprint"] = coverage_json(report.front_footprint);
-  j["fuse"] = {{"front_nodes", report.fuse.front_nodes},
-               {"back_nodes_in", report.fuse.back_nodes_in},
-               {"back_nodes_redundant", report.fuse.back_nodes_redundant},
-               {"back_nodes_hallucinated", report.fuse.back_nodes_hallucinated},
-               {"front_nodes_relabelled", report.fuse.front_nodes_relabelled},
-               {"links", report.fuse.links}};
-  j["seal"] = {{"enabled", options.seal_tears},
-               {"open_quads_before", report.seal.open_quads_before},
-               {"open_quads_after", report.seal.open_quads_after},
-               {"back_open_quads_before", report.seal.back_open_quads_before},
-               {"back_open_quads_after", report.seal.back_open_quads_after},
-               {"front_surface_open_quads_before", report.seal.front_surface_open_quads_before},
-               {"front_surface_open_quads_after", report.seal.front_surface_open_quads_after},
-               {"links_made", report.seal.links_made},
-               {"back_nodes_added", report.seal.back_nodes_added}};
-  j["normals"] = {{"nodes", report.normals.nodes}, {"sky_nodes", report.normals.sky_nodes}};
-  j["seconds"] = {{"load", report.seconds_load},
-                  {"warp", report.seconds_warp},
-                  {"stitch_front", report.seconds_stitch_front},
-                  {"stitch_back", report.seconds_stitch_back},
-                  {"fuse", report.seconds_fuse},
-                  {"normals", report.seconds_normals},
-                  {"write", report.seconds_write},
-                  {"total", report.seconds_total}};
-  io::WriteFileAtomic((fs::path(out_dir) / "panorama.json").string(), j.dump(2) + "\n");
+  io::WriteFileAtomic((fs::path(out_dir) / "panorama.json").string(),
+                      PanoramaReportJson(report, options, *pano.view_hints()));
   if (report_out) *report_out = report;
   return pano;
 }
