@@ -134,13 +134,11 @@ void AddEvaluateCommand(CLI::App& app) {
     // path fails at once.
     for (const auto& [flag, dir] : {std::pair{"--viewer-images", &args->viewer_images},
                                     std::pair{"--rephoto-images", &args->rephoto_images}}) {
-      if (dir->empty()) continue;
-      std::error_code ec;
-      std::filesystem::create_directories(*dir, ec);
-      if (ec || !std::filesystem::is_directory(*dir))
-        throw std::runtime_error(std::string(flag) + " " + *dir + ": cannot make this folder (" +
-                                 (ec ? ec.message() : "a file of that name exists") +
-                                 "; choose another)");
+      try {
+        if (!dir->empty()) io::CreateDirectories(*dir);
+      } catch (const std::exception& e) {
+        throw std::runtime_error(std::string(flag) + " " + e.what() + " (choose another folder)");
+      }
     }
     std::vector<eval::PhotoModelEvaluation> evals;
     for (size_t k = 0; k < args->photo3d.size(); ++k) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "base/parallel_for.h"
+#include "format/equirect.h"
 
 namespace casual3d::stitch {
 
@@ -30,7 +31,7 @@ void SmoothDepthAlongSurfaces(ImageF* depth_m, const DepthSmoothOptions& options
   const float lo = std::log(1.0f - tol), hi = std::log(1.0f + tol);
   // Column of x + dx for dx in [-r, r] at index x + dx + r (wrapping).
   std::vector<int> column(static_cast<size_t>(W) + 2 * r);
-  for (int k = 0; k < W + 2 * r; ++k) column[k] = ((k - r) % W + W) % W;
+  for (int k = 0; k < W + 2 * r; ++k) column[k] = WrapColumn(k - r, W);
   std::vector<float> next = log_depth;
   for (int pass = 0; pass < options.iterations; ++pass) {
     base::ParallelFor(0, H, base::ResolveThreads(num_threads), [&](int64_t y64) {
