@@ -199,6 +199,8 @@ int Main(int argc, char** argv) {
     std::fprintf(stderr, "usage: package_budget MASTER.exr [--normal-bits B] [--depth-bits B] "
                          "[--lossless-effort F] [--lossless-method M] [--tile-size T] "
                          "[--color-quality Q] [--color-method M] [--no-fill-absent] "
+                         "[--lossy-normals | --lossless-normals] [--normal-mean-error DEG] "
+                         "[--normal-p99-error DEG] "
                          "[--reference-only] [--shading out.png] [--write-package DIR] "
                          "[--against OTHER.exr]\n");
     return 2;
@@ -218,6 +220,10 @@ int Main(int argc, char** argv) {
     else if (arg == "--color-quality" && has_value) candidate.color_quality = static_cast<float>(std::atof(argv[++a]));
     else if (arg == "--color-method" && has_value) candidate.color_method = std::atoi(argv[++a]);
     else if (arg == "--no-fill-absent") candidate.fill_absent = false;
+    else if (arg == "--lossless-normals") candidate.lossy_normals = false;
+    else if (arg == "--lossy-normals") candidate.lossy_normals = true;
+    else if (arg == "--normal-mean-error" && has_value) candidate.normal_mean_error_deg = std::atof(argv[++a]);
+    else if (arg == "--normal-p99-error" && has_value) candidate.normal_p99_error_deg = std::atof(argv[++a]);
     else if (arg == "--shading" && has_value) shading = argv[++a];
     else if (arg == "--write-package" && has_value) package_dir = argv[++a];
     else if (arg == "--against" && has_value) against = argv[++a];
@@ -254,9 +260,13 @@ int Main(int argc, char** argv) {
   }
   PrintSizes("reference", reference);
   const Encoded encoded = EncodeAndDecode(*master, candidate);
-  std::printf("candidate: normal bits %d, depth bits %d, lossless effort %g method %d, "
+  std::printf("candidate: normals %s, depth bits %d, lossless effort %g method %d, "
               "tile size %d, colour quality %g method %d, absent nodes %s\n",
-              candidate.normal_bits, candidate.depth_bits, candidate.lossless_effort,
+              candidate.lossy_normals
+                  ? ("lossy within " + std::to_string(candidate.normal_mean_error_deg) + " / " +
+                     std::to_string(candidate.normal_p99_error_deg) + " deg").c_str()
+                  : (std::to_string(candidate.normal_bits) + " bits").c_str(),
+              candidate.depth_bits, candidate.lossless_effort,
               candidate.lossless_method, candidate.tile_size, candidate.color_quality,
               candidate.color_method, candidate.fill_absent ? "filled" : "zero");
   PrintSizes("candidate", encoded);

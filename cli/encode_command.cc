@@ -1,5 +1,6 @@
 // `casual3d encode <master.exr> -o <package> [--quality Q] [--tile-size N]
-// [--levels N] [--depth-bits B] [--normal-bits B] [--single-file out.c3d]
+// [--levels N] [--depth-bits B] [--normal-bits B] [--lossless-normals]
+// [--normal-mean-error DEG] [--normal-p99-error DEG] [--single-file out.c3d]
 // [--capture SPARSE_DIR] [--title T]`: turns a master file into a web package
 // (spec/package.md), optionally also as one .c3d file.
 
@@ -83,6 +84,11 @@ void AddEncodeCommand(CLI::App& app) {
   AddDescribedOption(cmd, "--levels", *options, options->package.levels);
   AddDescribedOption(cmd, "--depth-bits", *options, options->package.depth_bits);
   AddDescribedOption(cmd, "--normal-bits", *options, options->package.normal_bits);
+  cmd->add_flag("!--lossless-normals", options->package.lossy_normals,
+                "Store normals as lossless codes of --normal-bits (package version 1.1) instead "
+                "of lossy images within --normal-mean-error and --normal-p99-error");
+  AddDescribedOption(cmd, "--normal-mean-error", *options, options->package.normal_mean_error_deg);
+  AddDescribedOption(cmd, "--normal-p99-error", *options, options->package.normal_p99_error_deg);
   AddDescribedOption(cmd, "--threads", *options, options->package.num_threads);
   cmd->add_flag("!--no-viewer", options->viewer, "Do not add index.html and the viewer");
   cmd->add_option("--title", options->title,

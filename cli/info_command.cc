@@ -32,7 +32,12 @@ void RunInfo(const std::string& path) {
   std::printf("depth        log, %d bits, %.6g .. %.6g m (max relative error %.4f%%)\n",
               m->depth.bits, m->depth.near_m, m->depth.far_m,
               100.0 * m->depth.MaxRelativeError());
-  std::printf("normals      octahedral, %d bits per coordinate\n", m->normal.bits);
+  if (m->normal.lossy())
+    std::printf("normals      octahedral, lossy: per tile mean error at most %g, 99th percentile "
+                "at most %g degrees\n",
+                m->normal.mean_error_deg, m->normal.p99_error_deg);
+  else
+    std::printf("normals      octahedral, %d bits per coordinate\n", m->normal.bits);
   if (m->view) {
     const ViewHints& v = *m->view;
     const char* unit = v.metric ? " m" : " (the capture's units)";

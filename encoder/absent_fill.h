@@ -13,7 +13,8 @@ namespace casual3d::encoder {
 
 // Fills the pixels of absent nodes of a depth or normal tile image `image`
 // (w x 2h, 3 channels: rows [0, h) the front layer and [h, 2h) the back layer,
-// as EncodeTileImage writes it) of the tile at (x0, y0) of `pano`. In each
+// as EncodeTileImage writes it; for lossy normals 2w x 2h, 4 channels, each
+// half of w columns filled alike) of the tile at (x0, y0) of `pano`. In each
 // column of each layer half, an absent node takes the code of the nearest
 // present node above it in the tile, or, above the column's first present
 // node, that node's code; a column without present nodes takes the filled

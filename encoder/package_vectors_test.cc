@@ -430,10 +430,19 @@ void Regenerate() {
   int cross_links = 0;
   TwoLayerPanorama cross = CrossLayerPanorama(64, 32, 11, &cross_links);
   ASSERT_GT(cross_links, 0);
+  // Version 1.2: lossy normals, with a block of unlit (zero-normal) nodes.
+  PackageOptions lossy = two_levels;
+  lossy.lossy_normals = true;
+  TwoLayerPanorama lossy_pano = casual3d::testing::MakePackageTestPanorama(64, 32, 3);
+  for (int y = 4; y < 12; ++y)
+    for (int x = 40; x < 56; ++x)
+      for (int l = 0; l < kNumLayers; ++l)
+        std::fill_n(&lossy_pano.layer(l).normal[3 * lossy_pano.index(x, y)], 3, 0.0f);
   Vector vectors[] = {
       {"two-layer-64x32", casual3d::testing::MakePackageTestPanorama(64, 32, 3), two_levels},
       {"front-only-48x24", std::move(front_only), one_level},
       {"cross-layer-64x32", std::move(cross), two_levels},
+      {"lossy-normals-64x32", std::move(lossy_pano), lossy},
   };
   std::map<std::string, PackageFiles> encoded;
   for (Vector& v : vectors) {
@@ -483,7 +492,7 @@ TEST(PackageVectorsTest, ValidVectorsDecodeToTheExpectedValues) {
   StatusOr<Value> expected = json::Parse(std::string_view(reinterpret_cast<const char*>(text.data()), text.size()));
   ASSERT_TRUE(expected.ok()) << expected.status().ToString();
   WebpImageDecoder decoder;
-  ASSERT_EQ(expected->object().size(), 3u);
+  ASSERT_EQ(expected->object().size(), 4u);
   for (const auto& [name, levels] : expected->object()) {
     for (const std::string& form : {name, name + ".c3d"}) {
       StatusOr<std::unique_ptr<FileSource>> source = OpenPackage((dir / form).string());

@@ -6,12 +6,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <system_error>
+#include <utility>
 
 #include "base/atomic_file.h"
 #include "base/parallel_for.h"
 
 #include "encoder/absent_fill.h"
 #include "encoder/level_of_detail.h"
+#include "encoder/lossy_normal_tile.h"
 #include "encoder/tile_image_codec.h"
 #include "format/sha256.h"
 #include "format/single_file.h"
@@ -78,6 +80,12 @@ Status PackageOptions::Check() const {
   NormalQuantization normal;
   normal.bits = normal_bits;
   CASUAL3D_RETURN_IF_ERROR(normal.Check());
+  for (const auto& [name, value] : {std::make_pair("normal_mean_error_deg", normal_mean_error_deg),
+                                    std::make_pair("normal_p99_error_deg", normal_p99_error_deg)}) {
+    if (!(value >= 1.0 && value <= 90.0))
+      return InvalidArgument(std::string(name) + " " + std::to_string(value) +
+                             " is outside [1, 90]");
+  }
   if (num_threads < 0 || num_threads > 256)
     return InvalidArgument("num_threads " + std::to_string(num_threads) +
                            " is outside [0, 256] (0 = all cores)");
@@ -130,11 +138,18 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
   manifest.frame = pano.frame();
   // The lowest minor version whose members the manifest uses.
   manifest.view = pano.view_hints();
-  manifest.version_minor = manifest.view ? 1 : 0;
+  manifest.version_minor = options.lossy_normals ? 2 : manifest.view ? 1 : 0;
   manifest.tile_size = options.tile_size;
   manifest.depth = DepthRange(pano);
   manifest.depth.bits = options.depth_bits;
-  manifest.normal.bits = options.normal_bits;
+  if (options.lossy_normals) {
+    manifest.normal.type = NormalEncoding::kOctahedralLossy;
+    manifest.normal.bits = 8;
+    manifest.normal.mean_error_deg = options.normal_mean_error_deg;
+    manifest.normal.p99_error_deg = options.normal_p99_error_deg;
+  } else {
+    manifest.normal.bits = options.normal_bits;
+  }
   CASUAL3D_ASSIGN_OR_RETURN(const TileImageFormat* image_format, TileImageFormatOf(manifest));
   CASUAL3D_ASSIGN_OR_RETURN(const TileImageCodec* codec, TileImageCodecFor(*image_format));
 
@@ -185,11 +200,14 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
         (job.kind == TileImageKind::kDepth || job.kind == TileImageKind::kNormal))
       FillAbsentCodes(*level_pano[job.level], x, y, w, h, &image);
     TileEncodeSettings settings;
-    settings.lossless = TileImageIsLossless(job.kind);
+    settings.lossless = TileImageIsLossless(job.kind, manifest.normal.type);
     settings.quality = settings.lossless ? options.lossless_effort : options.color_quality;
     settings.method = settings.lossless ? options.lossless_method : options.color_method;
     StatusOr<std::vector<uint8_t>> bytes =
-        codec->Encode(static_cast<const Image8&>(image).view(), settings);
+        job.kind == TileImageKind::kNormal && manifest.normal.lossy()
+            ? EncodeLossyNormalTile(*level_pano[job.level], x, y, w, h, image, manifest.normal,
+                                    *codec, options.color_method)
+            : codec->Encode(static_cast<const Image8&>(image).view(), settings);
     if (!bytes.ok()) {
       job_status[j] = Status(bytes.status().code(), job.path + ": " + bytes.status().message());
       failed.store(true);

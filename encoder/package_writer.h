@@ -35,6 +35,15 @@ struct PackageOptions {
   int depth_bits = 12;
   // Octahedral normal bits per coordinate (4..8): 8 gives at most ~0.9 degrees.
   int normal_bits = 8;
+  // Normals as lossy images (spec/package.md 1.2, "octahedral-lossy") instead
+  // of lossless codes of normal_bits: each tile at the lowest WebP quality
+  // whose decoded normals are within normal_mean_error_deg on average and
+  // normal_p99_error_deg at the 99th percentile of the panorama's, over the
+  // tile's lit present nodes (lossy_normal_tile.h); bounds in degrees,
+  // [1, 90]. The manifest declares the bounds and says version 1.2.
+  bool lossy_normals = false;
+  double normal_mean_error_deg = 2.5;
+  double normal_p99_error_deg = 8.0;
   // Fill the depth and normal codes of absent nodes with codes of nearby
   // present nodes (absent_fill.h) instead of zeros: the decoded panorama is
   // the same, the lossless tiles smaller (4-9% on reconstructions). Off by

@@ -18,7 +18,8 @@ Status WebpEncodeOptions::Check() const {
 StatusOr<std::vector<uint8_t>> EncodeWebp(ImageView<const uint8_t> rgb,
                                           const WebpEncodeOptions& options) {
   CASUAL3D_RETURN_IF_ERROR(options.Check());
-  if (rgb.channels() != 3) return InvalidArgument("EncodeWebp needs a 3-channel image");
+  if (rgb.channels() != 3 && rgb.channels() != 4)
+    return InvalidArgument("EncodeWebp needs a 3- or 4-channel image");
   if (rgb.width() < 1 || rgb.height() < 1 || rgb.width() > kMaxWebpDimension ||
       rgb.height() > kMaxWebpDimension)
     return InvalidArgument("image size " + std::to_string(rgb.width()) + "x" +
@@ -39,7 +40,11 @@ StatusOr<std::vector<uint8_t>> EncodeWebp(ImageView<const uint8_t> rgb,
   picture.width = rgb.width();
   picture.height = rgb.height();
   picture.use_argb = options.lossless ? 1 : 0;
-  if (!WebPPictureImportRGB(&picture, rgb.data(), static_cast<int>(rgb.stride()))) {
+  const int imported =
+      rgb.channels() == 4
+          ? WebPPictureImportRGBA(&picture, rgb.data(), static_cast<int>(rgb.stride()))
+          : WebPPictureImportRGB(&picture, rgb.data(), static_cast<int>(rgb.stride()));
+  if (!imported) {
     WebPPictureFree(&picture);
     return InternalError("WebP: out of memory importing a " + std::to_string(rgb.width()) + "x" +
                          std::to_string(rgb.height()) + " image");
@@ -68,8 +73,15 @@ StatusOr<Image8> DecodeWebp(const uint8_t* data, size_t size, int64_t max_pixels
       static_cast<int64_t>(width) * height > max_pixels)
     return LimitExceeded("WebP image of " + std::to_string(width) + "x" + std::to_string(height) +
                          " exceeds the limit");
-  Image8 image(width, height, 3);
-  if (WebPDecodeRGBInto(data, size, image.data(), image.size(), width * 3) == nullptr)
+  WebPBitstreamFeatures features;
+  if (WebPGetFeatures(data, size, &features) != VP8_STATUS_OK)
+    return InvalidData("not a WebP image");
+  const int channels = features.has_alpha ? 4 : 3;
+  Image8 image(width, height, channels);
+  const uint8_t* decoded =
+      channels == 4 ? WebPDecodeRGBAInto(data, size, image.data(), image.size(), width * 4)
+                    : WebPDecodeRGBInto(data, size, image.data(), image.size(), width * 3);
+  if (decoded == nullptr)
     return InvalidData("WebP image of " + std::to_string(width) + "x" + std::to_string(height) +
                        " is truncated or corrupt");
   return image;

@@ -28,13 +28,16 @@ struct WebpEncodeOptions {
   Status Check() const;
 };
 
-// Encodes a 3-channel (RGB) image. Lossless encodings keep every value exactly.
+// Encodes a 3-channel (RGB) or 4-channel (RGBA) image. Lossless encodings keep
+// every value exactly; lossy ones keep alpha exactly (it is coded losslessly)
+// and the colour under any alpha (tile images carry data).
 StatusOr<std::vector<uint8_t>> EncodeWebp(ImageView<const uint8_t> rgb,
                                           const WebpEncodeOptions& options);
 
-// Decodes WebP bytes to a 3-channel RGB image. Untrusted input: returns
-// kInvalidData for anything that is not a decodable WebP image and
-// kLimitExceeded above kMaxWebpDimension or `max_pixels` pixels.
+// Decodes WebP bytes to a 3-channel RGB image, or RGBA when the image has
+// alpha. Untrusted input: returns kInvalidData for anything that is not a
+// decodable WebP image and kLimitExceeded above kMaxWebpDimension or
+// `max_pixels` pixels.
 StatusOr<Image8> DecodeWebp(const uint8_t* data, size_t size,
                             int64_t max_pixels = int64_t{1} << 26);
 

@@ -15,6 +15,7 @@ constexpr const char* kProjection = "equirectangular";
 constexpr const char* kAxes = "right-up-back";
 constexpr const char* kDepthType = "log";
 constexpr const char* kNormalType = "octahedral";
+constexpr const char* kNormalLossyType = "octahedral-lossy";  // Version 1.2.
 constexpr const char* kColorType = "srgb8";
 
 // Typed member access with messages that name the member's path.
@@ -327,8 +328,20 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes, const ReaderChecks& che
   C3D_CHECK(dr.Int("bits", 8, 16, &m.depth.bits));
   C3D_CHECK(r.Get("normal_encoding", json::Type::kObject, &enc));
   Reader nr(*enc, "normal_encoding");
-  C3D_CHECK(nr.Constant("type", kNormalType));
-  C3D_CHECK(nr.Int("bits", 4, 8, &m.normal.bits));
+  std::string normal_type;
+  C3D_CHECK(nr.String("type", &normal_type));
+  if (normal_type == kNormalType) {
+    C3D_CHECK(nr.Int("bits", 4, 8, &m.normal.bits));
+  } else if (normal_type == kNormalLossyType) {
+    m.normal.type = NormalEncoding::kOctahedralLossy;
+    m.normal.bits = 8;
+    C3D_CHECK(nr.Number("mean_error_deg", &m.normal.mean_error_deg));
+    C3D_CHECK(nr.Number("p99_error_deg", &m.normal.p99_error_deg));
+  } else {
+    return fail(InvalidData("normal_encoding.type: \"" + normal_type.substr(0, 40) +
+                            "\" is not supported (this reader knows \"" + kNormalType +
+                            "\" and \"" + kNormalLossyType + "\")"));
+  }
   C3D_CHECK(r.Get("color_encoding", json::Type::kObject, &enc));
   C3D_CHECK(Reader(*enc, "color_encoding").Constant("type", kColorType));
 
@@ -413,8 +426,14 @@ std::string SerializeManifest(const Manifest& m) {
   depth.Set("far_m", Value::Number(m.depth.far_m));
   root.Set("depth_encoding", std::move(depth));
   Value normal = Value::Object();
-  normal.Set("type", Value::String(kNormalType));
-  normal.Set("bits", Value::Number(m.normal.bits));
+  if (m.normal.lossy()) {
+    normal.Set("type", Value::String(kNormalLossyType));
+    normal.Set("mean_error_deg", Value::Number(m.normal.mean_error_deg));
+    normal.Set("p99_error_deg", Value::Number(m.normal.p99_error_deg));
+  } else {
+    normal.Set("type", Value::String(kNormalType));
+    normal.Set("bits", Value::Number(m.normal.bits));
+  }
   root.Set("normal_encoding", std::move(normal));
   Value color = Value::Object();
   color.Set("type", Value::String(kColorType));

@@ -27,8 +27,9 @@ namespace casual3d {
 constexpr const char* kPackageFormatName = "casual3d";
 constexpr int kPackageVersionMajor = 1;
 // The newest minor version this reader knows. Writers write the lowest minor
-// version whose members they use: 1.0 without "view", 1.1 with it.
-constexpr int kPackageVersionMinor = 1;
+// version whose members they use: 1.0 without "view", 1.1 with it, 1.2 with
+// lossy normals ("octahedral-lossy").
+constexpr int kPackageVersionMinor = 2;
 constexpr const char* kManifestFileName = "manifest.json";
 
 // Limits of spec/package.md, "Limits".

@@ -78,6 +78,45 @@ TEST(ManifestTest, VersioningRules) {
             StatusCode::kInvalidData);
 }
 
+TEST(ManifestTest, LossyNormalEncoding) {
+  Manifest m = SmallManifest();
+  m.version_minor = 2;
+  m.normal.type = NormalEncoding::kOctahedralLossy;
+  m.normal.bits = 8;
+  m.normal.mean_error_deg = 2.5;
+  m.normal.p99_error_deg = 8;
+  ASSERT_TRUE(m.Validate().ok()) << m.Validate().ToString();
+  const std::string text = SerializeManifest(m);
+  EXPECT_NE(text.find("\"type\": \"octahedral-lossy\""), std::string::npos) << text;
+  EXPECT_EQ(text.find("\"bits\": 8"), std::string::npos) << "the lossy encoding has no bits";
+  StatusOr<Manifest> back = ParseManifest(text);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_TRUE(back->normal.lossy());
+  EXPECT_EQ(back->normal.bits, 8);
+  EXPECT_EQ(back->normal.mean_error_deg, 2.5);
+  EXPECT_EQ(back->normal.p99_error_deg, 8);
+  EXPECT_EQ(SerializeManifest(*back), text);
+  // Bounds are required and in (0, 90].
+  for (const auto& [from, to] :
+       {std::make_pair("\"p99_error_deg\": 8", "\"p99_error_deg\": 0"),
+        std::make_pair("\"p99_error_deg\": 8", "\"p99_error_deg\": 91"),
+        std::make_pair("\"mean_error_deg\": 2.5", "\"mean_error_deg\": \"2.5\""),
+        std::make_pair("\"mean_error_deg\": 2.5,", "")}) {
+    StatusOr<Manifest> bad = ParseManifest(Replace(text, from, to));
+    ASSERT_FALSE(bad.ok()) << to;
+    EXPECT_NE(bad.status().message().find("normal_encoding"), std::string::npos)
+        << bad.status().ToString();
+  }
+  // An encoding type this reader does not know is refused, naming it.
+  StatusOr<Manifest> unknown =
+      ParseManifest(Replace(SerializeManifest(SmallManifest()), "\"octahedral\"", "\"spherical\""));
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.status().code(), StatusCode::kInvalidData);
+  EXPECT_NE(unknown.status().message().find("normal_encoding.type: \"spherical\" is not supported"),
+            std::string::npos)
+      << unknown.status().ToString();
+}
+
 TEST(ManifestTest, ErrorsNameTheField) {
   const std::string text = SerializeManifest(SmallManifest());
   struct Case {

@@ -50,7 +50,8 @@ Status PackageReader::VerifyFile(const std::string& path, const uint8_t* data,
   if (checks_.on(ReaderCheck::kChecksumMismatch) && Sha256Hex(data, size) != f->sha256)
     return InvalidData(path + ": SHA-256 does not match the manifest (corrupt file)");
   const int kind = file_kinds_[f - manifest_.files.data()];
-  if (kind >= 0 && TileImageIsLossless(static_cast<TileImageKind>(kind)) &&
+  if (kind >= 0 &&
+      TileImageIsLossless(static_cast<TileImageKind>(kind), manifest_.normal.type) &&
       checks_.on(ReaderCheck::kLossyDataTile)) {
     CASUAL3D_RETURN_IF_ERROR(image_format_->check_lossless(
         path, TileImageKindName(static_cast<TileImageKind>(kind)), data, size));

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 
 #if defined(__wasm_simd128__)
 #include <wasm_simd128.h>
@@ -80,8 +81,11 @@ const char* TileImageKindName(TileImageKind kind) {
   return "unknown";
 }
 
-void TileImageSize(TileImageKind kind, int w, int h, int* image_w, int* image_h) {
-  *image_w = w;
+void TileImageSize(TileImageKind kind, int w, int h, int* image_w, int* image_h,
+                   NormalEncoding normal_encoding) {
+  const bool two_codes =
+      kind == TileImageKind::kNormal && normal_encoding == NormalEncoding::kOctahedralLossy;
+  *image_w = two_codes ? 2 * w : w;
   *image_h = kind == TileImageKind::kGraph ? h : 2 * h;
 }
 
@@ -106,6 +110,15 @@ double DepthQuantization::MaxRelativeError() const {
 Status NormalQuantization::Check() const {
   if (bits < 4 || bits > 8)
     return InvalidArgument("normal bits " + std::to_string(bits) + " is outside [4, 8]");
+  if (!lossy()) return Status::Ok();
+  if (bits != 8) return InvalidArgument("lossy normals have 8-bit codes, not " +
+                                        std::to_string(bits));
+  for (const auto& [name, value] : {std::make_pair("mean_error_deg", mean_error_deg),
+                                    std::make_pair("p99_error_deg", p99_error_deg)}) {
+    if (!(value > 0.0 && value <= 90.0))
+      return InvalidArgument(std::string("normal ") + name + " " + std::to_string(value) +
+                             " is outside (0, 90]");
+  }
   return Status::Ok();
 }
 
@@ -129,19 +142,48 @@ double DequantizeDepth(uint16_t code, const DepthQuantization& q) {
          std::exp(static_cast<double>(code - 1) / (q.MaxCode() - 1) * std::log(q.far_m / q.near_m));
 }
 
-void EncodeOctahedral(const float normal[3], const NormalQuantization& q, uint8_t code[2]) {
+namespace {
+
+// The unit normal's point (u, v) on the octahedron, folded for z < 0 (sgn 0 =
+// +1); false for the zero or a non-finite normal.
+bool OctahedralPoint(const float normal[3], double* u, double* v) {
   const double x = normal[0], y = normal[1], z = normal[2];
   const double s = std::fabs(x) + std::fabs(y) + std::fabs(z);
-  if (!(s > 0) || !std::isfinite(s)) {
-    code[0] = code[1] = 0;
-    return;
+  if (!(s > 0) || !std::isfinite(s)) return false;
+  *u = x / s;
+  *v = y / s;
+  if (z < 0) {
+    const double fu = (1.0 - std::fabs(*v)) * (*u >= 0 ? 1.0 : -1.0);
+    const double fv = (1.0 - std::fabs(*u)) * (*v >= 0 ? 1.0 : -1.0);
+    *u = fu;
+    *v = fv;
   }
-  double u = x / s, v = y / s;
+  return true;
+}
+
+// The unit normal of the octahedron's point (u, v) in [-1, 1]^2 (unfolded for
+// z < 0, both new values from the old ones).
+void NormalOfOctahedralPoint(double u, double v, float normal[3]) {
+  const double z = 1.0 - std::fabs(u) - std::fabs(v);
   if (z < 0) {
     const double fu = (1.0 - std::fabs(v)) * (u >= 0 ? 1.0 : -1.0);
     const double fv = (1.0 - std::fabs(u)) * (v >= 0 ? 1.0 : -1.0);
     u = fu;
     v = fv;
+  }
+  const double n = std::sqrt(u * u + v * v + z * z);
+  normal[0] = static_cast<float>(u / n);
+  normal[1] = static_cast<float>(v / n);
+  normal[2] = static_cast<float>(z / n);
+}
+
+}  // namespace
+
+void EncodeOctahedral(const float normal[3], const NormalQuantization& q, uint8_t code[2]) {
+  double u, v;
+  if (!OctahedralPoint(normal, &u, &v)) {
+    code[0] = code[1] = 0;
+    return;
   }
   const double scale = (q.MaxCode() - 1) / 2.0;
   auto quantize = [scale](double t) {
@@ -158,25 +200,53 @@ bool DecodeOctahedral(const uint8_t code[2], const NormalQuantization& q, float 
   if (code[0] == 0 || code[1] == 0 || code[0] > q.MaxCode() || code[1] > q.MaxCode())
     return false;
   const double scale = 2.0 / (q.MaxCode() - 1);
-  double u = (code[0] - 1) * scale - 1.0, v = (code[1] - 1) * scale - 1.0;
-  const double z = 1.0 - std::fabs(u) - std::fabs(v);
-  if (z < 0) {
-    const double fu = (1.0 - std::fabs(v)) * (u >= 0 ? 1.0 : -1.0);
-    const double fv = (1.0 - std::fabs(u)) * (v >= 0 ? 1.0 : -1.0);
-    u = fu;
-    v = fv;
-  }
-  const double n = std::sqrt(u * u + v * v + z * z);
-  normal[0] = static_cast<float>(u / n);
-  normal[1] = static_cast<float>(v / n);
-  normal[2] = static_cast<float>(z / n);
+  NormalOfOctahedralPoint((code[0] - 1) * scale - 1.0, (code[1] - 1) * scale - 1.0, normal);
   return true;
+}
+
+bool EncodeOctahedralLossy(const float normal[3], uint8_t code[2]) {
+  double u, v;
+  if (!OctahedralPoint(normal, &u, &v)) {
+    code[0] = code[1] = 128;
+    return false;
+  }
+  auto quantize = [](double t) {
+    return static_cast<uint8_t>(std::lround((std::fmin(1.0, std::fmax(-1.0, t)) + 1.0) * 127.5));
+  };
+  code[0] = quantize(u);
+  code[1] = quantize(v);
+  return true;
+}
+
+void DecodeOctahedralLossy(const uint8_t code[2], float normal[3]) {
+  NormalOfOctahedralPoint(code[0] / 127.5 - 1.0, code[1] / 127.5 - 1.0, normal);
 }
 
 Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int h,
                        TileImageKind kind, const TileQuantization& q) {
   int iw, ih;
-  TileImageSize(kind, w, h, &iw, &ih);
+  TileImageSize(kind, w, h, &iw, &ih, q.normal.type);
+  if (kind == TileImageKind::kNormal && q.normal.lossy()) {
+    Image8 image(iw, ih, 4, 0);
+    for (int l = 0; l < kNumLayers; ++l) {
+      const LayerData& L = pano.layer(l);
+      for (int y = 0; y < h; ++y) {
+        uint8_t* row = image.row(l * h + y);
+        for (int x = 0; x < w; ++x) {
+          const size_t i = pano.index(x0 + x, y0 + y);
+          uint8_t code[2] = {0, 0};
+          const bool lit = L.present[i] && EncodeOctahedralLossy(&L.normal[3 * i], code);
+          const uint8_t alpha = L.present[i] && !lit ? 0 : 255;
+          uint8_t* pu = row + 4 * x;
+          uint8_t* pv = row + 4 * (w + x);
+          pu[0] = pu[1] = pu[2] = code[0];
+          pv[0] = pv[1] = pv[2] = code[1];
+          pu[3] = pv[3] = alpha;
+        }
+      }
+    }
+    return image;
+  }
   Image8 image(iw, ih, 3, 0);
   if (kind == TileImageKind::kColor) {
     for (int l = 0; l < kNumLayers; ++l)
@@ -232,7 +302,10 @@ TileDecoder::TileDecoder(const TileQuantization& q, const ReaderChecks& checks)
     for (int c1 = 0; c1 < 256; ++c1) {
       const uint8_t code[2] = {static_cast<uint8_t>(c0), static_cast<uint8_t>(c1)};
       float* n = &normal_table_[3 * (static_cast<size_t>(c0) << 8 | c1)];
-      if (!DecodeOctahedral(code, q.normal, n)) n[0] = n[1] = n[2] = invalid;
+      if (q.normal.lossy())
+        DecodeOctahedralLossy(code, n);
+      else if (!DecodeOctahedral(code, q.normal, n))
+        n[0] = n[1] = n[2] = invalid;
     }
   }
 }
@@ -371,6 +444,19 @@ void DecodeLayerRows(ImageView<const uint8_t> image, TileImageKind kind, int x0,
         float* depth = &L.depth_m[i0];
         for (int x = 0; x < w; ++x, px += kChannels)
           depth[x] = decoder.Depth(static_cast<uint16_t>((px[0] << 8) | px[1]));
+      } else if (decoder.quantization().normal.lossy()) {
+        // The u codes on the left half, the v codes on the right, in G;
+        // alpha below 128 marks an unlit node (the zero normal).
+        float* normal = &L.normal[3 * i0];
+        const uint8_t* pv = px + static_cast<size_t>(kChannels) * w;
+        for (int x = 0; x < w; ++x, px += kChannels, pv += kChannels, normal += 3) {
+          const uint8_t code[2] = {px[1], pv[1]};
+          const float* n = decoder.Normal(code);
+          const float lit = (kChannels == 4 && px[3] < 128) ? 0.0f : 1.0f;
+          normal[0] = n[0] * lit;
+          normal[1] = n[1] * lit;
+          normal[2] = n[2] * lit;
+        }
       } else {
         float* normal = &L.normal[3 * i0];
         for (int x = 0; x < w; ++x, px += kChannels, normal += 3) {
@@ -393,7 +479,7 @@ Status DecodeTileImage(ImageView<const uint8_t> image, TileImageKind kind, int x
     return InvalidArgument("tile region " + std::to_string(w) + "x" + std::to_string(h) + " at " +
                            PixelName(x0, y0) + " lies outside the panorama");
   int iw, ih;
-  TileImageSize(kind, w, h, &iw, &ih);
+  TileImageSize(kind, w, h, &iw, &ih, decoder.quantization().normal.type);
   const bool size_ok = decoder.checks().on(ReaderCheck::kWrongTileSize)
                            ? image.width() == iw && image.height() == ih
                            : image.width() >= iw && image.height() >= ih;

@@ -14,7 +14,12 @@
 //                     them).
 //   depth (lossless): R = code >> 8, G = code & 255, B = 0, with code the
 //                     log-depth code of QuantizeDepth (0: no node).
-//   normal (lossless): R, G = octahedral code (EncodeOctahedral), B = 0.
+//   normal (lossless, encoding "octahedral"): R, G = octahedral code
+//                     (EncodeOctahedral), B = 0.
+//   normal (lossy, encoding "octahedral-lossy", version 1.2): 2w x 2h, grey;
+//                     G of pixel (x, y) is the node's u code and G of (w + x,
+//                     y) its v code (EncodeOctahedralLossy); alpha below 128
+//                     at (x, y) marks the zero normal (unlit).
 //   graph (lossless): R = front links, G = back links (TwoLayerPanorama's packed
 //                     byte: 2 bits per direction), B = flags: bit 0 front present,
 //                     bit 1 back present, bit 2 front label, bit 3 back label;
@@ -36,11 +41,23 @@ constexpr int kNumTileImageKinds = 4;
 // "color", "depth", "normal", "graph": the names used in the manifest.
 const char* TileImageKindName(TileImageKind kind);
 
-// Pixel size of the image of `kind` for a tile of w x h panorama pixels.
-void TileImageSize(TileImageKind kind, int w, int h, int* image_w, int* image_h);
+// The manifest's normal_encoding type (spec/package.md Sec. 4.3):
+// "octahedral" (lossless codes of 4..8 bits) or, from version 1.2,
+// "octahedral-lossy" (a lossy grey image of 8-bit codes, Sec. 4.3.1).
+enum class NormalEncoding : int { kOctahedral = 0, kOctahedralLossy = 1 };
 
-// Whether the image of `kind` is stored lossless (all but colour).
-inline bool TileImageIsLossless(TileImageKind kind) { return kind != TileImageKind::kColor; }
+// Pixel size of the image of `kind` for a tile of w x h panorama pixels: w x h
+// for the graph, w x 2h for the others, but 2w x 2h for lossy normals.
+void TileImageSize(TileImageKind kind, int w, int h, int* image_w, int* image_h,
+                   NormalEncoding normal_encoding = NormalEncoding::kOctahedral);
+
+// Whether the image of `kind` must be stored lossless: depth, graph and, with
+// the "octahedral" encoding, normals.
+inline bool TileImageIsLossless(TileImageKind kind,
+                                NormalEncoding normal_encoding = NormalEncoding::kOctahedral) {
+  return kind != TileImageKind::kColor &&
+         !(kind == TileImageKind::kNormal && normal_encoding == NormalEncoding::kOctahedralLossy);
+}
 
 // How a WebP file codes its image, from its RIFF container alone
 // (spec/package.md Sec. 4): kLossless when the image is one VP8L chunk (the
@@ -84,9 +101,21 @@ double DequantizeDepth(uint16_t code, const DepthQuantization& q);
 // i.e. 1..M. The code (0, 0) means the zero normal (unlit, such as sky). A code
 // with exactly one 0, or above M, is invalid. Angular error at most about
 // 230 / (M - 1) degrees (0.9 degrees for b = 8).
+//
+// The lossy encoding ("octahedral-lossy") stores the same (u, v) as codes
+// round((u + 1) * 127.5) in 0..255, every one valid, in a lossy image: the
+// zero normal has no code there (the image's alpha marks it). The writer
+// bounds, per tile, the mean and the 99th percentile of the angle between the
+// normals it encoded and those a reader decodes, over the tile's lit present
+// nodes: mean_error_deg and p99_error_deg, which the manifest declares.
 struct NormalQuantization {
-  int bits = 8;  // Bits b per coordinate, 4..8.
+  NormalEncoding type = NormalEncoding::kOctahedral;
+  int bits = 8;  // Bits b per coordinate, 4..8 (8 for the lossy encoding).
+  // The lossy encoding's declared bounds, degrees, in (0, 90] (0 otherwise).
+  double mean_error_deg = 0.0;
+  double p99_error_deg = 0.0;
 
+  bool lossy() const { return type == NormalEncoding::kOctahedralLossy; }
   Status Check() const;
   int MaxCode() const { return (1 << bits) - 1; }
 };
@@ -94,6 +123,13 @@ struct NormalQuantization {
 void EncodeOctahedral(const float normal[3], const NormalQuantization& q, uint8_t code[2]);
 // Returns false for an invalid code (leaving `normal` zero).
 bool DecodeOctahedral(const uint8_t code[2], const NormalQuantization& q, float normal[3]);
+
+// The lossy encoding's codes of a unit normal (0..255 each); returns false,
+// writing (128, 128), for the zero (or a non-finite) normal, which this
+// encoding marks outside the codes.
+bool EncodeOctahedralLossy(const float normal[3], uint8_t code[2]);
+// Any code pair to its unit normal.
+void DecodeOctahedralLossy(const uint8_t code[2], float normal[3]);
 
 // How a package quantizes depth and normals (the manifest's encodings).
 struct TileQuantization {
@@ -104,13 +140,15 @@ struct TileQuantization {
 };
 
 // Builds the RGB image of `kind` for the tile [x0, x0+w) x [y0, y0+h) of
-// `pano`. Preconditions: the region lies inside the panorama, q.Check() is ok
+// `pano` (RGBA for lossy normals, alpha 255 at lit nodes and 0 at unlit
+// ones; absent nodes are (0, 0, 0, 255)). Preconditions: the region lies inside the panorama, q.Check() is ok
 // and every present node's depth lies in [near, far] (others are clamped).
 Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int h,
                        TileImageKind kind, const TileQuantization& q);
 
 // Precomputed DequantizeDepth for all 65536 codes (256 KB) and
-// DecodeOctahedral for all 65536 code pairs (768 KB), for fast decoding with
+// DecodeOctahedral (or DecodeOctahedralLossy) for all 65536 code pairs (768
+// KB), for fast decoding with
 // exactly the values of those functions. Invalid codes decode to markers that
 // FinishDecodedPanorama refuses at present nodes and clears at absent ones
 // (spec/package.md Sec. 5): depth -1 for a code above the maximum, a NaN

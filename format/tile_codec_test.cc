@@ -121,6 +121,76 @@ TEST(TileCodecTest, TileRoundTripKeepsTheGraphExactly) {
   }
 }
 
+TEST(TileCodecTest, LossyNormalCodesWithinOneDegreeAndUnlitByAlpha) {
+  double worst = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double z = 1 - 2 * (i + 0.5) / 20000, r = std::sqrt(1 - z * z), phi = i * 2.39996323;
+    const float n[3] = {float(r * std::cos(phi)), float(r * std::sin(phi)), float(z)};
+    uint8_t code[2];
+    ASSERT_TRUE(EncodeOctahedralLossy(n, code));
+    float back[3];
+    DecodeOctahedralLossy(code, back);
+    const double dot = n[0] * back[0] + n[1] * back[1] + n[2] * back[2];
+    worst = std::max(worst, std::acos(std::min(1.0, dot)) * 180 / 3.14159265358979);
+  }
+  EXPECT_LT(worst, 0.92);  // As 8-bit "octahedral" codes: below 1 degree.
+  const float zero[3] = {0, 0, 0};
+  uint8_t code[2];
+  EXPECT_FALSE(EncodeOctahedralLossy(zero, code));
+
+  // A tile round trip before any lossy coding: 2w x 2h RGBA, the codes in G,
+  // unlit nodes by alpha 0; decoded 3-channel images have no unlit node.
+  TwoLayerPanorama pano = casual3d::testing::MakePackageTestPanorama(48, 32);
+  for (int x = 5; x < 9; ++x) std::fill_n(&pano.layer(kFront).normal[3 * pano.index(x, 3)], 3, 0.0f);
+  TileQuantization q;
+  q.depth.near_m = 2.0;
+  q.depth.far_m = 100.0;
+  q.normal.type = NormalEncoding::kOctahedralLossy;
+  q.normal.mean_error_deg = 2;
+  q.normal.p99_error_deg = 5;
+  ASSERT_TRUE(q.Check().ok()) << q.Check().ToString();
+  EXPECT_FALSE(TileImageIsLossless(TileImageKind::kNormal, q.normal.type));
+  EXPECT_TRUE(TileImageIsLossless(TileImageKind::kNormal));
+  EXPECT_TRUE(TileImageIsLossless(TileImageKind::kDepth, q.normal.type));
+  const Image8 image = EncodeTileImage(pano, 0, 0, 48, 32, TileImageKind::kNormal, q);
+  int iw, ih;
+  TileImageSize(TileImageKind::kNormal, 48, 32, &iw, &ih, q.normal.type);
+  EXPECT_EQ(iw, 96);
+  EXPECT_EQ(ih, 64);
+  ASSERT_EQ(image.width(), 96);
+  ASSERT_EQ(image.height(), 64);
+  ASSERT_EQ(image.channels(), 4);
+  EXPECT_EQ(image.at(6, 3, 3), 0);
+  EXPECT_EQ(image.at(6 + 48, 3, 3), 0);
+  const TileDecoder decoder(q);
+  for (int channels : {4, 3}) {
+    Image8 input(96, 64, channels);
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 96; ++x)
+        for (int c = 0; c < channels; ++c) input.at(x, y, c) = image.at(x, y, c);
+    TwoLayerPanorama out = pano;
+    ASSERT_TRUE(DecodeTileImage(V(input), TileImageKind::kNormal, 0, 0, 48, 32, decoder, &out)
+                    .ok());
+    for (int l = 0; l < kNumLayers; ++l) {
+      for (size_t i = 0; i < pano.layer(l).present.size(); ++i) {
+        if (!pano.layer(l).present[i]) continue;
+        const float* a = &pano.layer(l).normal[3 * i];
+        const float* b = &out.layer(l).normal[3 * i];
+        const bool unlit = a[0] == 0 && a[1] == 0 && a[2] == 0;
+        if (unlit && channels == 4) {
+          EXPECT_TRUE(b[0] == 0 && b[1] == 0 && b[2] == 0) << i;
+        } else if (!unlit) {
+          EXPECT_GT(a[0] * b[0] + a[1] * b[1] + a[2] * b[2], std::cos(0.92 * 3.14159265 / 180)) << i;
+        }
+      }
+    }
+  }
+  // A lossless-size image is the wrong size for lossy normals.
+  Image8 narrow(48, 64, 3);
+  EXPECT_FALSE(
+      DecodeTileImage(V(narrow), TileImageKind::kNormal, 0, 0, 48, 32, decoder, &pano).ok());
+}
+
 TEST(TileCodecTest, HostileImagesAreRefused) {
   TwoLayerPanorama out(32, 16);
   TileQuantization q;

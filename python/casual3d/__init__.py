@@ -318,9 +318,12 @@ def write_package(pano: Panorama, path, **options) -> dict:
     holds a package. Options (encoder/package_writer.h, defaults in brackets):
     tile_size [512], levels [0: automatic], colour_quality [90] (lossy WebP,
     0..100), colour_method [3], lossless_effort [25], lossless_method [1],
-    depth_bits [12], normal_bits [8], threads [0: all cores], generator.
-    Colour is lossy; depth (quantized to depth_bits), normals (normal_bits),
-    labels and links are stored losslessly. Returns the sizes written.
+    depth_bits [12], normal_bits [8], lossy_normals [False],
+    normal_mean_error_deg [2.5], normal_p99_error_deg [8.0], threads [0: all
+    cores], generator. Colour is lossy; depth (quantized to depth_bits),
+    normals (normal_bits), labels and links are stored losslessly, but with
+    lossy_normals the normals are lossy images whose tiles keep the two error
+    bounds (package version 1.2). Returns the sizes written.
     """
     path = _os.fspath(path)
     native = _casual3d._PackageOptions()

@@ -103,6 +103,9 @@ void RegisterWriting(py::module_& m) {
       .def_readwrite("lossless_method", &PackageOptions::lossless_method)
       .def_readwrite("depth_bits", &PackageOptions::depth_bits)
       .def_readwrite("normal_bits", &PackageOptions::normal_bits)
+      .def_readwrite("lossy_normals", &PackageOptions::lossy_normals)
+      .def_readwrite("normal_mean_error_deg", &PackageOptions::normal_mean_error_deg)
+      .def_readwrite("normal_p99_error_deg", &PackageOptions::normal_p99_error_deg)
       .def_readwrite("threads", &PackageOptions::num_threads)
       .def_readwrite("generator", &PackageOptions::generator);
   py::enum_<encoder::TextureFormat>(m, "_TextureFormat")

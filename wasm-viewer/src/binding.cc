@@ -275,7 +275,7 @@ EMSCRIPTEN_KEEPALIVE const char* c3d_reader_level_json(Reader* r, int level) {
       const std::string& path = L.tiles[t].files[k];
       const casual3d::FileEntry* f = m.FindFile(path);
       int iw, ih;
-      casual3d::TileImageSize(kind, w, h, &iw, &ih);
+      casual3d::TileImageSize(kind, w, h, &iw, &ih, m.normal.type);
       j += (k ? ",{" : "{") + std::string("\"kind\":") +
            JsonString(casual3d::TileImageKindName(kind)) + ",\"path\":" + JsonString(path) +
            ",\"bytes\":" + std::to_string(f ? f->bytes : 0) +
