@@ -47,7 +47,7 @@ void RunInfo(const std::string& path) {
                 v.content_yaw_max_deg, v.content_pitch_min_deg, v.content_pitch_max_deg);
     std::printf("volume       radius %.6g%s\n", v.volume_radius, unit);
   } else {
-    std::printf("view         none (version 1.0): viewers choose\n");
+    std::printf("view         none: viewers choose\n");
   }
   StatusOr<const TileImageFormat*> images = TileImageFormatOf(*m);
   if (!images.ok()) throw std::runtime_error(path + ": " + images.status().message());

@@ -25,20 +25,28 @@ StatusOr<TwoLayerPanorama> HalvePanorama(const TwoLayerPanorama& fine) {
         C.present[c] = 1;
         C.depth_m[c] = F.depth_m[a];
         C.label[c] = F.label[a];
-        for (int k = 0; k < 3; ++k) C.normal[3 * c + k] = F.normal[3 * a + k];
-        // Colour: box filter over the block's nodes on the same surface.
+        // Colour and normal: box filters over the block's nodes on the same
+        // surface (a normal only where the node's is lit: unlit stays unlit).
         int sum[3] = {0, 0, 0}, count = 0;
+        double normal[3] = {0, 0, 0};
+        const bool lit = F.normal[3 * a] != 0 || F.normal[3 * a + 1] != 0 || F.normal[3 * a + 2] != 0;
         for (int dy = 0; dy < 2; ++dy) {
           for (int dx = 0; dx < 2; ++dx) {
             const size_t b = fine.index(2 * x + dx, 2 * y + dy);
             if (!F.present[b] || std::fabs(F.depth_m[b] - F.depth_m[a]) > 0.05f * F.depth_m[a])
               continue;
             for (int k = 0; k < 3; ++k) sum[k] += F.rgb[3 * b + k];
+            for (int k = 0; k < 3; ++k) normal[k] += F.normal[3 * b + k];
             ++count;
           }
         }
         for (int k = 0; k < 3; ++k)
           C.rgb[3 * c + k] = static_cast<uint8_t>((sum[k] + count / 2) / count);
+        const double length =
+            std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+        for (int k = 0; k < 3; ++k)
+          C.normal[3 * c + k] = lit && length > 1e-6 ? static_cast<float>(normal[k] / length)
+                                                     : F.normal[3 * a + k];
         // Links: two steps along the fine graph.
         uint8_t links = 0;
         for (int d = 0; d < kNumDirections; ++d) {

@@ -94,11 +94,15 @@ Status PackageOptions::Check() const {
 
 PackageOptions DeliveryPackageOptions() {
   PackageOptions options;
-  options.normal_bits = 5;
-  options.depth_bits = 10;
+  options.normal_bits = 5;  // For --lossless-normals.
+  options.lossy_normals = true;
+  options.normal_mean_error_deg = 2.5;
+  options.normal_p99_error_deg = 9.0;
+  options.depth_bits = 9;
   options.lossless_method = 4;
   options.lossless_effort = 75.0f;
   options.fill_absent = true;
+  options.compact_manifest = true;
   return options;
 }
 
@@ -233,7 +237,7 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
   Status manifest_ok = manifest.Validate();
   if (!manifest_ok.ok()) return InternalError("encoder built an invalid manifest: " +
                                               manifest_ok.message());
-  const std::string text = SerializeManifest(manifest);
+  const std::string text = SerializeManifest(manifest, options.compact_manifest);
   files[0].second.assign(text.begin(), text.end());
   s.manifest_bytes = text.size();
   s.total_bytes += text.size();

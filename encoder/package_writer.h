@@ -49,6 +49,9 @@ struct PackageOptions {
   // the same, the lossless tiles smaller (4-9% on reconstructions). Off by
   // default so that archives and the spec's vectors keep their bytes.
   bool fill_absent = false;
+  // manifest.json without white space (about 40% smaller) instead of
+  // pretty-printed.
+  bool compact_manifest = false;
   // Threads encoding tiles; 0 = all cores.
   int num_threads = 0;
   // Written to the manifest's "generator" member: the writing program.
@@ -59,15 +62,14 @@ struct PackageOptions {
 
 // The settings for web delivery of reconstructed 3D photos, used by
 // `casual3d encode` and `casual3d reconstruct` (docs/PERFORMANCE.md, "Package
-// size of reconstructions"; docs/DECISIONS.md, "Delivery budget"): PackageOptions' defaults but
-// 5-bit normals (angular error at most 8.1 degrees, about 2.6 on average
-// against 8 bits on reconstructions, whose normals are noisier than that),
-// 10-bit depth (relative error at most exp(ln(far_m / near_m) / 2046) - 1:
-// 0.34% for far/near = 1000), absent nodes filled (fill_absent) and lossless
-// WebP method 4, effort 75. Lossless
-// codes of reconstructed normals and depth are mostly noise, so every bit
-// they drop saves about as much as it can; readers are unchanged, as every
-// encoding declares its bits in the manifest.
+// size of reconstructions"; docs/DECISIONS.md, "Delivery budget" and "Lossy
+// normals"): PackageOptions' defaults but lossy normals within 2.5 degrees on
+// average and 9 at the 99th percentile of each tile (package version 1.2;
+// 5-bit lossless codes with lossy_normals off), 9-bit depth (relative error
+// at most exp(ln(far_m / near_m) / 1020) - 1: 0.58% for far/near = 363, the
+// demo's), absent nodes filled (fill_absent), lossless WebP method 4, effort
+// 75, and a compact manifest. Reconstructed normals and depth are noisy at
+// the codes' resolution, so the bits they drop cost little that shows.
 PackageOptions DeliveryPackageOptions();
 
 // Sizes and timing of an encoded package.

@@ -399,7 +399,7 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes, const ReaderChecks& che
   return m;
 }
 
-std::string SerializeManifest(const Manifest& m) {
+std::string SerializeManifest(const Manifest& m, bool compact) {
   Value root = Value::Object();
   root.Set("format", Value::String(kPackageFormatName));
   root.Set("version", Value::String(std::to_string(m.version_major) + "." +
@@ -465,7 +465,7 @@ std::string SerializeManifest(const Manifest& m) {
     files.Append(std::move(fv));
   }
   root.Set("files", std::move(files));
-  return json::Serialize(root, 2) + "\n";
+  return json::Serialize(root, compact ? 0 : 2) + "\n";
 }
 
 }  // namespace casual3d

@@ -115,7 +115,9 @@ constexpr int kMaxManifestNesting = 16;
 StatusOr<Manifest> ParseManifest(std::string_view bytes,
                                  const ReaderChecks& checks = ReaderChecks());
 
-// Serializes a manifest as pretty-printed JSON (2-space indent, trailing newline).
-std::string SerializeManifest(const Manifest& manifest);
+// Serializes a manifest as JSON with a trailing newline: pretty-printed with a
+// 2-space indent, or without any white space when `compact` (about 40% fewer
+// bytes for the same members).
+std::string SerializeManifest(const Manifest& manifest, bool compact = false);
 
 }  // namespace casual3d

@@ -73,9 +73,11 @@ def test_master_file_reads_back_exactly(room, tmp_path, cli):
         for field in ("colour", "depth", "normals", "labels", "links"):
             np.testing.assert_array_equal(getattr(r, field), getattr(w, field), err_msg=field)
     # The CLI encodes it into a package that Python reads as it wrote it.
-    # 12-bit depth and 8-bit normals: the encoder library's defaults, which the
-    # checks below state (the CLI's own defaults are the smaller delivery codes).
-    out = cli("encode", path, "-o", tmp_path / "encoded", "--depth-bits", "12", "--normal-bits", "8")
+    # 12-bit depth and 8-bit lossless normals: the encoder library's defaults,
+    # which the checks below state (the CLI's own defaults are the smaller
+    # delivery codes and lossy normals).
+    out = cli("encode", path, "-o", tmp_path / "encoded", "--depth-bits", "12",
+              "--lossless-normals", "--normal-bits", "8")
     assert out.returncode == 0, out.stderr
     assert_package_reads_back(room, casual3d.read(tmp_path / "encoded"))
 
@@ -91,3 +93,27 @@ def test_front_only_panorama_without_view_hints(tmp_path):
     assert read.view_hints is None
     assert not read.back.present.any()
     assert_package_reads_back(pano, read)
+
+
+def test_lossy_normals_keep_their_declared_bounds(room, tmp_path, cli):
+    path = tmp_path / "lossy"
+    casual3d.write_package(room, path, lossy_normals=True, normal_mean_error_deg=2.0,
+                           normal_p99_error_deg=6.0)
+    manifest = casual3d.read_manifest(path)
+    assert manifest["version"] == "1.2"
+    assert manifest["normal_encoding"] == {
+        "type": "octahedral-lossy", "mean_error_deg": 2.0, "p99_error_deg": 6.0}
+    out = cli("validate", path)
+    assert out.returncode == 0, out.stderr
+    read = casual3d.read(path)
+    angles = []
+    for w, r in zip(room.layers, read.layers):
+        lit = w.present & np.any(w.normals != 0, axis=-1)
+        assert np.all(r.normals[w.present & ~lit] == 0)
+        cosine = np.sum(r.normals[lit] * w.normals[lit], axis=-1)
+        angles.append(np.degrees(np.arccos(np.clip(cosine, -1, 1))))
+    angles = np.concatenate(angles)
+    # Each tile keeps both bounds over its lit nodes, so the whole level does.
+    assert angles.size > 1000
+    assert angles.mean() <= 2.0
+    assert np.percentile(angles, 99, method="inverted_cdf") <= 6.0

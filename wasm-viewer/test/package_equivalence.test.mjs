@@ -23,6 +23,10 @@ const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'casual3d-pkg-eq-'));
 process.on('exit', () => fs.rmSync(dir, { recursive: true, force: true }));
 const pkg = path.join(dir, 'pkg');
 runTool('viewer_test_tool', ['package', 'test', '1024', '512', pkg, '256', '2']);
+// The delivery settings: 10-bit depth and lossy normals (package version 1.2),
+// whose grey images both libwebp builds decode to the same codes.
+const delivery = path.join(dir, 'delivery');
+runTool('viewer_test_tool', ['package', 'test', '1024', '512', delivery, '256', '2', 'delivery']);
 
 for (const [name, f] of [['single-threaded', format], ['threaded', formatThreaded]]) {
   for (const level of [1, 0]) {
@@ -33,6 +37,16 @@ for (const [name, f] of [['single-threaded', format], ['threaded', formatThreade
     });
   }
 }
+
+test('a delivery package with lossy normals: wasm reader + mesh == native reader + mesh', async () => {
+  const manifest = JSON.parse(fs.readFileSync(path.join(delivery, 'manifest.json'), 'utf8'));
+  assert.equal(manifest.version, '1.2');
+  assert.equal(manifest.normal_encoding.type, 'octahedral-lossy');
+  for (const level of [0, 1]) {
+    const { triangles } = await assertLevelMatchesNative(format, delivery, level, path.join(dir, `native_delivery_${level}`));
+    assert.ok(triangles > 1000, `only ${triangles} triangles`);
+  }
+});
 
 test('the threaded build uses more than one thread where the machine has them', () => {
   assert.equal(format.numThreads, 1);
