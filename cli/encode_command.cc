@@ -1,5 +1,5 @@
 // `casual3d encode <master.exr> -o <package> [--quality Q] [--tile-size N]
-// [--levels N] [--depth-bits B] [--normal-bits B] [--lossless-normals]
+// [--levels N] [--depth-bits B] [--normal-bits B] [--lossy-normals]
 // [--normal-mean-error DEG] [--normal-p99-error DEG] [--single-file out.c3d]
 // [--capture SPARSE_DIR] [--title T]`: turns a master file into a web package
 // (spec/package.md), optionally also as one .c3d file.
@@ -84,9 +84,10 @@ void AddEncodeCommand(CLI::App& app) {
   AddDescribedOption(cmd, "--levels", *options, options->package.levels);
   AddDescribedOption(cmd, "--depth-bits", *options, options->package.depth_bits);
   AddDescribedOption(cmd, "--normal-bits", *options, options->package.normal_bits);
-  cmd->add_flag("!--lossless-normals", options->package.lossy_normals,
-                "Store normals as lossless codes of --normal-bits (package version 1.1) instead "
-                "of lossy images within --normal-mean-error and --normal-p99-error");
+  cmd->add_flag("--lossy-normals", options->package.lossy_normals,
+                "Store normals as lossy images within --normal-mean-error and --normal-p99-error "
+                "(package version 1.2, which readers before it refuse) instead of lossless codes "
+                "of --normal-bits");
   AddDescribedOption(cmd, "--normal-mean-error", *options, options->package.normal_mean_error_deg);
   AddDescribedOption(cmd, "--normal-p99-error", *options, options->package.normal_p99_error_deg);
   AddDescribedOption(cmd, "--threads", *options, options->package.num_threads);

@@ -23,8 +23,8 @@ struct EncodeCommandOptions {
   bool viewer = true;        // Add index.html and the viewer to the folder.
   std::string capture;       // Optional sparse stage output whose advice the page shows.
   std::string title;         // The page's title; empty: the output folder's name.
-  // Web delivery settings; --depth-bits 12 --lossless-normals --normal-bits 8
-  // keep each node's value as closely as PackageOptions' defaults.
+  // Web delivery settings; --depth-bits 12 --normal-bits 8 keep each node's
+  // value as closely as PackageOptions' defaults.
   encoder::PackageOptions package = encoder::DeliveryPackageOptions();
 
   template <typename Self, typename Visitor>
@@ -43,8 +43,8 @@ struct EncodeCommandOptions {
             "Bits per octahedral normal coordinate (5: angular error at most 8.1 degrees; 8 for "
             "1 degree)");
     v.Field("package.lossy_normals", o.package.lossy_normals, R::Any(),
-            "Normals as lossy images within the two error bounds below (package version 1.2); "
-            "false: lossless codes of --normal-bits");
+            "Normals as lossy images within the two error bounds below (package version 1.2) "
+            "instead of lossless codes of --normal-bits");
     v.Field("package.normal_mean_error_deg", o.package.normal_mean_error_deg, R::Closed(1, 90),
             "Lossy normals: each tile's mean angular error at most this, degrees");
     v.Field("package.normal_p99_error_deg", o.package.normal_p99_error_deg, R::Closed(1, 90),

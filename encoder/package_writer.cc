@@ -94,11 +94,8 @@ Status PackageOptions::Check() const {
 
 PackageOptions DeliveryPackageOptions() {
   PackageOptions options;
-  options.normal_bits = 5;  // For --lossless-normals.
-  options.lossy_normals = true;
-  options.normal_mean_error_deg = 2.5;
-  options.normal_p99_error_deg = 9.0;
-  options.depth_bits = 9;
+  options.normal_bits = 5;
+  options.depth_bits = 10;
   options.lossless_method = 4;
   options.lossless_effort = 75.0f;
   options.fill_absent = true;

@@ -203,17 +203,41 @@ TEST_F(PackageWriterTest, DeliveryOptionsKeepTheirBoundsAndShrinkThePackage) {
     Manifest manifest;
     StatusOr<TwoLayerPanorama> decoded = ReadPackage(source, decoder_, read, &manifest);
     ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+    EXPECT_FALSE(manifest.normal.lossy());
+    EXPECT_EQ(manifest.normal.bits, 5);
+    EXPECT_EQ(manifest.depth.bits, 10);
+    // Depth within exp(ln(50) / 2046) - 1 = 0.19% (the bound of 10-bit codes).
+    EXPECT_NEAR(manifest.depth.MaxRelativeError(), std::exp(std::log(50.0) / 2046) - 1, 1e-5);
+    const double min_psnr[3] = {37.5, 35.5, 33.5};
+    ExpectDecodedMatches(expected, *decoded, manifest.depth, min_psnr[level], 8.1);
+    if (level < 2) expected = *HalvePanorama(expected);
+  }
+}
+
+TEST_F(PackageWriterTest, LossyNormalsKeepTheirBoundsAtEveryLevel) {
+  options_ = DeliveryPackageOptions();
+  options_.lossy_normals = true;
+  options_.tile_size = 64;
+  options_.levels = 3;
+  options_.num_threads = 2;
+  PackageStats stats;
+  const PackageFiles files = Encode(&stats);
+  MemoryFileSource source;
+  for (const auto& [path, bytes] : files) source.Add(path, bytes);
+  TwoLayerPanorama expected = pano_;
+  for (int level = 0; level < 3; ++level) {
+    ReadOptions read;
+    read.level = level;
+    Manifest manifest;
+    StatusOr<TwoLayerPanorama> decoded = ReadPackage(source, decoder_, read, &manifest);
+    ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
     EXPECT_EQ(manifest.version_minor, 2);
     EXPECT_TRUE(manifest.normal.lossy());
     EXPECT_EQ(manifest.normal.mean_error_deg, 2.5);
     EXPECT_EQ(manifest.normal.p99_error_deg, 9.0);
-    EXPECT_EQ(manifest.depth.bits, 9);
-    // Depth within exp(ln(50) / 1020) - 1 = 0.38% (the bound of 9-bit codes).
-    EXPECT_NEAR(manifest.depth.MaxRelativeError(), std::exp(std::log(50.0) / 1020) - 1, 1e-5);
-    const double min_psnr[3] = {37.5, 35.5, 33.5};
-    // Lossy normals are bounded on average and at the 99th percentile per
-    // tile, so over the level too; single nodes may be further off.
-    ExpectDecodedMatches(expected, *decoded, manifest.depth, min_psnr[level], 180.0);
+    // Each tile keeps both bounds, so the level does; single nodes may be
+    // further off, and unlit nodes stay unlit (ExpectDecodedMatches).
+    ExpectDecodedMatches(expected, *decoded, manifest.depth, 33.5, 180.0);
     const NormalAngles angles = NormalAnglesOf(expected, *decoded);
     EXPECT_LE(angles.mean_deg, 2.5) << level;
     EXPECT_LE(angles.p99_deg, 9.0) << level;

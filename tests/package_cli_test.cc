@@ -74,28 +74,37 @@ TEST_F(PackageCliTest, ViewHintsGoFromTheMasterFileToThePackage) {
   ASSERT_EQ(encode.exit_code, 0) << encode.output;
   CommandResult info = Casual3d("info " + pkg);
   ASSERT_EQ(info.exit_code, 0) << info.output;
-  // Delivery settings: lossy normals, so version 1.2.
-  EXPECT_NE(info.output.find("casual3d 1.2"), std::string::npos) << info.output;
-  EXPECT_NE(info.output.find("normals      octahedral, lossy: per tile mean error at most 2.5, "
-                             "99th percentile at most 9 degrees"),
-            std::string::npos)
+  EXPECT_NE(info.output.find("casual3d 1.1"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("normals      octahedral, 5 bits per coordinate"), std::string::npos)
       << info.output;
   EXPECT_NE(info.output.find("opens at yaw 12.5, pitch 0.0, field of view 48.0 deg"),
             std::string::npos) << info.output;
   EXPECT_NE(info.output.find("radius 0.07 (the capture's units)"), std::string::npos) << info.output;
   CommandResult validate = Casual3d("validate " + pkg);
   EXPECT_EQ(validate.exit_code, 0) << validate.output;
-  EXPECT_NE(validate.output.find("valid casual3d 1.2 package"), std::string::npos) << validate.output;
-  // With lossless normals and without hints the package is 1.0, with them 1.1.
-  CommandResult lossless = Casual3d("encode " + master + " -o " + (dir_ / "lossless").string() +
-                                    " --no-viewer --lossless-normals");
-  ASSERT_EQ(lossless.exit_code, 0) << lossless.output;
-  info = Casual3d("info " + (dir_ / "lossless").string());
-  EXPECT_NE(info.output.find("casual3d 1.1"), std::string::npos) << info.output;
-  EXPECT_NE(info.output.find("normals      octahedral, 5 bits per coordinate"), std::string::npos)
+  EXPECT_NE(validate.output.find("valid casual3d 1.1 package"), std::string::npos) << validate.output;
+  // Lossy normals make it 1.2, and say their bounds.
+  const std::string lossy = (dir_ / "lossy").string();
+  CommandResult encode_lossy = Casual3d("encode " + master + " -o " + lossy +
+                                        " --no-viewer --lossy-normals --normal-p99-error 7");
+  ASSERT_EQ(encode_lossy.exit_code, 0) << encode_lossy.output;
+  info = Casual3d("info " + lossy);
+  EXPECT_NE(info.output.find("casual3d 1.2"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("normals      octahedral, lossy: per tile mean error at most 2.5, "
+                             "99th percentile at most 7 degrees"),
+            std::string::npos)
       << info.output;
+  validate = Casual3d("validate " + lossy);
+  EXPECT_EQ(validate.exit_code, 0) << validate.output;
+  EXPECT_NE(validate.output.find("valid casual3d 1.2 package"), std::string::npos) << validate.output;
+  // A bound out of range: one line naming the flag, exit 1.
+  CommandResult bad = Casual3d("encode " + master + " -o " + (dir_ / "bad").string() +
+                               " --lossy-normals --normal-mean-error 0.5");
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("--normal-mean-error"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir_ / "bad"));
   CommandResult plain = Casual3d("encode " + master_ + " -o " + (dir_ / "plain").string() +
-                                 " --no-viewer --lossless-normals");
+                                 " --no-viewer");
   ASSERT_EQ(plain.exit_code, 0) << plain.output;
   info = Casual3d("info " + (dir_ / "plain").string());
   EXPECT_NE(info.output.find("casual3d 1.0"), std::string::npos) << info.output;
@@ -117,7 +126,7 @@ TEST_F(PackageCliTest, EncodeInfoValidate) {
   for (const std::string& p : {pkg, c3d}) {
     CommandResult validate = Casual3d("validate " + p);
     EXPECT_EQ(validate.exit_code, 0) << validate.output;
-    EXPECT_NE(validate.output.find("valid casual3d 1.2 package"), std::string::npos);
+    EXPECT_NE(validate.output.find("valid casual3d 1.0 package"), std::string::npos);
   }
   // A corrupted tile: exit 1, one line naming the file.
   {

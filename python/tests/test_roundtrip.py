@@ -73,11 +73,9 @@ def test_master_file_reads_back_exactly(room, tmp_path, cli):
         for field in ("colour", "depth", "normals", "labels", "links"):
             np.testing.assert_array_equal(getattr(r, field), getattr(w, field), err_msg=field)
     # The CLI encodes it into a package that Python reads as it wrote it.
-    # 12-bit depth and 8-bit lossless normals: the encoder library's defaults,
-    # which the checks below state (the CLI's own defaults are the smaller
-    # delivery codes and lossy normals).
-    out = cli("encode", path, "-o", tmp_path / "encoded", "--depth-bits", "12",
-              "--lossless-normals", "--normal-bits", "8")
+    # 12-bit depth and 8-bit normals: the encoder library's defaults, which the
+    # checks below state (the CLI's own defaults are the smaller delivery codes).
+    out = cli("encode", path, "-o", tmp_path / "encoded", "--depth-bits", "12", "--normal-bits", "8")
     assert out.returncode == 0, out.stderr
     assert_package_reads_back(room, casual3d.read(tmp_path / "encoded"))
 

@@ -9,6 +9,8 @@
 //    in front of it shows; water covers the floor but not the sphere's top;
 //  - a package with a corrupted tile shows the error message, keeps the coarser
 //    level on screen and the page stays responsive;
+//  - a delivery package (lossy normals, version 1.2) decodes in Chromium to
+//    the same normals as under Node (a wasm libwebp) and natively;
 //  - the same package as one .c3d file, by URL: read in HTTP range requests,
 //    the first frame before any range of the finest level was asked for, the
 //    same images; and from a server that ignores ranges (one whole download).
@@ -22,7 +24,8 @@ import path from 'node:path';
 import { after, before, test } from 'node:test';
 
 import { psnr, readCanvas, readPpm } from './native-comparison.mjs';
-import { BINARY_DIR, DIST_DIR, copyPackageWithView, runTool } from './node-support.mjs';
+import { BINARY_DIR, DIST_DIR, copyPackageWithView, loadFormatModule, runTool } from './node-support.mjs';
+import { readPackageLevel } from './node-package.mjs';
 import { chromiumArgs, chromiumOrSkip, startServer, viewerPage } from './static-server.mjs';
 
 const { chromium, executable: CHROMIUM } = await chromiumOrSkip('the browser test');
@@ -258,6 +261,60 @@ async function psnrOfCamera0(p) {
   await p.evaluate((c) => document.getElementById('v').setCamera(c), CAMERAS[0]);
   return psnr(await readCanvas(p), readPpm(reference).data, W, H);
 }
+
+test('a delivery package with lossy normals decodes in Chromium as under Node', async () => {
+  const delivery = path.join(tmp, 'delivery');
+  runTool('viewer_test_tool', ['package', 'test', '512', '256', delivery, '128', '2', 'lossy-normals']);
+  assert.equal(JSON.parse(fs.readFileSync(path.join(delivery, 'manifest.json'), 'utf8')).normal_encoding.type, 'octahedral-lossy');
+  // Per layer: present nodes, unlit present nodes and the sums of the normals'
+  // components (the images' G codes and alpha, through each decoder).
+  const summary = (pano) => [0, 1].map((l) => {
+    const { present, normal } = pano.layer(l);
+    const s = { present: 0, unlit: 0, sum: [0, 0, 0] };
+    for (let i = 0; i < present.length; ++i) {
+      if (!present[i]) continue;
+      ++s.present;
+      if (normal[3 * i] === 0 && normal[3 * i + 1] === 0 && normal[3 * i + 2] === 0) ++s.unlit;
+      for (let c = 0; c < 3; ++c) s.sum[c] += normal[3 * i + c];
+    }
+    return s;
+  });
+  const format = await loadFormatModule();
+  const expected = [];
+  for (const level of [0, 1]) {
+    const { pano } = await readPackageLevel(format, delivery, level);
+    try { expected.push(summary(pano)); } finally { pano.free(); }
+  }
+  assert.ok(expected[0][0].unlit > 0 && expected[0][0].unlit < expected[0][0].present);
+  const served = await startServer({ '/viewer/': DIST_DIR, '/pkg/': delivery }, { '/index.html': '<!doctype html><title>t</title>' });
+  const other = await browser.newPage();
+  try {
+    await other.goto(`${served.url}/index.html`);
+    const got = await other.evaluate(async (summarySource) => {
+      const summarize = eval(summarySource);
+      const { openPackage: open } = await import('/viewer/format.js');
+      const pkg = await open('/pkg/manifest.json');
+      const out = [];
+      for (const level of [0, 1]) {
+        const pano = await pkg.readLevel(level);
+        try { out.push(summarize(pano)); } finally { pano.free(); }
+      }
+      pkg.close();
+      return out;
+    }, summary.toString());
+    for (let level = 0; level < 2; ++level) {
+      for (let l = 0; l < 2; ++l) {
+        const [g, e] = [got[level][l], expected[level][l]];
+        assert.equal(g.present, e.present);
+        assert.equal(g.unlit, e.unlit, `level ${level} layer ${l}: unlit nodes`);
+        for (let c = 0; c < 3; ++c) assert.ok(Math.abs(g.sum[c] - e.sum[c]) < 1e-3 * e.present, `level ${level} layer ${l}: normal sums ${g.sum} vs ${e.sum}`);
+      }
+    }
+  } finally {
+    await other.close();
+    await served.close();
+  }
+});
 
 test('a .c3d by URL: range requests, the first frame before the finest level is asked for', async () => {
   const file = path.join(tmp, 'single', 'room.c3d');

@@ -1,9 +1,10 @@
 // viewer_test_tool: native helpers of the viewer's browser test and benchmark.
 //
 //   viewer_test_tool package <room|room-nosphere|room-partial|sphere|test> <width> <height>
-//                            <out_dir> [tile_size] [levels] [delivery]
+//                            <out_dir> [tile_size] [levels] [lossy-normals]
 //     Writes a web package of a procedural two-layer panorama (encoder/), at
-//     PackageOptions' defaults or, with "delivery", DeliveryPackageOptions().
+//     PackageOptions' defaults or, with "lossy-normals", DeliveryPackageOptions()
+//     with lossy normals (package version 1.2).
 //     room-partial: the room with nodes only at longitudes [-75, 45] and
 //     latitudes [-40, 50] degrees, like a capture of part of the sphere.
 //     room-sheets: the room without a back layer, its sphere's outline linked
@@ -125,16 +126,18 @@ int Package(int argc, char** argv) {
   if (argc < 6)
     return Fail(
         "usage: viewer_test_tool package <kind> <width> <height> <out_dir> [tile_size] [levels] "
-        "[delivery]");
+        "[lossy-normals]");
   casual3d::TwoLayerPanorama pano;
   if (!MakePanorama(argv[2], std::atoi(argv[3]), std::atoi(argv[4]), &pano)) {
     return Fail(std::string("unknown panorama kind '") + argv[2] + "'");
   }
   casual3d::encoder::PackageOptions options;
   if (argc > 8) {
-    if (std::string(argv[8]) != "delivery")
-      return Fail(std::string("unknown package settings '") + argv[8] + "' (expected delivery)");
+    if (std::string(argv[8]) != "lossy-normals")
+      return Fail(std::string("unknown package settings '") + argv[8] +
+                  "' (expected lossy-normals)");
     options = casual3d::encoder::DeliveryPackageOptions();
+    options.lossy_normals = true;
   }
   if (argc > 6) options.tile_size = std::atoi(argv[6]);
   if (argc > 7) options.levels = std::atoi(argv[7]);
