@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -34,6 +35,26 @@ class PackageWriterTest : public casual3d::testing::TestWithScratchDir {
     StatusOr<PackageFiles> files = EncodePackage(pano_, options_, stats);
     EXPECT_TRUE(files.ok()) << files.status().ToString();
     return files.ok() ? *files : PackageFiles();
+  }
+
+  // Reads each of the first `levels` levels of `files` and calls `check`
+  // with the level, the manifest, what it should hold (pano_ halved as the
+  // encoder halves it) and what was decoded.
+  void ForEachDecodedLevel(const PackageFiles& files, int levels,
+                           const std::function<void(int, const Manifest&, const TwoLayerPanorama&,
+                                                    const TwoLayerPanorama&)>& check) {
+    MemoryFileSource source;
+    for (const auto& [path, bytes] : files) source.Add(path, bytes);
+    TwoLayerPanorama expected = pano_;
+    for (int level = 0; level < levels; ++level) {
+      ReadOptions read;
+      read.level = level;
+      Manifest manifest;
+      StatusOr<TwoLayerPanorama> decoded = ReadPackage(source, decoder_, read, &manifest);
+      ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+      check(level, manifest, expected, *decoded);
+      if (level + 1 < levels) expected = *HalvePanorama(expected);
+    }
   }
 
   TwoLayerPanorama pano_;
@@ -194,24 +215,17 @@ TEST_F(PackageWriterTest, DeliveryOptionsKeepTheirBoundsAndShrinkThePackage) {
   const PackageFiles files = Encode(&delivery_stats);
   EXPECT_LT(delivery_stats.total_bytes, exact_stats.total_bytes * 3 / 4);
   EXPECT_TRUE(options_.fill_absent);
-  MemoryFileSource source;
-  for (const auto& [path, bytes] : files) source.Add(path, bytes);
-  TwoLayerPanorama expected = pano_;
-  for (int level = 0; level < 3; ++level) {
-    ReadOptions read;
-    read.level = level;
-    Manifest manifest;
-    StatusOr<TwoLayerPanorama> decoded = ReadPackage(source, decoder_, read, &manifest);
-    ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+  ForEachDecodedLevel(files, 3, [](int level, const Manifest& manifest,
+                                    const TwoLayerPanorama& expected,
+                                    const TwoLayerPanorama& decoded) {
     EXPECT_FALSE(manifest.normal.lossy());
     EXPECT_EQ(manifest.normal.bits, 5);
     EXPECT_EQ(manifest.depth.bits, 10);
     // Depth within exp(ln(50) / 2046) - 1 = 0.19% (the bound of 10-bit codes).
     EXPECT_NEAR(manifest.depth.MaxRelativeError(), std::exp(std::log(50.0) / 2046) - 1, 1e-5);
     const double min_psnr[3] = {37.5, 35.5, 33.5};
-    ExpectDecodedMatches(expected, *decoded, manifest.depth, min_psnr[level], 8.1);
-    if (level < 2) expected = *HalvePanorama(expected);
-  }
+    ExpectDecodedMatches(expected, decoded, manifest.depth, min_psnr[level], 8.1);
+  });
 }
 
 TEST_F(PackageWriterTest, LossyNormalsKeepTheirBoundsAtEveryLevel) {
@@ -222,28 +236,21 @@ TEST_F(PackageWriterTest, LossyNormalsKeepTheirBoundsAtEveryLevel) {
   options_.num_threads = 2;
   PackageStats stats;
   const PackageFiles files = Encode(&stats);
-  MemoryFileSource source;
-  for (const auto& [path, bytes] : files) source.Add(path, bytes);
-  TwoLayerPanorama expected = pano_;
-  for (int level = 0; level < 3; ++level) {
-    ReadOptions read;
-    read.level = level;
-    Manifest manifest;
-    StatusOr<TwoLayerPanorama> decoded = ReadPackage(source, decoder_, read, &manifest);
-    ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+  ForEachDecodedLevel(files, 3, [](int level, const Manifest& manifest,
+                                    const TwoLayerPanorama& expected,
+                                    const TwoLayerPanorama& decoded) {
     EXPECT_EQ(manifest.version_minor, 2);
     EXPECT_TRUE(manifest.normal.lossy());
     EXPECT_EQ(manifest.normal.mean_error_deg, 2.5);
     EXPECT_EQ(manifest.normal.p99_error_deg, 9.0);
     // Each tile keeps both bounds, so the level does; single nodes may be
     // further off, and unlit nodes stay unlit (ExpectDecodedMatches).
-    ExpectDecodedMatches(expected, *decoded, manifest.depth, 33.5, 180.0);
-    const NormalAngles angles = NormalAnglesOf(expected, *decoded);
+    ExpectDecodedMatches(expected, decoded, manifest.depth, 33.5, 180.0);
+    const NormalAngles angles = NormalAnglesOf(expected, decoded);
     EXPECT_LE(angles.mean_deg, 2.5) << level;
     EXPECT_LE(angles.p99_deg, 9.0) << level;
     EXPECT_GT(angles.mean_deg, 0.1) << level;
-    if (level < 2) expected = *HalvePanorama(expected);
-  }
+  });
 }
 
 // Bytes of the tile files whose name ends in `suffix`.
