@@ -175,7 +175,7 @@ void RunExport(ExportOptions& opts) {
   encoder::GltfExportStats stats;
   const auto write_start = std::chrono::steady_clock::now();
   const Status written =
-      encoder::ExportGlb(mesh, encoder::BuildColourAtlas(pano), opts.gltf, opts.glb, &stats);
+      encoder::ExportGlb(mesh, encoder::BuildColorAtlas(pano), opts.gltf, opts.glb, &stats);
   if (!written.ok()) Fail(written.message());
   util::LogInfo("encoded and wrote the GLB" + since(write_start));
   progress.Finish();

@@ -30,6 +30,7 @@ target_compile_features(casual3d_format INTERFACE cxx_std_17)
 # private one). Internal headers (threads, SIMD, SHA-256, levels of detail,
 # tinygltf, test scenes) stay private.
 set(CASUAL3D_PUBLIC_FORMAT_HEADERS
+  format/color_atlas.h
   format/colour_atlas.h
   format/equirect.h
   format/file_source.h

@@ -18,7 +18,7 @@
 #include "encoder/gltf_draco.h"
 #include "encoder/gltf_texture.h"
 #include "encoder/gltf_tinygltf.h"
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 #include "format/version.h"
 
 namespace casual3d::encoder {
@@ -87,8 +87,8 @@ int AddFloatAccessor(tinygltf::Model* model, int view, const std::vector<float>&
 
 }  // namespace
 
-// The one atlas of format/colour_atlas.h, whose fill rule the mesh's uvs rely on.
-Image8 BuildColourAtlas(const TwoLayerPanorama& pano) { return ::casual3d::BuildColourAtlas(pano, 3); }
+// The one atlas of format/color_atlas.h, whose fill rule the mesh's uvs rely on.
+Image8 BuildColorAtlas(const TwoLayerPanorama& pano) { return ::casual3d::BuildColorAtlas(pano, 3); }
 
 Status GltfExportOptions::Check() const {
   if (texture_format != TextureFormat::kPng && texture_format != TextureFormat::kJpeg) {

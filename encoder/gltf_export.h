@@ -117,7 +117,12 @@ struct GltfExportStats {
 // colour of the other layer's node at that pixel (black if there is none), so
 // that texture filtering along the border of a layer's region, and the coarse
 // mipmap levels, do not blend in black.
-Image8 BuildColourAtlas(const TwoLayerPanorama& pano);
+Image8 BuildColorAtlas(const TwoLayerPanorama& pano);
+
+// Deprecated: the earlier name of BuildColorAtlas (docs/SDK.md, "Deprecated names").
+[[deprecated("use BuildColorAtlas")]] inline Image8 BuildColourAtlas(const TwoLayerPanorama& pano) {
+  return BuildColorAtlas(pano);
+}
 
 // Checks that `mesh` can be exported: positions, uvs and indices present and
 // consistent (3 floats per vertex, 2 uvs per vertex, normals empty or 3 per

@@ -628,9 +628,19 @@ TEST(GltfExportTest, RejectsBadOptionsMeshesAndAtlases) {
   expect_invalid(mesh, Image8(4, 4, 1), GltfExportOptions(), "colour atlas");
 }
 
-TEST(GltfExportTest, ColourAtlasStacksLayersAndFillsAbsentNodes) {
+// The earlier name keeps working (docs/SDK.md, "Deprecated names").
+TEST(GltfExportTest, DeprecatedNameBuildsTheSameAtlas) {
   const TwoLayerPanorama pano = testing::MakeRoomPanorama(64, 32);
-  const Image8 atlas = BuildColourAtlas(pano);
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+  const Image8 old = BuildColourAtlas(pano);
+#pragma GCC diagnostic pop
+  EXPECT_EQ(old.vector(), BuildColorAtlas(pano).vector());
+}
+
+TEST(GltfExportTest, ColorAtlasStacksLayersAndFillsAbsentNodes) {
+  const TwoLayerPanorama pano = testing::MakeRoomPanorama(64, 32);
+  const Image8 atlas = BuildColorAtlas(pano);
   ASSERT_EQ(atlas.width(), 64);
   ASSERT_EQ(atlas.height(), 64);
   ASSERT_EQ(atlas.channels(), 3);
@@ -660,7 +670,7 @@ const unsigned char* Texel(const tinygltf::Image& image, float u, float v) {
   return &image.image[(static_cast<size_t>(y) * image.width + x) * image.component];
 }
 
-TEST(GltfExportTest, BuiltMeshTexturesEveryVertexWithItsNodeColour) {
+TEST(GltfExportTest, BuiltMeshTexturesEveryVertexWithItsNodeColor) {
   TwoLayerPanorama pano = testing::MakeRoomPanorama(96, 48);
   // Make the top rows unlit (sky), as reconstructions do.
   for (int y = 0; y < 4; ++y) {
@@ -670,7 +680,7 @@ TEST(GltfExportTest, BuiltMeshTexturesEveryVertexWithItsNodeColour) {
   }
   auto mesh = BuildMesh(pano);
   ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
-  auto glb = EncodeGlb(*mesh, BuildColourAtlas(pano), PngOptions());
+  auto glb = EncodeGlb(*mesh, BuildColorAtlas(pano), PngOptions());
   ASSERT_TRUE(glb.ok()) << glb.status().ToString();
   const Parsed p = ParseGlb(*glb);
   ASSERT_TRUE(p.ok) << p.error;
@@ -703,7 +713,7 @@ TEST(GltfExportTest, SimplifiedMeshMeetsTheTriangleBudget) {
   GltfExportOptions options;
   options.draco = true;
   GltfExportStats stats;
-  auto glb = EncodeGlb(simplified->mesh, BuildColourAtlas(pano), options, &stats);
+  auto glb = EncodeGlb(simplified->mesh, BuildColorAtlas(pano), options, &stats);
   ASSERT_TRUE(glb.ok()) << glb.status().ToString();
   EXPECT_EQ(stats.num_triangles, simplified->mesh.num_triangles());
   EXPECT_LE(stats.num_triangles, 12000u);

@@ -27,7 +27,7 @@
 // behind the foreground as far as its depth is (a blurred fill, as an
 // inpainting would give, never the foreground's texture at the background's
 // depth). Vertex uvs point into the back half of the colour atlas at the
-// vertex's pixel (for readers that can only texture; format/colour_atlas.h).
+// vertex's pixel (for readers that can only texture; format/color_atlas.h).
 // Normals are (0, 0, 0): the backdrop is unlit.
 //
 // Deterministic like BuildMesh: the same panorama gives the same floats

@@ -21,7 +21,7 @@ namespace casual3d {
 struct Mesh {
   std::vector<float> positions;  // x, y, z per vertex: panorama frame, metres.
   std::vector<float> normals;    // x, y, z per vertex; (0, 0, 0) where unlit.
-  // u, v per vertex into the colour atlas (format/colour_atlas.h): the front
+  // u, v per vertex into the colour atlas (format/color_atlas.h): the front
   // layer's colour panorama (width x height) stacked above the back layer's
   // (the atlas is width x 2*height), each half filled with the other layer's
   // colour where its own node is absent. A vertex of node (x, y, layer) has

@@ -365,14 +365,14 @@ Mesh MeshAssembler::Finish(int num_threads) {
     const double horizontal = cos_lat[y] * depth;
     float* position = &mesh.positions[3 * static_cast<size_t>(index)];
     float* normal = &mesh.normals[3 * static_cast<size_t>(index)];
-    uint8_t* colour = &mesh.colors[3 * static_cast<size_t>(index)];
+    uint8_t* color = &mesh.colors[3 * static_cast<size_t>(index)];
     float* uv = &mesh.uvs[2 * static_cast<size_t>(index)];
     position[0] = static_cast<float>(horizontal * sin_lon[x]);
     position[1] = static_cast<float>(sin_lat[y] * depth);
     position[2] = static_cast<float>(-(horizontal * cos_lon[x]));
     for (int c = 0; c < 3; ++c) {
       normal[c] = d.normal[3 * i + c];
-      colour[c] = d.rgb[3 * i + c];
+      color[c] = d.rgb[3 * i + c];
     }
     uv[0] = u_of[seam ? w : x];
     uv[1] = v_of[2 * y + half];

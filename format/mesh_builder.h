@@ -46,7 +46,7 @@ struct MeshBuildOptions {
 // a copy with its uv in the other layer's atlas half where a triangle joining
 // front and back nodes needs it, plus seam copies; triangles counter-clockwise
 // seen from the centre. Every triangle's uvs lie in one half of the atlas
-// (format/colour_atlas.h). Errors:
+// (format/color_atlas.h). Errors:
 // options out of range (kInvalidArgument), panorama larger than
 // options.max_pixels (kLimitExceeded), width below 2 (kInvalidArgument), or
 // an invalid panorama (the status of Validate()).

@@ -6,7 +6,7 @@
 #include <set>
 #include <tuple>
 
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 #include "format/equirect.h"
 #include "format/testing/mesh_checksum.h"
 #include "format/testing/test_panoramas.h"
@@ -69,10 +69,10 @@ TwoLayerPanorama FrontOnly(int w, int h, F depth) {
 }
 
 // The number of vertices whose colour differs from the atlas texel at their
-// uv (format/colour_atlas.h), i.e. where atlas texturing shows another colour
+// uv (format/color_atlas.h), i.e. where atlas texturing shows another colour
 // than the node's at the vertex itself.
-int CountVerticesWithOtherAtlasColour(const TwoLayerPanorama& p, const Mesh& m) {
-  const Image8 atlas = BuildColourAtlas(p);
+int CountVerticesWithOtherAtlasColor(const TwoLayerPanorama& p, const Mesh& m) {
+  const Image8 atlas = BuildColorAtlas(p);
   int wrong = 0;
   for (size_t v = 0; v < m.num_vertices(); ++v) {
     const int x = static_cast<int>(std::lround(m.uvs[2 * v] * p.width() - 0.5)) % p.width();
@@ -260,7 +260,7 @@ TEST(MeshBuilderTest, BackLayerFillsDisocclusion) {
   // 4 seam copies.
   EXPECT_EQ(mesh->num_vertices(), 32u + 8 + 8 + 4);
   CheckTriangles(p, *mesh);
-  EXPECT_EQ(CountVerticesWithOtherAtlasColour(p, *mesh), 0);
+  EXPECT_EQ(CountVerticesWithOtherAtlasColor(p, *mesh), 0);
   // Vertex order: (row, column, layer, own half first). Row 0: (0..2, 0)
   // front, the back-half copy of (2, 0), (3, 0) front and back, (4, 0) front
   // and back, (5, 0) front and its copy, (6, 0), (7, 0).
@@ -324,7 +324,7 @@ TEST(MeshBuilderTest, CrossLayerTriangleTakesTheHalfWithFewerWrongVertices) {
     for (int k = 0; k < 3; ++k) {
       EXPECT_EQ(NodeOfVertex(p, *mesh, mesh->indices[k]).half, want_half);
     }
-    EXPECT_EQ(CountVerticesWithOtherAtlasColour(p, *mesh), 1);
+    EXPECT_EQ(CountVerticesWithOtherAtlasColor(p, *mesh), 1);
   }
 }
 
@@ -340,7 +340,7 @@ TEST(MeshBuilderTest, ProceduralRoomMeshIsConsistentAndDeterministic) {
   CheckTriangles(p, *a);
   // Back nodes exist only behind the sphere, so every front node joined to
   // a back node sits where the back half shows its own colour.
-  EXPECT_EQ(CountVerticesWithOtherAtlasColour(p, *a), 0);
+  EXPECT_EQ(CountVerticesWithOtherAtlasColor(p, *a), 0);
   // Nearly every quad is closed by the front or back sheet; the sphere adds its own.
   EXPECT_GT(a->num_triangles(), 2u * 96 * 47);
   EXPECT_LT(a->num_triangles(), 2u * 96 * 47 + 400);

@@ -81,7 +81,7 @@ TEST(ReconstructEndToEndTest, PhotosToWebPackageAndBack) {
   // Virtual rephotography from every registered photo's pose.
   const auto mesh = BuildMesh(*pano);
   ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
-  const Image8 atlas = encoder::BuildColourAtlas(*pano);
+  const Image8 atlas = encoder::BuildColorAtlas(*pano);
   const fs::path sparse = out / "work" / "sparse";
   const geometry::SparseModel model = geometry::ReadModel((sparse / "sparse").string());
   ASSERT_GE(model.images.size(), 15u);

@@ -33,7 +33,7 @@ def print_layers(path):
             depth = layer.depth[present]
             print(f"  level {level} {name}: {present.sum()} nodes, depth "
                   f"{depth.min():.2f}-{depth.max():.2f} m, mean colour "
-                  f"{layer.colour[present].mean(axis=0).round().astype(int).tolist()}")
+                  f"{layer.color[present].mean(axis=0).round().astype(int).tolist()}")
     return package.read(0)
 
 
@@ -50,11 +50,11 @@ def synthetic_panorama(width=256, height=128):
 
     pano.front.depth[:] = np.where(box, 1.0, 3.0)
     pano.front.normals[:] = inward
-    pano.front.colour[:] = grey[..., None]
-    pano.front.colour[box] = [200, 80, 60]
+    pano.front.color[:] = grey[..., None]
+    pano.front.color[box] = [200, 80, 60]
     pano.back.depth[box] = 3.0
     pano.back.normals[box] = inward[box]
-    pano.back.colour[box] = grey[box][:, None]
+    pano.back.color[box] = grey[box][:, None]
     pano.back.labels[box] = casual3d.LABEL_B
     return casual3d.link_neighbours(pano)
 

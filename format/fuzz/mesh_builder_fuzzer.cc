@@ -141,16 +141,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         const size_t i = pano.index(x, y);
         const uint8_t present = in.Next();
         const uint8_t depth = in.Next(), normal = in.Next(), label = in.Next();
-        const uint8_t links = in.Next(), colour = in.Next();
+        const uint8_t links = in.Next(), color = in.Next();
         if (repair && !(present & 1)) continue;  // Absent nodes stay all zero.
         d.present[i] = repair ? 1 : present % 3;
         d.depth_m[i] = DecodeDepth(depth, repair);
         DecodeNormal(normal, repair, &d.normal[3 * i]);
         d.label[i] = repair ? (label & 1) : label % 3;
         d.links[i] = links;
-        d.rgb[3 * i] = colour;
-        d.rgb[3 * i + 1] = static_cast<uint8_t>(colour * 7);
-        d.rgb[3 * i + 2] = static_cast<uint8_t>(colour * 13);
+        d.rgb[3 * i] = color;
+        d.rgb[3 * i + 1] = static_cast<uint8_t>(color * 7);
+        d.rgb[3 * i + 2] = static_cast<uint8_t>(color * 13);
       }
     }
   }

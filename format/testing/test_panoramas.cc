@@ -55,7 +55,7 @@ void SetNode(TwoLayerPanorama* p, int l, int x, int y, float depth, const double
   d.label[i] = static_cast<uint8_t>(l == kFront ? NodeLabel::kF : NodeLabel::kB);
 }
 
-void RoomColour(const Vec3d& p, int face, uint8_t rgb[3]) {
+void RoomColor(const Vec3d& p, int face, uint8_t rgb[3]) {
   const int checker =
       (static_cast<int>(std::floor(p.x * 2.0)) + static_cast<int>(std::floor(p.y * 2.0)) +
        static_cast<int>(std::floor(p.z * 2.0))) &
@@ -77,7 +77,7 @@ TwoLayerPanorama MakeRoomPanorama(int width, int height, const RoomOptions& opti
       const double t_room = HitBox(dir, wall_normal, &face);
       const Vec3d p_room = {dir.x * t_room, dir.y * t_room, dir.z * t_room};
       uint8_t room_rgb[3];
-      RoomColour(p_room, face, room_rgb);
+      RoomColor(p_room, face, room_rgb);
       const double t_sphere = options.with_sphere ? HitSphere(dir, options) : -1.0;
       if (t_sphere > 0 && t_sphere < t_room) {
         const double* c = options.sphere_centre;

@@ -27,8 +27,10 @@ or inconsistent data, ValueError for arguments out of range and OSError when
 the operating system refuses a read or write; messages name the file.
 """
 
+import functools as _functools
 import json as _json
 import os as _os
+import warnings as _warnings
 from dataclasses import dataclass, field
 from typing import List, Optional
 
@@ -39,7 +41,8 @@ from ._casual3d import FormatError, __version__
 
 __all__ = [
     "FormatError", "Layer", "Panorama", "Package", "Mesh", "read", "read_manifest",
-    "validate", "build_mesh", "colour_atlas", "write_package", "write_master", "export_glb",
+    "validate", "build_mesh", "color_atlas", "colour_atlas", "write_package", "write_master",
+    "export_glb",
     "link_neighbours", "RIGHT", "DOWN", "LEFT", "UP", "NO_LINK", "LINK_FRONT", "LINK_BACK",
     "LABEL_F", "LABEL_B", "__version__",
 ]
@@ -55,12 +58,57 @@ LABEL_F, LABEL_B = 0, 1
 _EXR_MAGIC = b"\x76\x2f\x31\x01"
 
 
+# The earlier names spelt "colour" keep working, deprecated (python/README.md,
+# "Deprecated names"): each use warns with DeprecationWarning.
+def _warn_renamed(old: str, new: str) -> None:
+    _warnings.warn(f"casual3d: {old} is deprecated; use {new}", DeprecationWarning, stacklevel=3)
+
+
+def _renamed_fields(renamed: dict):
+    """Class decorator: the fields' former names (old -> new) as constructor
+    keywords and attributes that warn and use the new field."""
+
+    def decorate(cls):
+        init = cls.__init__
+
+        @_functools.wraps(init)
+        def __init__(self, *args, **kwargs):
+            for old, new in renamed.items():
+                if old in kwargs:
+                    _warn_renamed(f"{cls.__name__}({old}=...)", f"{new}=")
+                    kwargs[new] = kwargs.pop(old)
+            init(self, *args, **kwargs)
+
+        def alias(old, new):
+            def get(self):
+                _warn_renamed(f"{cls.__name__}.{old}", new)
+                return getattr(self, new)
+
+            def put(self, value):
+                _warn_renamed(f"{cls.__name__}.{old}", new)
+                setattr(self, new, value)
+
+            return property(get, put, doc=f"Deprecated name of {new}.")
+
+        cls.__init__ = __init__
+        for old, new in renamed.items():
+            setattr(cls, old, alias(old, new))
+        return cls
+
+    return decorate
+
+
+# write_package's options under their former names.
+_RENAMED_PACKAGE_OPTIONS = {"colour_quality": "color_quality", "colour_method": "color_method"}
+
+
+@_renamed_fields({"colour": "color"})
 @dataclass
 class Layer:
     """One layer (front or back) of a panorama of H x W pixels.
 
     Attributes:
-        colour: uint8 (H, W, 3), sRGB; 0 where the node is absent.
+        color: uint8 (H, W, 3), sRGB; 0 where the node is absent.
         depth: float32 (H, W), metres from the frame centre along the pixel's
             ray (> 0); NaN where the pixel has no node of this layer. A node
             exists exactly where depth is not NaN.
@@ -75,7 +123,7 @@ class Layer:
             nodes are linked.
     """
 
-    colour: np.ndarray
+    color: np.ndarray
     depth: np.ndarray
     normals: np.ndarray
     labels: np.ndarray
@@ -85,7 +133,7 @@ class Layer:
     def empty(cls, width: int, height: int) -> "Layer":
         """A layer of width x height pixels without nodes (all fields as absent)."""
         return cls(
-            colour=np.zeros((height, width, 3), np.uint8),
+            color=np.zeros((height, width, 3), np.uint8),
             depth=np.full((height, width), np.nan, np.float32),
             normals=np.full((height, width, 3), np.nan, np.float32),
             labels=np.zeros((height, width), np.uint8),
@@ -153,6 +201,7 @@ class Panorama:
                    _json.loads(hints) if hints is not None else None)
 
 
+@_renamed_fields({"colours": "colors"})
 @dataclass
 class Mesh:
     """A triangle mesh of a panorama (spec/mesh.md) with its colour atlas.
@@ -164,11 +213,11 @@ class Mesh:
         uvs: float32 (N, 2) into `atlas`: u = (x + 0.5) / W, v over the atlas
             height; seam copies of column-0 nodes have u > 1 (textures repeat
             horizontally).
-        colours: uint8 (N, 3), each vertex's node colour (sRGB).
+        colors: uint8 (N, 3), each vertex's node colour (sRGB).
         indices: uint32 (T, 3), counter-clockwise seen from the centre.
         atlas: uint8 (2H, W, 3), the front layer's colours above the back
             layer's, each filled with the other layer's colour where its own
-            node is absent (format/colour_atlas.h).
+            node is absent (format/color_atlas.h).
         error_bound: simplified meshes: the largest relative depth error of a
             merged block (0.01 = 1 %); None for the full mesh.
         full_triangles: simplified meshes: triangles of the full mesh.
@@ -179,7 +228,7 @@ class Mesh:
     positions: np.ndarray
     normals: np.ndarray
     uvs: np.ndarray
-    colours: np.ndarray
+    colors: np.ndarray
     indices: np.ndarray
     atlas: np.ndarray
     error_bound: Optional[float] = None
@@ -298,9 +347,15 @@ def build_mesh(pano: Panorama, *, simplify: bool = False, max_triangles: Optiona
     return Mesh(**_casual3d._build_mesh(pano, choice))
 
 
-def colour_atlas(pano: Panorama) -> np.ndarray:
+def color_atlas(pano: Panorama) -> np.ndarray:
     """uint8 (2H, W, 3): the atlas that Mesh.uvs address (see Mesh.atlas)."""
-    return _casual3d._colour_atlas(pano)
+    return _casual3d._color_atlas(pano)
+
+
+def colour_atlas(pano: Panorama) -> np.ndarray:
+    """Deprecated name of :func:`color_atlas`."""
+    _warn_renamed("colour_atlas()", "color_atlas()")
+    return color_atlas(pano)
 
 
 def _set_options(options, kwargs, what):
@@ -316,8 +371,8 @@ def write_package(pano: Panorama, path, **options) -> dict:
 
     Written atomically; an existing folder is replaced only if it is empty or
     holds a package. Options (encoder/package_writer.h, defaults in brackets):
-    tile_size [512], levels [0: automatic], colour_quality [90] (lossy WebP,
-    0..100), colour_method [3], lossless_effort [25], lossless_method [1],
+    tile_size [512], levels [0: automatic], color_quality [90] (lossy WebP,
+    0..100), color_method [3], lossless_effort [25], lossless_method [1],
     depth_bits [12], normal_bits [8], lossy_normals [False],
     normal_mean_error_deg [2.5], normal_p99_error_deg [8.0], threads [0: all
     cores], generator. Colour is lossy; depth (quantized to depth_bits),
@@ -328,6 +383,10 @@ def write_package(pano: Panorama, path, **options) -> dict:
     path = _os.fspath(path)
     native = _casual3d._PackageOptions()
     native.generator = f"casual3d {__version__}"
+    for old, new in _RENAMED_PACKAGE_OPTIONS.items():
+        if old in options:
+            _warn_renamed(f"write_package({old}=...)", f"{new}=")
+            options[new] = options.pop(old)
     _set_options(native, options, "write_package")
     return _casual3d._write_package(pano, path, path.lower().endswith(".c3d"), native)
 

@@ -10,7 +10,7 @@ namespace casual3d::python {
 
 // _Package (open, manifest, read a level), _read_master, _validate.
 void RegisterReading(pybind11::module_& m);
-// _build_mesh, _colour_atlas.
+// _build_mesh, _color_atlas.
 void RegisterMeshes(pybind11::module_& m);
 // _write_package, _write_master, _export_glb.
 void RegisterWriting(pybind11::module_& m);

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <optional>
 
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 #include "format/mesh_builder.h"
 #include "format/mesh_simplify.h"
 #include "python/src/bindings.h"
@@ -50,7 +50,7 @@ py::dict MeshToPython(Mesh&& mesh, const SimplifiedMesh& facts, bool simplified)
   out["positions"] = ToNumpy(std::move(mesh.positions), {vertices, 3});
   out["normals"] = ToNumpy(std::move(mesh.normals), {vertices, 3});
   out["uvs"] = ToNumpy(std::move(mesh.uvs), {vertices, 2});
-  out["colours"] = ToNumpy(std::move(mesh.colors), {vertices, 3});
+  out["colors"] = ToNumpy(std::move(mesh.colors), {vertices, 3});
   out["indices"] = ToNumpy(std::move(mesh.indices), {triangles, 3});
   if (simplified) {
     out["error_bound"] = facts.error_bound;
@@ -74,7 +74,7 @@ py::dict BuildMeshFromPython(py::handle pano_object, const MeshChoice& choice) {
   {
     py::gil_scoped_release release;
     mesh = BuildAnyMesh(pano, choice, &facts);
-    if (mesh.ok()) atlas = BuildColourAtlas(pano, 3);
+    if (mesh.ok()) atlas = BuildColorAtlas(pano, 3);
   }
   ThrowIfError(mesh.status());
   py::dict out = MeshToPython(std::move(mesh).value(), facts, choice.simplify);
@@ -82,12 +82,12 @@ py::dict BuildMeshFromPython(py::handle pano_object, const MeshChoice& choice) {
   return out;
 }
 
-py::array ColourAtlasFromPython(py::handle pano_object) {
+py::array ColorAtlasFromPython(py::handle pano_object) {
   const TwoLayerPanorama pano = PanoramaFromPython(pano_object);
   Image8 atlas;
   {
     py::gil_scoped_release release;
-    atlas = BuildColourAtlas(pano, 3);
+    atlas = BuildColorAtlas(pano, 3);
   }
   return AtlasToPython(std::move(atlas));
 }
@@ -103,7 +103,7 @@ void RegisterMeshes(py::module_& m) {
       .def_readwrite("include_back_layer", &MeshChoice::include_back_layer)
       .def_readwrite("num_threads", &MeshChoice::num_threads);
   m.def("_build_mesh", &BuildMeshFromPython, py::arg("panorama"), py::arg("choice"));
-  m.def("_colour_atlas", &ColourAtlasFromPython, py::arg("panorama"));
+  m.def("_color_atlas", &ColorAtlasFromPython, py::arg("panorama"));
 }
 
 }  // namespace casual3d::python

@@ -29,7 +29,7 @@ py::dict LayerToPython(LayerData&& d, int width, int height) {
       links[4 * i + dir] = static_cast<uint8_t>(GetLink(d.links[i], static_cast<Direction>(dir)));
   }
   py::dict out;
-  out["colour"] = ToNumpy(std::move(d.rgb), {height, width, 3});
+  out["color"] = ToNumpy(std::move(d.rgb), {height, width, 3});
   out["depth"] = ToNumpy(std::move(depth), {height, width});
   out["normals"] = ToNumpy(std::move(normals), {height, width, 3});
   out["labels"] = ToNumpy(std::move(d.label), {height, width});
@@ -63,13 +63,13 @@ void LayerFromPython(py::handle layer, const std::string& name, int width, int h
                      LayerData* d) {
   const py::ssize_t h = height, w = width;
   const auto depth = LayerArray<float>(layer, name, "depth", {h, w});
-  const auto colour = LayerArray<uint8_t>(layer, name, "colour", {h, w, 3});
+  const auto color = LayerArray<uint8_t>(layer, name, "color", {h, w, 3});
   const auto normals = LayerArray<float>(layer, name, "normals", {h, w, 3});
   const auto labels = LayerArray<uint8_t>(layer, name, "labels", {h, w});
   const auto links = LayerArray<uint8_t>(layer, name, "links", {h, w, 4});
   const float* depth_p = depth.data();
   const float* normal_p = normals.data();
-  const uint8_t* rgb_p = colour.data();
+  const uint8_t* rgb_p = color.data();
   const uint8_t* label_p = labels.data();
   const uint8_t* link_p = links.data();
   // Absent nodes keep the zeros of TwoLayerPanorama(width, height).

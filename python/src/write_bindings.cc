@@ -8,7 +8,7 @@
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
 #include "encoder/package_writer.h"
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 #include "python/src/bindings.h"
 #include "python/src/errors.h"
 #include "python/src/mesh_options.h"
@@ -71,7 +71,7 @@ py::dict ExportGlb(py::handle pano_object, const std::string& path, const MeshCh
     } else if (mesh->num_triangles() == 0) {
       status = InvalidData("the 3D photo has no triangles to export");
     } else {
-      status = encoder::ExportGlb(*mesh, BuildColourAtlas(pano, 3), options, path, &stats);
+      status = encoder::ExportGlb(*mesh, BuildColorAtlas(pano, 3), options, path, &stats);
     }
   }
   ThrowIfError(status, path);
@@ -97,8 +97,8 @@ void RegisterWriting(py::module_& m) {
       .def(py::init<>())
       .def_readwrite("tile_size", &PackageOptions::tile_size)
       .def_readwrite("levels", &PackageOptions::levels)
-      .def_readwrite("colour_quality", &PackageOptions::color_quality)
-      .def_readwrite("colour_method", &PackageOptions::color_method)
+      .def_readwrite("color_quality", &PackageOptions::color_quality)
+      .def_readwrite("color_method", &PackageOptions::color_method)
       .def_readwrite("lossless_effort", &PackageOptions::lossless_effort)
       .def_readwrite("lossless_method", &PackageOptions::lossless_method)
       .def_readwrite("depth_bits", &PackageOptions::depth_bits)

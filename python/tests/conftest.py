@@ -49,10 +49,10 @@ def make_room(width=128, height=64):
     # tinted blue, the walls tinted warm.
     brightness = 110 + 60 * np.sin(4 * lon) * np.cos(2 * lat) + np.where(box, 40, 0)
     tint = np.where(box[..., None], [0.85, 0.95, 1.1], [1.1, 1.0, 0.85])
-    front.colour[:] = np.clip(brightness[..., None] * tint, 0, 255).astype(np.uint8)
+    front.color[:] = np.clip(brightness[..., None] * tint, 0, 255).astype(np.uint8)
     back.depth[:] = np.where(box, wall, np.nan)
     back.normals[:] = np.where(box[..., None], -direction, np.nan)
-    back.colour[:] = np.where(box[..., None], front.colour // 2, 0).astype(np.uint8)
+    back.color[:] = np.where(box[..., None], front.color // 2, 0).astype(np.uint8)
     back.labels[:] = np.where(box, casual3d.LABEL_B, 0).astype(np.uint8)
     pano.view_hints = {"yaw_deg": 10.0, "pitch_deg": 0.0, "fov_deg": 70.0,
                        "content_yaw_deg": [-180.0, 180.0], "content_pitch_deg": [-90.0, 90.0],

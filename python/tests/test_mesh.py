@@ -18,7 +18,7 @@ def mesh_checksum(mesh):
     """format/testing/mesh_checksum.h MeshChecksum: 64-bit FNV-1a over the
     bytes of positions, normals, uvs, colours and indices, in that order."""
     h = 1469598103934665603
-    for array in (mesh.positions, mesh.normals, mesh.uvs, mesh.colours, mesh.indices):
+    for array in (mesh.positions, mesh.normals, mesh.uvs, mesh.colors, mesh.indices):
         for byte in np.ascontiguousarray(array).tobytes():
             h = ((h ^ byte) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
     return h
@@ -37,10 +37,10 @@ def make_blocks_panorama():
                                   (pano.back, background, near)):
         layer.depth[:] = np.where(present, depth, np.nan)
         layer.normals[:] = np.where(np.asarray(present)[..., None], [0, 0, 1], np.nan)
-        layer.colour[..., 0] = x & 255
-        layer.colour[..., 1] = y & 255
-    pano.back.colour[..., 2] = 100
-    pano.back.colour[~near] = 0
+        layer.color[..., 0] = x & 255
+        layer.color[..., 1] = y & 255
+    pano.back.color[..., 2] = 100
+    pano.back.color[~near] = 0
     pano.back.labels[near] = casual3d.LABEL_B
     return casual3d.link_neighbours(pano, 0.75)
 

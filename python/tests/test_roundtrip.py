@@ -33,7 +33,7 @@ def assert_package_reads_back(written, read):
         cosine = np.sum(r.normals[lit] * w.normals[lit], axis=-1)
         assert np.all(np.degrees(np.arccos(np.clip(cosine, -1, 1))) < 1.0)
         assert np.all(r.normals[present & ~lit] == 0)
-        assert psnr(r.colour[present], w.colour[present]) > 38.0
+        assert psnr(r.color[present], w.color[present]) > 38.0
 
 
 @pytest.mark.parametrize("name", ["web", "photo.c3d"])
@@ -70,7 +70,7 @@ def test_master_file_reads_back_exactly(room, tmp_path, cli):
     np.testing.assert_array_equal(read.rotation, room.rotation)
     assert read.view_hints == room.view_hints
     for w, r in zip(room.layers, read.layers):
-        for field in ("colour", "depth", "normals", "labels", "links"):
+        for field in ("color", "depth", "normals", "labels", "links"):
             np.testing.assert_array_equal(getattr(r, field), getattr(w, field), err_msg=field)
     # The CLI encodes it into a package that Python reads as it wrote it.
     # 12-bit depth and 8-bit normals: the encoder library's defaults, which the
@@ -84,9 +84,9 @@ def test_front_only_panorama_without_view_hints(tmp_path):
     pano = casual3d.Panorama.empty(64, 32)
     pano.front.depth[:] = np.linspace(2.0, 4.0, 32, dtype=np.float32)[:, None]
     pano.front.normals[:] = 0.0
-    pano.front.colour[:] = [90, 160, 70]
+    pano.front.color[:] = [90, 160, 70]
     casual3d.link_neighbours(pano)
-    casual3d.write_package(pano, tmp_path / "p.c3d", colour_quality=95)
+    casual3d.write_package(pano, tmp_path / "p.c3d", color_quality=95)
     read = casual3d.read(tmp_path / "p.c3d")
     assert read.view_hints is None
     assert not read.back.present.any()

@@ -24,7 +24,7 @@ def summary(pano):
     for layer in pano.layers:
         present = layer.present
         out["present"].append(int(present.sum()))
-        out["rgb_sum"].append(int(layer.colour[present].astype(np.int64).sum()))
+        out["rgb_sum"].append(int(layer.color[present].astype(np.int64).sum()))
         out["depth_sum_m"].append(float(layer.depth[present].astype(np.float64).sum()))
         out["normal_sum"].append(layer.normals[present].astype(np.float64).sum(axis=0).tolist())
         graph += (present.astype(np.uint8).tobytes() + layer.labels.tobytes() +

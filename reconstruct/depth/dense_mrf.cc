@@ -32,7 +32,7 @@ void AssembleDenseMrf(const ImageF& photo_weight, const ImageF& color, const std
   }
   mrf->weight_right.assign(np, 0.0f);
   mrf->weight_down.assign(np, 0.0f);
-  // In double precision with std::exp, not colour_weights.h's float fast
+  // In double precision with std::exp, not color_weights.h's float fast
   // exponential: the weights, and so the solved labels, stay those of the
   // stage's reference outputs.
   const double inv2s2 = 1.0 / (2.0 * options.sigma_color * options.sigma_color);

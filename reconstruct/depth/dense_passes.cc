@@ -12,7 +12,7 @@
 #include "reconstruct/depth/dense_report.h"
 #include "reconstruct/depth/depth_metrics.h"
 #include "reconstruct/depth/mrf_trws.h"
-#include "reconstruct/io/colour_map.h"
+#include "reconstruct/io/color_map.h"
 #include "reconstruct/io/cv_bridge.h"
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
@@ -39,7 +39,7 @@ int ScaledRadius(int radius_at_reference, double ratio) {
 
 // Inverse depth over the photo's range (near = warm); invalid pixels black.
 Image8 Colorize(const ImageF& depth, const DepthRange& range) {
-  return io::ColouriseDepth(depth, range.near_m, range.far_m);
+  return io::ColorizeDepth(depth, range.near_m, range.far_m);
 }
 
 // Per-pixel verdict against ground truth: red = near floater (d < 0.85 g),

@@ -6,7 +6,7 @@
 
 #include "base/parallel_for.h"
 #include "reconstruct/depth/avx2_clones.h"
-#include "reconstruct/depth/colour_weights.h"
+#include "reconstruct/depth/color_weights.h"
 #include "reconstruct/depth/label_histogram.h"
 
 namespace casual3d::depth {
@@ -16,7 +16,7 @@ namespace {
 // Filters row y of `labels` into `out`. hist (num_labels zeros, left zeroed)
 // and wgt (2r + 1 floats) are the caller's scratch.
 CASUAL3D_AVX2_CLONES
-void FilterRow(int y, const std::vector<int>& labels, const ColourPlanes& planes, int w, int h, int r,
+void FilterRow(int y, const std::vector<int>& labels, const ColorPlanes& planes, int w, int h, int r,
                const float* spatial, float inv2s2, float* __restrict hist, float* __restrict wgt, int* out) {
   for (int x = 0; x < w; ++x) {
     const size_t c = static_cast<size_t>(y) * w + x;
@@ -32,7 +32,7 @@ void FilterRow(int y, const std::vector<int>& labels, const ColourPlanes& planes
       const float* __restrict pg = planes.g.data() + row;
       const float* __restrict pb = planes.b.data() + row;
       for (int i = 0; i < n; ++i) {
-        wgt[i] = srow[i] * ColourAffinity(pr[i] - r0, pg[i] - g0, pb[i] - b0, inv2s2);
+        wgt[i] = srow[i] * ColorAffinity(pr[i] - r0, pg[i] - g0, pb[i] - b0, inv2s2);
       }
       for (int i = 0; i < n; ++i) total += wgt[i];
       histogram.AddRow(labels.data() + row, wgt, n);
@@ -59,7 +59,7 @@ std::vector<int> EdgeAwareMedian(const std::vector<int>& labels, int num_labels,
           std::exp(-(dx * dx + dy * dy) / (2.0 * options.sigma_spatial * options.sigma_spatial)));
   const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
   const size_t n = labels.size();
-  const ColourPlanes planes = SplitColour(color);
+  const ColorPlanes planes = SplitColor(color);
 
   std::vector<int> out(n);
   base::ParallelFor(0, h, base::ResolveThreads(num_threads), [&](int64_t y) {

@@ -8,7 +8,7 @@ namespace {
 // A near object (colour 0.2, label 50) left of x = 20 in front of a
 // background (colour 0.8, label 10); the labelling is fattened: the near label
 // reaches 3 pixels into the background, as a window-based cost leaves it.
-TEST(EdgeAwareMedian, RemovesAFattenedBandAndSnapsTheEdgeToTheColourEdge) {
+TEST(EdgeAwareMedian, RemovesAFattenedBandAndSnapsTheEdgeToTheColorEdge) {
   const int w = 48, h = 24;
   ImageF color(w, h, 3);
   std::vector<int> labels(static_cast<size_t>(w) * h);
@@ -23,7 +23,7 @@ TEST(EdgeAwareMedian, RemovesAFattenedBandAndSnapsTheEdgeToTheColourEdge) {
       ASSERT_EQ(out[static_cast<size_t>(y) * w + x], x < 20 ? 50 : 10) << x << "," << y;
 }
 
-TEST(EdgeAwareMedian, KeepsThinStructuresOfTheirOwnColour) {
+TEST(EdgeAwareMedian, KeepsThinStructuresOfTheirOwnColor) {
   // A 2-pixel-wide pole (own colour, own label) survives the filter.
   const int w = 40, h = 30;
   ImageF color(w, h, 3);

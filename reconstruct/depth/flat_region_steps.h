@@ -21,7 +21,7 @@ namespace casual3d::depth::flat {
 struct FlatGroups {
   std::vector<int> group;                    // Per pixel (row-major): group id, -1 none.
   std::vector<long long> area;               // Pixels per group id.
-  std::vector<std::array<float, 3>> colour;  // Mean colour per group id.
+  std::vector<std::array<float, 3>> color;  // Mean colour per group id.
   int size() const { return static_cast<int>(area.size()); }
 };
 

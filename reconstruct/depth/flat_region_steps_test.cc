@@ -31,7 +31,7 @@ TEST(SegmentFlatGroups, JoinsTheWallThatAThinPoleCrosses) {
   EXPECT_EQ(left, right);
   EXPECT_EQ(groups.group[5 * 60 + 30], -1);  // The pole.
   EXPECT_EQ(groups.area[left], 57 * 40);
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(groups.colour[left][c], kGrey, 1e-6);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(groups.color[left][c], kGrey, 1e-6);
 }
 
 TEST(SegmentFlatGroups, KeepsTheSidesApartAcrossAWidePoleAndDropsSmallRegions) {
@@ -67,7 +67,7 @@ struct TwoGroups {
       for (int x = 0; x < 20; ++x)
         if (x < 8 || x >= 12) groups.group[y * 20 + x] = x < 8 ? 0 : 1;
     groups.area = {80, 80};
-    groups.colour = {{{kGrey, kGrey, kGrey}}, {{kGrey, kGrey, kGrey}}};
+    groups.color = {{{kGrey, kGrey, kGrey}}, {{kGrey, kGrey, kGrey}}};
     fits.resize(2);
     fits[0].ok = true;
     fits[0].plane.c = 5;
@@ -78,7 +78,7 @@ struct TwoGroups {
   }
 };
 
-TEST(AdoptPlanes, TakesTheCloseSameColouredGroupsPlane) {
+TEST(AdoptPlanes, TakesTheCloseSameColoredGroupsPlane) {
   TwoGroups t;
   EdgePoint e;
   e.x = 15;
@@ -90,7 +90,7 @@ TEST(AdoptPlanes, TakesTheCloseSameColouredGroupsPlane) {
   EXPECT_EQ(t.fits[1].plane.c, 5);
 }
 
-TEST(AdoptPlanes, RefusesAFarOtherColouredOrContradictedPlane) {
+TEST(AdoptPlanes, RefusesAFarOtherColoredOrContradictedPlane) {
   FlatRegionOptions near;
   near.adopt_distance = 4;  // The boxes are 5 pixels apart.
   TwoGroups far;
@@ -98,7 +98,7 @@ TEST(AdoptPlanes, RefusesAFarOtherColouredOrContradictedPlane) {
   EXPECT_FALSE(far.fits[1].ok);
 
   TwoGroups other;
-  other.groups.colour[1] = {0.5f, 0.7f, 0.5f};
+  other.groups.color[1] = {0.5f, 0.7f, 0.5f};
   other.Adopt(FlatRegionOptions());
   EXPECT_FALSE(other.fits[1].ok);
 
@@ -110,7 +110,7 @@ TEST(AdoptPlanes, RefusesAFarOtherColouredOrContradictedPlane) {
   EXPECT_FALSE(behind.fits[1].ok);
 }
 
-TEST(AssignPriors, CoversTheGroupAndItsConnectedColourClampedToTheLabels) {
+TEST(AssignPriors, CoversTheGroupAndItsConnectedColorClampedToTheLabels) {
   const int w = 10, h = 4, labels = 5;
   ImageF color(w, h, 3, kGrey), weight(w, h, 1, 0.0f);
   FlatGroups groups;
@@ -122,7 +122,7 @@ TEST(AssignPriors, CoversTheGroupAndItsConnectedColourClampedToTheLabels) {
     }
   color.at(6, 0, 1) = 0.9f;  // Another colour.
   groups.area = {5 * h};
-  groups.colour = {{{kGrey, kGrey, kGrey}}};
+  groups.color = {{{kGrey, kGrey, kGrey}}};
   std::vector<PlaneFit> fits(1);
   fits[0].ok = true;
   fits[0].plane.a = 1;

@@ -78,7 +78,7 @@ void EstimateGain(const ImageF& color, const ImageF& photo_weight, const ImageF&
 // nothing); labels that fewer than half of the seeing neighbours cover are
 // left out (one neighbour alone matches by chance). False when the minimum
 // is not clear.
-bool MeasureEdge(const std::vector<Neighbor>& nbs, const float* region_colour, const std::vector<float>& inv_of,
+bool MeasureEdge(const std::vector<Neighbor>& nbs, const float* region_color, const std::vector<float>& inv_of,
                  EdgePoint* e) {
   const int L = static_cast<int>(inv_of.size());
   std::vector<float> cost(L, 0.0f), weight(L, 0.0f);
@@ -96,7 +96,7 @@ bool MeasureEdge(const std::vector<Neighbor>& nbs, const float* region_colour, c
     const float wn = std::min(1.0f, motion / 4.0f);
     if (wn < 0.05f) continue;
     float ref[3];
-    for (int c = 0; c < 3; ++c) ref[c] = region_colour[c] / nb.gain[c];
+    for (int c = 0; c < 3; ++c) ref[c] = region_color[c] / nb.gain[c];
     const float inv_scale = 1.0f / e->scale;
     for (int k = 0; k < L; ++k) {
       float u, v;
@@ -194,7 +194,7 @@ void Score(const Plane& pl, const std::vector<EdgePoint>& pts, double touch, int
 }
 
 struct GroupShape {
-  std::array<float, 3> colour = {0, 0, 0};
+  std::array<float, 3> color = {0, 0, 0};
   std::vector<std::pair<float, float>> samples;  // A subset of the group's pixels.
   bool touches_top = false;                      // Reaches the image's top row.
 };
@@ -367,7 +367,7 @@ PlaneFit FitPlane(const std::vector<EdgePoint>& pts, const GroupShape& shape, co
       *lr += std::abs(e.nx) > 0.5f;
     }
   };
-  const bool sky_like = shape.touches_top && shape.colour[2] > std::max(shape.colour[0], shape.colour[1]) + 0.03f;
+  const bool sky_like = shape.touches_top && shape.color[2] > std::max(shape.color[0], shape.color[1]) + 0.03f;
   const int side = options.min_side_points;
   Plane pl;
   int t, o, up, down, lr;
@@ -479,7 +479,7 @@ void JoinRegions(const std::vector<int>& region, const std::vector<std::array<do
 }
 
 // The colour edge outward of the boundary pixel (x, y) of a region of colour
-// `region_colour` along e's normal: the first pixel outward (within
+// `region_color` along e's normal: the first pixel outward (within
 // kMaxMarch) that looks different from the region. The flat pixels can stop
 // short of it, where the colour-weighted texture measure sees texture
 // beyond. Its position to a fraction of a pixel: where the colour difference
@@ -487,13 +487,13 @@ void JoinRegions(const std::vector<int>& region, const std::vector<std::array<do
 // half of its value 1.5 pixels further out (an error of half a pixel there
 // is an error of half a pixel of disparity). Sets e's position, scale and
 // profile; false when there is no clear edge or the profile leaves the image.
-bool LocateColourEdge(const ImageF& color, int x, int y, const float* region_colour,
+bool LocateColorEdge(const ImageF& color, int x, int y, const float* region_color,
                       const FlatRegionOptions& options, EdgePoint* e) {
   constexpr float kMaxMarch = 6.0f, kStep = 0.25f;
   auto diff_at = [&](float t, float* d) {
     float s[3];
     if (!SampleRgb(color, x + t * e->nx, y + t * e->ny, s)) return false;
-    *d = std::abs(s[0] - region_colour[0]) + std::abs(s[1] - region_colour[1]) + std::abs(s[2] - region_colour[2]);
+    *d = std::abs(s[0] - region_color[0]) + std::abs(s[1] - region_color[1]) + std::abs(s[2] - region_color[2]);
     return true;
   };
   float t_out = -1.0f, d_out = 0.0f;
@@ -535,8 +535,8 @@ bool LocateColourEdge(const ImageF& color, int x, int y, const float* region_col
     float s3[3];
     const float o = kProfileStart + i * kProfileStep;
     inside_image = SampleRgb(color, e->x + o * e->nx, e->y + o * e->ny, s3);
-    const float d = std::abs(s3[0] - region_colour[0]) + std::abs(s3[1] - region_colour[1]) +
-                    std::abs(s3[2] - region_colour[2]);
+    const float d = std::abs(s3[0] - region_color[0]) + std::abs(s3[1] - region_color[1]) +
+                    std::abs(s3[2] - region_color[2]);
     e->profile[i] = std::min(1.0f, d / e->scale);
   }
   return inside_image;
@@ -563,7 +563,7 @@ std::vector<std::vector<EdgePoint>> MeasureGroupEdges(
     }
     for (const EdgePoint& e : pts) {
       EdgePoint m = e;
-      if (!MeasureEdge(nbs, groups.colour[g].data(), inv_of, &m)) continue;
+      if (!MeasureEdge(nbs, groups.color[g].data(), inv_of, &m)) continue;
       m.kind = Classify(m, g, groups.group, anchors, photo_weight, grid, options);
       measured[g].push_back(m);
     }
@@ -585,7 +585,7 @@ std::vector<PlaneFit> FitGroupPlanes(const FlatGroups& groups, int w,
   for (int g = 0; g < groups.size(); ++g) {
     if (groups.area[g] < min_area) continue;
     GroupShape shape;
-    shape.colour = groups.colour[g];
+    shape.color = groups.color[g];
     for (size_t p = 0; p < n; p += 7)
       if (groups.group[p] == g) shape.samples.emplace_back(static_cast<float>(p % w), static_cast<float>(p / w));
     for (int x = 0; x < w && !shape.touches_top; ++x) shape.touches_top = groups.group[x] == g;
@@ -620,10 +620,10 @@ FlatGroups SegmentFlatGroups(const ImageF& color, const ImageF& photo_weight,
     ++groups.area[g];
     for (int c = 0; c < 3; ++c) group_sum[g][c] += color.data()[3 * p + c];
   }
-  groups.colour.assign(num_regions, {0, 0, 0});
+  groups.color.assign(num_regions, {0, 0, 0});
   for (int g = 0; g < num_regions; ++g)
     if (groups.area[g] > 0)
-      for (int c = 0; c < 3; ++c) groups.colour[g][c] = static_cast<float>(group_sum[g][c] / groups.area[g]);
+      for (int c = 0; c < 3; ++c) groups.color[g][c] = static_cast<float>(group_sum[g][c] / groups.area[g]);
   return groups;
 }
 
@@ -655,7 +655,7 @@ std::vector<std::vector<EdgePoint>> FindEdgePoints(const ImageF& color, const Fl
       EdgePoint e;
       e.nx = -gx / len;
       e.ny = -gy / len;
-      if (LocateColourEdge(color, x, y, groups.colour[g].data(), options, &e)) points[g].push_back(e);
+      if (LocateColorEdge(color, x, y, groups.color[g].data(), options, &e)) points[g].push_back(e);
     }
   return points;
 }
@@ -664,7 +664,7 @@ void AdoptPlanes(const FlatGroups& groups, int w, int h,
                  const std::vector<std::vector<EdgePoint>>& measured,
                  const std::vector<int>& fitted_groups, const std::vector<int>& unfitted_groups,
                  const FlatRegionOptions& options, std::vector<PlaneFit>* fits) {
-  const std::vector<std::array<float, 3>>& colour = groups.colour;
+  const std::vector<std::array<float, 3>>& color = groups.color;
   std::vector<std::array<int, 4>> box(groups.size(), {w, h, -1, -1});
   for (size_t p = 0; p < groups.group.size(); ++p) {
     const int g = groups.group[p];
@@ -677,7 +677,7 @@ void AdoptPlanes(const FlatGroups& groups, int w, int h,
     int best = -1, best_touching = -1;
     for (int f : fitted_groups) {
       double d2 = 0;
-      for (int c = 0; c < 3; ++c) d2 += (colour[g][c] - colour[f][c]) * (colour[g][c] - colour[f][c]);
+      for (int c = 0; c < 3; ++c) d2 += (color[g][c] - color[f][c]) * (color[g][c] - color[f][c]);
       if (d2 > adopt2) continue;
       const int gap = std::max({box[f][0] - box[g][2], box[g][0] - box[f][2], box[f][1] - box[g][3],
                                 box[g][1] - box[f][3], 0});
@@ -730,7 +730,7 @@ std::vector<float> AssignPriors(const ImageF& color, const ImageF& photo_weight,
         if (q[0] < 0 || q[1] < 0 || q[0] >= w || q[1] >= h) continue;
         const size_t qi = static_cast<size_t>(q[1]) * w + q[0];
         if (!std::isnan(prior[qi]) || group[qi] >= 0 || photo_weight.data()[qi] >= extend_w) continue;
-        if (Dist2(groups.colour[g].data(), color.data() + 3 * qi) > spread2) continue;
+        if (Dist2(groups.color[g].data(), color.data() + 3 * qi) > spread2) continue;
         assign(qi);
         stack.push_back(static_cast<int>(qi));
       }

@@ -9,7 +9,7 @@
 
 #include "base/parallel_for.h"
 #include "reconstruct/depth/avx2_clones.h"
-#include "reconstruct/depth/colour_weights.h"
+#include "reconstruct/depth/color_weights.h"
 #include "reconstruct/depth/fast_exp.h"
 #include "reconstruct/depth/near_envelope.h"
 #include "reconstruct/depth/plane_sweep.h"
@@ -274,7 +274,7 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
       // The colour-weighted window of the reference: pixel (u, v) weighs
       // exp(-|c_uv - c_xy|^2 / (2 sigma_color^2)).
       const float* c0 = &color.at(x, y, 0);
-      auto gather_colour = [&](int i, int u, int v) {
+      auto gather_color = [&](int i, int u, int v) {
         const float* c = &color.at(u, v, 0);
         pr[i] = c[0];
         pg[i] = c[1];
@@ -288,14 +288,14 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
           const int u = x + du;
           if (u < 0 || u >= w) continue;
           if (du == 0 && dv == 0) centre = m;
-          gather_colour(m, u, v);
+          gather_color(m, u, v);
           ival[m] = gray.at(u, v);
           sx[m] = static_cast<float>(u);
           sy[m] = static_cast<float>(v);
           ++m;
         }
       }
-      ColourWeights(pr.data(), pg.data(), pb.data(), m, c0, inv2s2, wgt.data());
+      ColorWeights(pr.data(), pg.data(), pb.data(), m, c0, inv2s2, wgt.data());
       double sw = 0, si = 0, sii = 0;
       for (int i = 0; i < m; ++i) {
         sw += wgt[i];
@@ -345,10 +345,10 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
           for (int u = std::max(0, x - R); u <= std::min(w - 1, x + R); u += cs) {
             const size_t q = static_cast<size_t>(v) * w + u;
             if (cur - inv[q] < same) continue;
-            gather_colour(ns, u, v);
+            gather_color(ns, u, v);
             pinv[ns++] = inv[q];
           }
-        ColourWeights(pr.data(), pg.data(), pb.data(), ns, c0, inv2s2, pw.data());
+        ColorWeights(pr.data(), pg.data(), pb.data(), ns, c0, inv2s2, pw.data());
         samples.clear();
         double total = 0;
         for (int i = 0; i < ns; ++i) {

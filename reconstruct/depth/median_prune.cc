@@ -8,7 +8,7 @@
 
 #include "base/parallel_for.h"
 #include "reconstruct/depth/avx2_clones.h"
-#include "reconstruct/depth/colour_weights.h"
+#include "reconstruct/depth/color_weights.h"
 #include "reconstruct/depth/label_histogram.h"
 
 namespace casual3d::depth {
@@ -64,7 +64,7 @@ namespace {
 // `anchor` (1 at anchors, else 0) are padded by 8 past the image; hist (bins
 // zeros, left zeroed) and wgt (2r + 8 floats) are scratch.
 CASUAL3D_AVX2_CLONES
-void BilateralMedianRow(int y, const std::vector<int>& label, const ColourPlanes& planes,
+void BilateralMedianRow(int y, const std::vector<int>& label, const ColorPlanes& planes,
                         const std::vector<float>& anchor, int w, int h, int r, float inv2s2, float* __restrict hist,
                         float* __restrict wgt, int* med) {
   const float* __restrict pr = planes.r.data();
@@ -87,7 +87,7 @@ void BilateralMedianRow(int y, const std::vector<int>& label, const ColourPlanes
       // window weigh 0).
       const int n8 = (n + 7) & ~7;
       for (int i = 0; i < n8; ++i) {
-        wgt[i] = pa[row + i] * ColourAffinity(pr[row + i] - r0, pg[row + i] - g0, pb[row + i] - b0, inv2s2);
+        wgt[i] = pa[row + i] * ColorAffinity(pr[row + i] - r0, pg[row + i] - g0, pb[row + i] - b0, inv2s2);
       }
       for (int i = n; i < n8; ++i) wgt[i] = 0.0f;
       for (int i = 0; i < n8; ++i) total += wgt[i];
@@ -121,7 +121,7 @@ ImageF BilateralMedianPrune(const ImageF& depth, const ImageF& color, const Labe
       anchor[p] = 1.0f;
     }
   }
-  const ColourPlanes planes = SplitColour(color, 8);
+  const ColorPlanes planes = SplitColor(color, 8);
   // Colour weights exp(-|c_q - c_p|^2 / (2 sigma_c^2)).
   const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
 

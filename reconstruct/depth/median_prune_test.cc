@@ -41,7 +41,7 @@ TEST(MedianPrune, DropsIsolatedSurvivorsAndKeepsOneLabelJitter) {
     for (int x = 0; x < 5; ++x) EXPECT_GT(out.at(x, y), 0.0f);
 }
 
-TEST(BilateralMedianPrune, RemovesAFloaterButKeepsAThinStructureOfItsOwnColour) {
+TEST(BilateralMedianPrune, RemovesAFloaterButKeepsAThinStructureOfItsOwnColor) {
   const int w = 80, h = 60;
   ImageF d(w, h, 1, LabelDepth(150));
   ImageF c(w, h, 3, 0.5f);

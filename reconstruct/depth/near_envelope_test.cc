@@ -10,7 +10,7 @@ namespace casual3d::depth {
 namespace {
 
 // Two colour regions split at x = 30; one anchor patch in each.
-TEST(PropagateAnchors, FollowsColourEdges) {
+TEST(PropagateAnchors, FollowsColorEdges) {
   const int w = 60, h = 40;
   ImageF color(w, h, 3);
   std::mt19937 rng(1);

@@ -433,7 +433,7 @@ namespace {
 // the wall pixels two columns from the stripe see its texture in their 7x7
 // window. The colour-weighted texture measure must call them flat; the plain
 // window variance calls them textured.
-TEST(PlaneSweep, TextureWeightIgnoresADifferentlyColouredNeighbour) {
+TEST(PlaneSweep, TextureWeightIgnoresADifferentlyColoredNeighbour) {
   const int w = 40, h = 20;
   DenseView v;
   v.name = "stripe";

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "base/parallel_for.h"
-#include "reconstruct/depth/colour_weights.h"
+#include "reconstruct/depth/color_weights.h"
 
 namespace casual3d::depth {
 
@@ -27,7 +27,7 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
   ImageF out(hw, hh, 1, 0.0f);
   // The spatial weight is separable: per column and per row, the 2r + 1
   // factors exp(-d^2 / (2 sigma_s^2)) of its window. The colour weights
-  // are computed per sample (ColourWeights).
+  // are computed per sample (ColorWeights).
   const int taps = 2 * r + 1;
   std::vector<int> ucol(hw);
   std::vector<float> wcol(static_cast<size_t>(hw) * taps);
@@ -88,7 +88,7 @@ ImageF JointBilateralMedianUpsample(const ImageF& low, const ImageF& low_color,
       if (count == 0) continue;
       const float* wc = &wcol[static_cast<size_t>(x) * taps];
       const float* c0 = &high_color.at(x, y, 0);
-      ColourWeights(sr.data(), sg.data(), sb.data(), count, c0, inv_sc, weight.data());
+      ColorWeights(sr.data(), sg.data(), sb.data(), count, c0, inv_sc, weight.data());
       float total = 0.0f;
       for (int s = 0; s < count; ++s) {
         weight[s] = spatial[s] * wc[column[s]] * weight[s] + 1e-12f;

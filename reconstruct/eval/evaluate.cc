@@ -325,7 +325,7 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     auto built = BuildMesh(photo3d.pano);
     if (!built.ok()) throw std::runtime_error(photo3d.source + ": " + built.status().message());
     mesh = std::move(*built);
-    atlas = encoder::BuildColourAtlas(photo3d.pano);
+    atlas = encoder::BuildColorAtlas(photo3d.pano);
     eval.mesh_triangles = mesh.indices.size() / 3;
     if (options.backdrop && options.viewer_views) {
       auto built_backdrop = BuildBackdrop(photo3d.pano);

@@ -127,15 +127,15 @@ RephotoMetrics ComputeRephotoMetrics(ImageView<const uint8_t> photo,
     cv::Mat distance, labels;
     cv::distanceTransform(holes, distance, labels, cv::DIST_L2, cv::DIST_MASK_5,
                           cv::DIST_LABEL_PIXEL);
-    std::vector<cv::Vec3b> colour_of(1);
+    std::vector<cv::Vec3b> color_of(1);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)
-        if (!holes.at<uint8_t>(y, x)) colour_of.push_back(render_mat.at<cv::Vec3b>(y, x));
+        if (!holes.at<uint8_t>(y, x)) color_of.push_back(render_mat.at<cv::Vec3b>(y, x));
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         const int label = labels.at<int>(y, x);
-        if (holes.at<uint8_t>(y, x) && label > 0 && label < static_cast<int>(colour_of.size()))
-          filled.at<cv::Vec3b>(y, x) = colour_of[label];
+        if (holes.at<uint8_t>(y, x) && label > 0 && label < static_cast<int>(color_of.size()))
+          filled.at<cv::Vec3b>(y, x) = color_of[label];
       }
   }
   double sum_sq_filled = 0;

@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "reconstruct/eval/viewer_views_report.h"
-#include "reconstruct/io/colour_map.h"
+#include "reconstruct/io/color_map.h"
 #include "reconstruct/io/cv_bridge.h"
 #include "reconstruct/util/html.h"
 
@@ -70,7 +70,7 @@ void HeatmapColor(float error, double max_error, uint8_t rgb[3]) {
     rgb[0] = rgb[1] = rgb[2] = 128;
     return;
   }
-  io::HeatColour(error / max_error, rgb);
+  io::HeatColor(error / max_error, rgb);
 }
 
 namespace {

@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "format/backdrop.h"
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 #include "format/mesh_builder.h"
 #include "format/testing/test_panoramas.h"
 #include "reconstruct/eval/captured_field.h"
@@ -48,7 +48,7 @@ struct MeshAndAtlas {
 MeshAndAtlas Build(const TwoLayerPanorama& pano) {
   const StatusOr<Mesh> mesh = BuildMesh(pano);
   EXPECT_TRUE(mesh.ok()) << mesh.status().ToString();
-  return {mesh.ok() ? *mesh : Mesh(), BuildColourAtlas(pano)};
+  return {mesh.ok() ? *mesh : Mesh(), BuildColorAtlas(pano)};
 }
 
 ViewHints Ahead(double volume_radius) {

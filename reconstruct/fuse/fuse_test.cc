@@ -95,7 +95,7 @@ TEST(FuseTest, GrowsTheBackLayerBehindTheForeground) {
   EXPECT_GT(stats.back_nodes_hallucinated, 2 * 10 * 30);
 }
 
-TEST(FuseTest, RemovesColourFringes) {
+TEST(FuseTest, RemovesColorFringes) {
   Scene scene(3);
   FuseOptions options;
   options.expansion_fraction = 0;

@@ -233,8 +233,8 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
         const float mean = sum / count;
         const float var = std::max(0.0f, sum2 / count - mean * mean);
         const uint8_t* c = &front.rgb[3 * i];
-        const bool sky_colour = c[2] >= c[0] || mean > 0.6f;
-        candidate[i] = std::sqrt(var) <= options.sky_max_texture && sky_colour;
+        const bool sky_color = c[2] >= c[0] || mean > 0.6f;
+        candidate[i] = std::sqrt(var) <= options.sky_max_texture && sky_color;
       }
       // Flood fill from candidates at the top of the content (no front node above).
       std::vector<size_t> stack;

@@ -158,7 +158,7 @@ int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<i
     throw std::invalid_argument("coverage: gap filling needs images of one size");
   const bool with_label = label && !label->empty();
   float* depth = depth_m->data();
-  uint8_t* colour = rgb->data();
+  uint8_t* color = rgb->data();
   const auto gap = [&](int64_t i) { return mask.data()[i] != 0 && !(depth[i] > 0); };
   // Calls visit(j) for the 8-neighbours j of pixel i (columns wrap, rows end).
   const auto for_each_neighbour = [W, H](int64_t i, auto&& visit) {
@@ -224,7 +224,7 @@ int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<i
       const int64_t rim = original[source] ? source : origin[source];
       origin[i] = rim;
       if (const int64_t m = rim >= 0 ? mirrored(i, rim, depth[source]) : -1; m >= 0) {
-        fills.push_back({colour[3 * m], colour[3 * m + 1], colour[3 * m + 2]});
+        fills.push_back({color[3 * m], color[3 * m + 1], color[3 * m + 2]});
         continue;
       }
       const float limit = 0.95f * depth[source];
@@ -232,7 +232,7 @@ int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<i
       int count = 0;
       for_each_neighbour(i, [&](int64_t j) {
         if (!(depth[j] >= limit)) return;
-        for (int c = 0; c < 3; ++c) sum[c] += colour[3 * j + c];
+        for (int c = 0; c < 3; ++c) sum[c] += color[3 * j + c];
         ++count;
       });
       std::array<uint8_t, 3> mean;
@@ -243,7 +243,7 @@ int64_t FillGapsInside(const Image8& mask, Image8* rgb, ImageF* depth_m, Image<i
     for (size_t k = 0; k < ring.size(); ++k) {
       const auto [i, source] = ring[k];
       depth[i] = depth[source];
-      for (int c = 0; c < 3; ++c) colour[3 * i + c] = fills[k][c];
+      for (int c = 0; c < 3; ++c) color[3 * i + c] = fills[k][c];
       if (with_label) label->data()[i] = label->data()[source];
     }
     filled += static_cast<int64_t>(ring.size());

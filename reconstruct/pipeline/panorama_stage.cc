@@ -10,7 +10,7 @@
 
 #include "encoder/master_file.h"
 #include "reconstruct/geometry/colmap_model.h"
-#include "reconstruct/io/colour_map.h"
+#include "reconstruct/io/color_map.h"
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/pipeline/view_volume.h"
 #include "reconstruct/io/image_io.h"
@@ -51,7 +51,7 @@ void WritePreviews(const TwoLayerPanorama& pano, const std::string& dir) {
         const size_t i = pano.index(x * step, y * step);
         if (!layer.present[i]) continue;
         for (int c = 0; c < 3; ++c) color.at(x, y, c) = layer.rgb[3 * i + c];
-        io::DepthRampColour(near / layer.depth_m[i], &depth.at(x, y, 0));
+        io::DepthRampColor(near / layer.depth_m[i], &depth.at(x, y, 0));
       }
     }
     const std::string name = l == kFront ? "front" : "back";

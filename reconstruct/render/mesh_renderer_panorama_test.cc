@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 #include "format/equirect.h"
 #include "format/mesh_builder.h"
 #include "format/testing/test_panoramas.h"
@@ -41,7 +41,7 @@ TEST(MeshRendererPanoramaTest, RoomSeenFromTheCentreShowsTheFrontLayer) {
   const TwoLayerPanorama pano = testing::MakeRoomPanorama(w, h);
   const StatusOr<Mesh> mesh = BuildMesh(pano);
   ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
-  const Image8 atlas = BuildColourAtlas(pano);
+  const Image8 atlas = BuildColorAtlas(pano);
   const LayerData& front = pano.layer(0);
 
   struct ViewCase {
@@ -174,7 +174,7 @@ TEST(MeshRendererPanoramaTest, CrossLayerTrianglesSampleOneAtlasHalf) {
   const TwoLayerPanorama pano = SquareOverBackground(128, 64);
   const StatusOr<Mesh> mesh = BuildMesh(pano);
   ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
-  const Image8 atlas = BuildColourAtlas(pano);
+  const Image8 atlas = BuildColorAtlas(pano);
   // From the centre the cross-layer triangles show as a strip along the
   // square's outline; from 0.4 m to the side as the disocclusion beside it.
   const double eye_x[] = {0.0, 0.4};

@@ -91,14 +91,14 @@ Eigen::Vector3d EvaluateAlbedo(const Material& m, const Eigen::Vector3d& p,
                                const Eigen::Vector2d& uv, double footprint) {
   switch (m.kind) {
     case TextureKind::kFlat:
-      return m.colour_a;
+      return m.color_a;
     case TextureKind::kNoise: {
       // Gain 0.75 keeps fine octaves strong (corners for SIFT at every scale);
       // the stretch undoes the averaging of 7 octaves (standard deviation
       // about 0.07 before, 0.3 after).
       double n = FractalNoise(p, m.frequency, 7, 0.75, footprint, m.seed);
       n = Clamp01(0.5 + 4.5 * (n - 0.5));
-      return m.colour_a + (m.colour_b - m.colour_a) * n;
+      return m.color_a + (m.color_b - m.color_a) * n;
     }
     case TextureKind::kBricks: {
       const double length = m.cell_m, height = m.cell_m * 0.36, mortar = m.cell_m * 0.05;
@@ -111,36 +111,36 @@ Eigen::Vector3d EvaluateAlbedo(const Material& m, const Eigen::Vector3d& p,
       const uint64_t h = Hash(static_cast<uint64_t>(((col % 4) + 4) % 4),
                               static_cast<uint64_t>(((row % 3) + 3) % 3), m.seed);
       const double t = HashToUnit(h);
-      Eigen::Vector3d brick = m.colour_a + (m.colour_b - m.colour_a) * t;
+      Eigen::Vector3d brick = m.color_a + (m.color_b - m.color_a) * t;
       // Mortar lines, box-filtered over the footprint (no aliasing at a distance).
       const double in_u = FilteredPulse(u - mortar * 0.5, length, 1.0 - mortar / length, footprint);
       const double in_v =
           FilteredPulse(uv.y() - mortar * 0.5, height, 1.0 - mortar / height, footprint);
       const double brick_fraction = in_u * in_v;
-      const Eigen::Vector3d mortar_colour(0.55, 0.53, 0.5);
+      const Eigen::Vector3d mortar_color(0.55, 0.53, 0.5);
       const double grain = FractalNoise(p, 12.0, 4, 0.5, footprint, m.seed + 1);
       brick *= 0.85 + 0.3 * grain;
-      return mortar_colour + (brick - mortar_colour) * brick_fraction;
+      return mortar_color + (brick - mortar_color) * brick_fraction;
     }
     case TextureKind::kLeaves: {
       const double low = FractalNoise(p, m.frequency * 0.25, 3, 0.5, footprint, m.seed);
       double leaf = FractalNoise(p, m.frequency * 2.0, 5, 0.7, footprint, m.seed + 3);
       leaf = Clamp01(0.5 + 4.5 * (leaf - 0.5));
-      const Eigen::Vector3d c = m.colour_a + (m.colour_b - m.colour_a) * leaf;
+      const Eigen::Vector3d c = m.color_a + (m.color_b - m.color_a) * leaf;
       return c * (0.6 + 0.8 * low);
     }
     case TextureKind::kWindows: {
       double n = FractalNoise(p, m.frequency, 6, 0.75, footprint, m.seed);
-      const Eigen::Vector3d wall = m.colour_a * (0.6 + 0.8 * n);
+      const Eigen::Vector3d wall = m.color_a * (0.6 + 0.8 * n);
       const double period = m.cell_m;
       const double in_u = FilteredPulse(uv.x(), period, 0.55, footprint);
       const double in_v = FilteredPulse(uv.y() - 0.3 * period, period * 1.2, 0.6, footprint);
       const double window = in_u * in_v;
-      const Eigen::Vector3d glass = m.colour_b * (0.7 + 0.6 * n);
+      const Eigen::Vector3d glass = m.color_b * (0.7 + 0.6 * n);
       return wall + (glass - wall) * window;
     }
   }
-  return m.colour_a;
+  return m.color_a;
 }
 
 }  // namespace casual3d::synth

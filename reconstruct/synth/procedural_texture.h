@@ -44,8 +44,8 @@ enum class TextureKind : int {
 
 struct Material {
   TextureKind kind = TextureKind::kNoise;
-  Eigen::Vector3d colour_a{0.5, 0.5, 0.5};  // Linear albedo, [0, 1].
-  Eigen::Vector3d colour_b{0.5, 0.5, 0.5};  // Second linear albedo, [0, 1].
+  Eigen::Vector3d color_a{0.5, 0.5, 0.5};  // Linear albedo, [0, 1].
+  Eigen::Vector3d color_b{0.5, 0.5, 0.5};  // Second linear albedo, [0, 1].
   double frequency = 4.0;   // Base noise frequency, cycles per metre.
   double cell_m = 0.25;     // Brick length or window period, metres.
   uint64_t seed = 0;        // Decorrelates materials.

@@ -56,8 +56,8 @@ geometry::SparseModel MakeGroundTruthModel(const std::vector<Scene>& scenes, con
       if (scenes[i].primitives()[hit.primitive].is_moving) continue;      // Not static.
       Candidate c;
       c.xyz = centres[i] + hit.t * dir;
-      const Eigen::Vector3d colour = scenes[i].Shade(hit, centres[i], dir, 1.0 / fx);
-      for (int k = 0; k < 3; ++k) c.rgb[k] = LinearToSrgb8(colour[k]);
+      const Eigen::Vector3d color = scenes[i].Shade(hit, centres[i], dir, 1.0 / fx);
+      for (int k = 0; k < 3; ++k) c.rgb[k] = LinearToSrgb8(color[k]);
       for (int j = 0; j < n; ++j) {
         const Eigen::Vector3d p = R[j] * c.xyz + rig.poses[j].translation;
         if (p.z() <= 1e-6) continue;

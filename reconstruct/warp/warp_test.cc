@@ -20,7 +20,7 @@ void MakeScene(const geometry::Camera& cam, const geometry::Pose& pose, double p
   testing::RenderSquareScene(scene, cam, pose, depth, rgb);
 }
 
-TEST(WarpTest, CentredViewReproducesRadialDepthAndColour) {
+TEST(WarpTest, CentredViewReproducesRadialDepthAndColor) {
   const geometry::Camera cam = MakeCamera(200, 150, 60.0);
   const geometry::Pose pose = ForwardPose(Eigen::Vector3d::Zero());
   ImageF depth;

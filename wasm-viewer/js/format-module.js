@@ -253,7 +253,7 @@ export class Panorama {
   }
 
   /**
-   * The colour atlas of format/colour_atlas.h (front colours above back colours, each half
+   * The colour atlas of format/color_atlas.h (front colours above back colours, each half
    * filled from the other layer where its node is absent; the mesh's uvs rely on that):
    * {width, height: 2 * panorama height, data: RGBA Uint8Array}.
    */

@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 #include "format/image.h"
 #include "format/manifest.h"
 #include "format/backdrop.h"
@@ -136,12 +136,12 @@ EMSCRIPTEN_KEEPALIVE int c3d_panorama_validate(Panorama* p) {
   return s.ok() ? 1 : 0;
 }
 
-// The colour atlas of format/colour_atlas.h as RGBA (alpha 255): width x
+// The colour atlas of format/color_atlas.h as RGBA (alpha 255): width x
 // 2*height, the front layer's colours above the back layer's, each half filled
 // from the other layer where its node is absent (the mesh's uvs rely on it).
 // Owned by the panorama.
 EMSCRIPTEN_KEEPALIVE const uint8_t* c3d_panorama_atlas_rgba(Panorama* p) {
-  casual3d::Image8 atlas = casual3d::BuildColourAtlas(p->pano, 4);
+  casual3d::Image8 atlas = casual3d::BuildColorAtlas(p->pano, 4);
   p->atlas = std::move(atlas.vector());
   return p->atlas.data();
 }

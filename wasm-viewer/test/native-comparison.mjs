@@ -14,11 +14,11 @@ import { readPackageLevel } from './node-package.mjs';
  * its full mesh; has viewer_test_tool do the same natively (writing
  * `${base}.mesh`). Asserts that positions, normals, uvs and indices are
  * byte-identical (depth, normals and links are stored lossless) and that
- * colours differ by at most `maxColourDifference` levels (the colour images are
+ * colours differ by at most `maxColorDifference` levels (the colour images are
  * lossy WebP, decoded by two different builds of libwebp).
- * Returns {triangles, colours: {differing, maxAbs}}.
+ * Returns {triangles, colors: {differing, maxAbs}}.
  */
-export async function assertLevelMatchesNative(format, pkg, level, base, { maxColourDifference = 2 } = {}) {
+export async function assertLevelMatchesNative(format, pkg, level, base, { maxColorDifference = 2 } = {}) {
   runTool('viewer_test_tool', ['mesh', pkg, String(level), base]);
   const native = parseMeshBlob(fs.readFileSync(`${base}.mesh`));
   const { pano } = await readPackageLevel(format, pkg, level);
@@ -33,10 +33,10 @@ export async function assertLevelMatchesNative(format, pkg, level, base, { maxCo
     assert.ok(r.sameLength, `${field}: ${wasm[field].length} (wasm) vs ${native[field].length} (native) elements`);
     assert.equal(r.differing, 0, `${field}: ${r.differing} elements differ (largest ${r.maxAbs})`);
   }
-  const colours = compareArrays(wasm.colors, native.colors);
-  assert.ok(colours.sameLength, `colors: ${wasm.colors.length} (wasm) vs ${native.colors.length} (native) elements`);
-  assert.ok(colours.maxAbs <= maxColourDifference, `colours differ by up to ${colours.maxAbs}`);
-  return { triangles: native.indices.length / 3, colours: { differing: colours.differing, maxAbs: colours.maxAbs } };
+  const colors = compareArrays(wasm.colors, native.colors);
+  assert.ok(colors.sameLength, `colors: ${wasm.colors.length} (wasm) vs ${native.colors.length} (native) elements`);
+  assert.ok(colors.maxAbs <= maxColorDifference, `colours differ by up to ${colors.maxAbs}`);
+  return { triangles: native.indices.length / 3, colors: { differing: colors.differing, maxAbs: colors.maxAbs } };
 }
 
 /** A binary PPM (P6) file: {width, height, data: RGB bytes, top row first}. */

@@ -31,9 +31,9 @@ runTool('viewer_test_tool', ['package', 'test', '1024', '512', delivery, '256', 
 for (const [name, f] of [['single-threaded', format], ['threaded', formatThreaded]]) {
   for (const level of [1, 0]) {
     test(`package level ${level}: wasm reader + mesh (${name}) == native reader + mesh`, async () => {
-      const { triangles, colours } = await assertLevelMatchesNative(f, pkg, level, path.join(dir, `native_${name}_${level}`));
+      const { triangles, colors } = await assertLevelMatchesNative(f, pkg, level, path.join(dir, `native_${name}_${level}`));
       assert.ok(triangles > 1000, `only ${triangles} triangles`);
-      console.log(`level ${level}, ${name} (${f.numThreads} threads): ${triangles} triangles; colours differing: ${colours.differing}, largest difference ${colours.maxAbs}`);
+      console.log(`level ${level}, ${name} (${f.numThreads} threads): ${triangles} triangles; colours differing: ${colors.differing}, largest difference ${colors.maxAbs}`);
     });
   }
 }

@@ -38,7 +38,7 @@
 #include "encoder/package_writer.h"
 #include "encoder/tile_image_codec.h"
 #include "format/backdrop.h"
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 #include "format/file_source.h"
 #include "format/mesh_builder.h"
 #include "format/package_reader.h"
@@ -204,8 +204,8 @@ int Render(int argc, char** argv) {
   if (!pano.ok()) return Fail(std::string(argv[2]) + ": " + pano.status().ToString());
   auto mesh = casual3d::BuildMesh(*pano);
   if (!mesh.ok()) return Fail(mesh.status().ToString());
-  // The colour atlas the viewer uploads (format/colour_atlas.h).
-  const casual3d::Image8 atlas = casual3d::BuildColourAtlas(*pano, 3);
+  // The colour atlas the viewer uploads (format/color_atlas.h).
+  const casual3d::Image8 atlas = casual3d::BuildColorAtlas(*pano, 3);
   casual3d::render::RenderOptions options;
   if (as_viewer) {
     auto backdrop = casual3d::BuildBackdrop(*pano);

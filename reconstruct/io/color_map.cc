@@ -1,4 +1,4 @@
-#include "reconstruct/io/colour_map.h"
+#include "reconstruct/io/color_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,19 +18,19 @@ void Interpolate(const double (&stops)[N][3], double t, uint8_t rgb[3]) {
 
 }  // namespace
 
-void DepthRampColour(double t, uint8_t rgb[3]) {
+void DepthRampColor(double t, uint8_t rgb[3]) {
   static const double kStops[5][3] = {
       {20, 20, 110}, {20, 120, 170}, {60, 190, 120}, {240, 210, 40}, {215, 40, 30}};
   Interpolate(kStops, t, rgb);
 }
 
-void HeatColour(double t, uint8_t rgb[3]) {
+void HeatColor(double t, uint8_t rgb[3]) {
   static const double kStops[5][3] = {
       {10, 10, 40}, {90, 30, 120}, {200, 60, 80}, {250, 160, 40}, {255, 250, 200}};
   Interpolate(kStops, t, rgb);
 }
 
-Image8 ColouriseDepth(const ImageF& depth_m, double near_m, double far_m) {
+Image8 ColorizeDepth(const ImageF& depth_m, double near_m, double far_m) {
   const int w = depth_m.width(), h = depth_m.height();
   Image8 rgb(w, h, 3, 0);
   const double inv_near = 1.0 / near_m, inv_far = 1.0 / far_m;
@@ -40,7 +40,7 @@ Image8 ColouriseDepth(const ImageF& depth_m, double near_m, double far_m) {
       const float d = depth_m.at(x, y);
       if (!(d > 0) || !std::isfinite(d)) continue;
       const double t = span != 0 ? (1.0 / d - inv_far) / span : 1.0;
-      DepthRampColour(t, &rgb.at(x, y, 0));
+      DepthRampColor(t, &rgb.at(x, y, 0));
     }
   return rgb;
 }

@@ -1,4 +1,4 @@
-#include "reconstruct/depth/colour_weights.h"
+#include "reconstruct/depth/color_weights.h"
 
 #include <gtest/gtest.h>
 
@@ -7,10 +7,10 @@
 namespace casual3d::depth {
 namespace {
 
-TEST(ColourWeights, SplitsChannelsIntoPaddedPlanes) {
+TEST(ColorWeights, SplitsChannelsIntoPaddedPlanes) {
   ImageF c(3, 2, 3);
   for (int i = 0; i < 18; ++i) c.data()[i] = 0.01f * i;
-  const ColourPlanes p = SplitColour(c, 4);
+  const ColorPlanes p = SplitColor(c, 4);
   ASSERT_EQ(p.r.size(), 10u);
   ASSERT_EQ(p.g.size(), 10u);
   ASSERT_EQ(p.b.size(), 10u);
@@ -20,17 +20,17 @@ TEST(ColourWeights, SplitsChannelsIntoPaddedPlanes) {
     EXPECT_EQ(p.b[i], c.data()[3 * i + 2]);
   }
   for (int i = 6; i < 10; ++i) EXPECT_EQ(p.r[i] + p.g[i] + p.b[i], 0.0f);
-  EXPECT_THROW(SplitColour(ImageF(2, 2, 1)), std::invalid_argument);
+  EXPECT_THROW(SplitColor(ImageF(2, 2, 1)), std::invalid_argument);
 }
 
-TEST(ColourWeights, AreGaussianInTheColourDistance) {
+TEST(ColorWeights, AreGaussianInTheColorDistance) {
   const float r[] = {0.5f, 0.6f, 0.1f, 0.5f, 0.9f};
   const float g[] = {0.5f, 0.5f, 0.2f, 0.45f, 0.0f};
   const float b[] = {0.5f, 0.4f, 0.3f, 0.5f, 1.0f};
   const float c0[] = {0.5f, 0.5f, 0.5f};
   const float sigma = 0.06f, inv2s2 = 1.0f / (2 * sigma * sigma);
   float w[5];
-  ColourWeights(r, g, b, 5, c0, inv2s2, w);
+  ColorWeights(r, g, b, 5, c0, inv2s2, w);
   for (int i = 0; i < 5; ++i) {
     const double d2 = std::pow(r[i] - 0.5, 2) + std::pow(g[i] - 0.5, 2) + std::pow(b[i] - 0.5, 2);
     const double expect = std::exp(-d2 * inv2s2);

@@ -14,20 +14,20 @@
 namespace casual3d::depth {
 
 // exp(-(dr^2 + dg^2 + db^2) inv2s2), inv2s2 = 1 / (2 sigma^2) >= 0.
-inline float ColourAffinity(float dr, float dg, float db, float inv2s2) {
+inline float ColorAffinity(float dr, float dg, float db, float inv2s2) {
   return ExpNonPositive(-(dr * dr + dg * dg + db * db) * inv2s2);
 }
 
 // An RGB image's channels as planes of width * height + padding floats
 // each (the padding zero, for loops that run over whole vector blocks).
-struct ColourPlanes {
+struct ColorPlanes {
   std::vector<float> r, g, b;
 };
-ColourPlanes SplitColour(const ImageF& color, size_t padding = 0);
+ColorPlanes SplitColor(const ImageF& color, size_t padding = 0);
 
-// out[i] = ColourAffinity(r[i] - c0[0], g[i] - c0[1], b[i] - c0[2], inv2s2)
+// out[i] = ColorAffinity(r[i] - c0[0], g[i] - c0[1], b[i] - c0[2], inv2s2)
 // for i < n: the weights of n gathered samples against colour c0.
-void ColourWeights(const float* r, const float* g, const float* b, int n, const float* c0, float inv2s2,
+void ColorWeights(const float* r, const float* g, const float* b, int n, const float* c0, float inv2s2,
                    float* out);
 
 }  // namespace casual3d::depth

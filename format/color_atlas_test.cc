@@ -1,9 +1,10 @@
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
+#include "format/colour_atlas.h"  // The deprecated names, tested below.
 #include "format/testing/test_panoramas.h"
 
 namespace casual3d {
@@ -31,9 +32,9 @@ TwoLayerPanorama SmallPanorama() {
   return p;
 }
 
-TEST(ColourAtlasTest, EachHalfShowsItsLayerAndFillsFromTheOtherLayer) {
+TEST(ColorAtlasTest, EachHalfShowsItsLayerAndFillsFromTheOtherLayer) {
   const TwoLayerPanorama p = SmallPanorama();
-  const Image8 atlas = BuildColourAtlas(p);
+  const Image8 atlas = BuildColorAtlas(p);
   ASSERT_EQ(atlas.width(), 4);
   ASSERT_EQ(atlas.height(), 4);
   ASSERT_EQ(atlas.channels(), 3);
@@ -58,10 +59,10 @@ TEST(ColourAtlasTest, EachHalfShowsItsLayerAndFillsFromTheOtherLayer) {
   }
 }
 
-TEST(ColourAtlasTest, RgbaMatchesRgbWithOpaqueAlpha) {
+TEST(ColorAtlasTest, RgbaMatchesRgbWithOpaqueAlpha) {
   const TwoLayerPanorama p = testing::MakeRoomPanorama(64, 32);
-  const Image8 rgb = BuildColourAtlas(p, 3);
-  const Image8 rgba = BuildColourAtlas(p, 4);
+  const Image8 rgb = BuildColorAtlas(p, 3);
+  const Image8 rgba = BuildColorAtlas(p, 4);
   ASSERT_EQ(rgba.width(), 64);
   ASSERT_EQ(rgba.height(), 64);
   ASSERT_EQ(rgba.channels(), 4);
@@ -73,10 +74,21 @@ TEST(ColourAtlasTest, RgbaMatchesRgbWithOpaqueAlpha) {
   }
 }
 
-TEST(ColourAtlasTest, RefusesUnsupportedChannelCounts) {
+TEST(ColorAtlasTest, RefusesUnsupportedChannelCounts) {
   const TwoLayerPanorama p = SmallPanorama();
-  EXPECT_TRUE(BuildColourAtlas(p, 1).empty());
-  EXPECT_TRUE(BuildColourAtlas(p, 5).empty());
+  EXPECT_TRUE(BuildColorAtlas(p, 1).empty());
+  EXPECT_TRUE(BuildColorAtlas(p, 5).empty());
+}
+
+// format/colour_atlas.h keeps the earlier name working (docs/SDK.md).
+TEST(ColorAtlasTest, DeprecatedNameBuildsTheSameAtlas) {
+  const TwoLayerPanorama p = SmallPanorama();
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+  const Image8 old_rgb = BuildColourAtlas(p), old_rgba = BuildColourAtlas(p, 4);
+#pragma GCC diagnostic pop
+  EXPECT_EQ(old_rgb.vector(), BuildColorAtlas(p).vector());
+  EXPECT_EQ(old_rgba.vector(), BuildColorAtlas(p, 4).vector());
 }
 
 }  // namespace

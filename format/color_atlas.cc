@@ -1,10 +1,10 @@
-#include "format/colour_atlas.h"
+#include "format/color_atlas.h"
 
 #include <cstring>
 
 namespace casual3d {
 
-Image8 BuildColourAtlas(const TwoLayerPanorama& pano, int channels) {
+Image8 BuildColorAtlas(const TwoLayerPanorama& pano, int channels) {
   const int w = pano.width(), h = pano.height();
   if ((channels != 3 && channels != 4) || w < 1 || h < 1) return Image8();
   Image8 atlas(w, 2 * h, channels, 0);

@@ -1,4 +1,4 @@
-#include "reconstruct/depth/colour_weights.h"
+#include "reconstruct/depth/color_weights.h"
 
 #include <stdexcept>
 
@@ -6,10 +6,10 @@
 
 namespace casual3d::depth {
 
-ColourPlanes SplitColour(const ImageF& color, size_t padding) {
-  if (color.channels() != 3) throw std::invalid_argument("SplitColour: the image needs 3 channels");
+ColorPlanes SplitColor(const ImageF& color, size_t padding) {
+  if (color.channels() != 3) throw std::invalid_argument("SplitColor: the image needs 3 channels");
   const size_t n = static_cast<size_t>(color.width()) * color.height();
-  ColourPlanes planes;
+  ColorPlanes planes;
   planes.r.assign(n + padding, 0.0f);
   planes.g.assign(n + padding, 0.0f);
   planes.b.assign(n + padding, 0.0f);
@@ -23,10 +23,10 @@ ColourPlanes SplitColour(const ImageF& color, size_t padding) {
 }
 
 CASUAL3D_AVX2_CLONES
-void ColourWeights(const float* __restrict r, const float* __restrict g, const float* __restrict b, int n,
+void ColorWeights(const float* __restrict r, const float* __restrict g, const float* __restrict b, int n,
                    const float* c0, float inv2s2, float* __restrict out) {
   const float r0 = c0[0], g0 = c0[1], b0 = c0[2];
-  for (int i = 0; i < n; ++i) out[i] = ColourAffinity(r[i] - r0, g[i] - g0, b[i] - b0, inv2s2);
+  for (int i = 0; i < n; ++i) out[i] = ColorAffinity(r[i] - r0, g[i] - g0, b[i] - b0, inv2s2);
 }
 
 }  // namespace casual3d::depth
