@@ -70,7 +70,7 @@ void AddEvaluateCommand(CLI::App& app) {
   cmd->add_option("--reference", args->references,
                   "Published result on the same protocol shown in the report, NAME:PSNR_DB:SSIM "
                   "(repeatable; e.g. LLFF:23.22:0.753)");
-  cmd->add_option("--title", args->report.title, "Title of the HTML report")->capture_default_str();
+  AddDescribedOption(cmd, "--title", args->report, args->report.title);
   cmd->add_flag("--no-backdrop", args->no_backdrop,
                  "Viewer views: the mesh alone, without the backdrop the viewer draws behind "
                  "it (format/backdrop.h); the photos are always rendered without it");

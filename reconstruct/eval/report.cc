@@ -16,16 +16,11 @@
 
 namespace casual3d::eval {
 
-Status ReportOptions::Check() const {
-  if (thumbnail_width < 32 || thumbnail_width > 2048)
-    return InvalidArgument("thumbnail_width: " + std::to_string(thumbnail_width) + " is outside [32, 2048]");
-  if (!(heatmap_max_error > 0 && heatmap_max_error <= 1))
-    return InvalidArgument("heatmap_max_error: " + std::to_string(heatmap_max_error) + " is outside (0, 1]");
+std::string ReportOptions::InvalidReference(const std::vector<ReferenceResult>& references) {
   for (const ReferenceResult& r : references)
     if (r.label.empty() || !(r.psnr_db > 0 && r.psnr_db < 1000) || !(r.ssim >= -1 && r.ssim <= 1))
-      return InvalidArgument("references: '" + r.label +
-             "' needs a name, a PSNR in (0, 1000) dB and an SSIM in [-1, 1]");
-  return Status::Ok();
+      return "'" + r.label + "' needs a name, a PSNR in (0, 1000) dB and an SSIM in [-1, 1]";
+  return "";
 }
 
 std::string Base64(const std::string& bytes) {

@@ -18,6 +18,7 @@
 
 #include "format/status.h"
 #include "reconstruct/eval/evaluate.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::eval {
 
@@ -36,9 +37,28 @@ struct ReportOptions {
   // (0, 1].
   double heatmap_max_error = 0.25;
   std::string title = "casual3d rephotography report";
-  std::vector<ReferenceResult> references;  // Shown under the 3D photos' rows.
+  // Shown under the 3D photos' rows; each needs a label, a PSNR in
+  // (0, 1000) dB and an SSIM in [-1, 1].
+  std::vector<ReferenceResult> references;
 
-  Status Check() const;  // Names the field and its range.
+  // `references`, a list, is not described (options_fields.h describes single
+  // values); its entries are checked by one requirement.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("thumbnail_width", o.thumbnail_width, R::Closed(32, 2048),
+            "Width of the thumbnails embedded per photo, pixels");
+    v.Field("heatmap_max_error", o.heatmap_max_error, R::OpenClosed(0, 1),
+            "Error mapped to the hottest heatmap colour, units of the metric");
+    v.Field("title", o.title, R::Any(), "Title of the HTML report");
+    const std::string invalid = InvalidReference(o.references);
+    v.Require(invalid.empty(), "references", invalid);
+  }
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
+
+  // What is wrong with the first invalid reference ("'NeRF' needs a name, ..."),
+  // or "" if all are valid.
+  static std::string InvalidReference(const std::vector<ReferenceResult>& references);
 };
 
 // The HTML document for `capture` and the evaluations of one or more 3D photos.

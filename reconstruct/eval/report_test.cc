@@ -110,8 +110,26 @@ TEST(ReportTest, JsonCarriesThePerPhotoFigures) {
 TEST(ReportTest, RejectsAReferenceWithoutFigures) {
   ReportOptions options;
   options.references = {{"NeRF", 0.0, 0.792}};
+  EXPECT_EQ(options.Check().message(),
+            "references 'NeRF' needs a name, a PSNR in (0, 1000) dB and an SSIM in [-1, 1]");
   EXPECT_THROW(RenderHtmlReport("c", {MakeEvaluation("full", 0.04)}, options),
                std::invalid_argument);
+}
+
+TEST(ReportOptionsTest, CheckNamesTheFieldAndItsRange) {
+  ReportOptions options;
+  EXPECT_TRUE(options.Check().ok());
+  options.thumbnail_width = 16;
+  EXPECT_EQ(options.Check().message(), "thumbnail_width 16 outside [32, 2048]");
+  options.thumbnail_width = 300;
+  options.heatmap_max_error = 0;
+  EXPECT_EQ(options.Check().message(), "heatmap_max_error 0 outside (0, 1]");
+}
+
+TEST(ReportOptionsTest, EveryFieldButTheReferenceListIsDescribed) {
+  // `references` is a list, which options_fields.h does not describe.
+  EXPECT_EQ(util::DescribedFieldCount<ReportOptions>() + 1,
+            util::AggregateFieldCount<ReportOptions>());
 }
 
 TEST(ReportTest, Base64MatchesRfc4648Vectors) {

@@ -103,19 +103,6 @@ void AddAdvice(const std::vector<std::string>& order, CaptureShape* s) {
 
 }  // namespace
 
-Status CaptureShapeOptions::Check() const {
-  if (!(near_percentile >= 0 && near_percentile <= 0.5)) return InvalidArgument("near_percentile: must be in [0, 0.5]");
-  if (!(off_axis_percentile >= 0.5 && off_axis_percentile <= 1))
-    return InvalidArgument("off_axis_percentile: must be in [0.5, 1]");
-  if (!(max_off_axis_over_near > 0 && max_off_axis_over_near <= 10))
-    return InvalidArgument("max_off_axis_over_near: must be in (0, 10]");
-  if (!(min_sweep >= 1 && min_sweep <= 100)) return InvalidArgument("min_sweep: must be in [1, 100]");
-  if (min_link_points < 1 || min_link_points > 1000000) return InvalidArgument("min_link_points: must be in [1, 1e6]");
-  if (!(min_link_fraction >= 0 && min_link_fraction <= 1)) return InvalidArgument("min_link_fraction: must be in [0, 1]");
-  if (sphere_samples < 64 || sphere_samples > 1000000) return InvalidArgument("sphere_samples: must be in [64, 1e6]");
-  return Status::Ok();
-}
-
 double CameraSpread(const std::vector<CoverageView>& views, const PanoramaFrame& frame) {
   Eigen::Matrix3d R;
   for (int r = 0; r < 3; ++r)

@@ -48,6 +48,7 @@
 #include "format/equirect.h"
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/pipeline/coverage.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::pipeline {
 
@@ -73,7 +74,25 @@ struct CaptureShapeOptions {
   // Directions sampled on the sphere for the coverage, [64, 1e6].
   int sphere_samples = 8192;
 
-  Status Check() const;  // Names the field and its range.
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("near_percentile", o.near_percentile, R::Closed(0, 0.5),
+            "Percentile of the observations' camera-frame depths taken as the near depth");
+    v.Field("off_axis_percentile", o.off_axis_percentile, R::Closed(0.5, 1),
+            "Percentile over the cameras of their off-axis distance");
+    v.Field("max_off_axis_over_near", o.max_off_axis_over_near, R::OpenClosed(0, 10),
+            "Off-axis distance over near depth above which the camera walked");
+    v.Field("min_sweep", o.min_sweep, R::Closed(1, 100),
+            "Union of the photos' views over the median photo's view below which they look one way");
+    v.Field("min_link_points", o.min_link_points, R::Closed(1, 1e6),
+            "Shared points that link two photos");
+    v.Field("min_link_fraction", o.min_link_fraction, R::Closed(0, 1),
+            "Share of the smaller photo's points that link two photos");
+    v.Field("sphere_samples", o.sphere_samples, R::Closed(64, 1e6),
+            "Directions sampled on the sphere for the coverage");
+  }
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
 
 struct CaptureShape {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "reconstruct/util/options_fields_testing.h"
+
 namespace casual3d::pipeline {
 namespace {
 
@@ -303,9 +305,13 @@ TEST(CaptureShapeOptions, CheckNamesTheField) {
   CaptureShapeOptions o;
   EXPECT_TRUE(o.Check().ok());
   o.min_sweep = 0.5;
-  EXPECT_EQ(o.Check().message().rfind("min_sweep", 0), 0u);
+  EXPECT_EQ(o.Check().message(), "min_sweep 0.5 outside [1, 100]");
   EXPECT_THROW(MeasureCaptureShape(geometry::SparseModel(), PanoramaFrame(), {}, true, o),
                std::invalid_argument);
+}
+
+TEST(CaptureShapeOptions, EveryFieldIsDescribed) {
+  util::testing::ExpectEveryFieldDescribed<CaptureShapeOptions>();
 }
 
 }  // namespace

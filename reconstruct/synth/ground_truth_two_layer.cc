@@ -12,13 +12,6 @@ double Ratio(float a, float b) { return std::min(a, b) / std::max(a, b); }
 
 }  // namespace
 
-Status TwoLayerOptions::Check() const {
-  if (!(tau_dratio > 0.0 && tau_dratio <= 1.0)) return InvalidArgument("tau_dratio must be in (0, 1]");
-  if (!(link_ratio > 0.0 && link_ratio < 1.0)) return InvalidArgument("link_ratio must be in (0, 1)");
-  if (!(sky_depth_m > 0.0 && std::isfinite(sky_depth_m))) return InvalidArgument("sky_depth_m must be > 0");
-  return Status::Ok();
-}
-
 TwoLayerPanorama GroundTruthToTwoLayer(const GroundTruthPanorama& gt, const TwoLayerOptions& options) {
   const int w = gt.pixels.width(), h = gt.pixels.height();
   TwoLayerPanorama pano(w, h);

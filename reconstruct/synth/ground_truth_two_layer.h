@@ -20,6 +20,7 @@
 #include "format/status.h"
 #include "format/two_layer.h"
 #include "reconstruct/synth/ground_truth_panorama.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::synth {
 
@@ -27,7 +28,17 @@ struct TwoLayerOptions {
   double tau_dratio = 0.75;   // Sec. 4.4.3: back nodes with d(f)/d(b) above this are dropped, (0, 1].
   double link_ratio = 0.9;    // Neighbours link when their depth ratio is above this, (0, 1).
   double sky_depth_m = 1000.0;  // Depth given to the sky, metres, > 0.
-  Status Check() const;  // Names the field and its range.
+
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("tau_dratio", o.tau_dratio, R::OpenClosed(0, 1),
+            "Sec. 4.4.3: back nodes with d(f)/d(b) above this are dropped");
+    v.Field("link_ratio", o.link_ratio, R::Open(0, 1),
+            "Neighbours link when their depth ratio is above this");
+    v.Field("sky_depth_m", o.sky_depth_m, R::Above(0), "Depth given to the sky, metres");
+  }
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
 
 // Precondition: options.Check() is ok and the panorama has kNumPanoramaChannels channels.

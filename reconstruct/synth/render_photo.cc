@@ -44,14 +44,6 @@ Eigen::Vector3d Sample(const Scene& scene, const CameraRays& rays, double u, dou
 
 }  // namespace
 
-Status RenderOptions::Check() const {
-  if (edge_samples < 1 || edge_samples > 8) {
-    return InvalidArgument("edge_samples " + std::to_string(edge_samples) + " is outside 1..8");
-  }
-  if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
-  return Status::Ok();
-}
-
 PhotoRender RenderPhoto(const Scene& scene, const geometry::Camera& camera,
                         const geometry::Pose& pose, const RenderOptions& options) {
   const int w = camera.width, h = camera.height;

@@ -15,13 +15,22 @@
 #include "reconstruct/geometry/camera.h"
 #include "reconstruct/geometry/pose.h"
 #include "reconstruct/synth/scene.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::synth {
 
 struct RenderOptions {
   int edge_samples = 3;  // Rays per axis at edge pixels (n x n), 1..8; 1 disables anti-aliasing.
   int num_threads = 0;   // 0: all hardware threads. Results do not depend on it.
-  Status Check() const;  // Names the field and its range.
+
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("edge_samples", o.edge_samples, R::Closed(1, 8),
+            "Rays per axis at edge pixels (n x n); 1 disables anti-aliasing");
+    v.Field("num_threads", o.num_threads, R::AtLeast(0), "Worker threads; 0 = all cores", util::Keyed::kNo);
+  }
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
 
 struct PhotoRender {

@@ -77,27 +77,6 @@ RigOptions RigOptions::Defaults(RigKind kind) {
   return o;
 }
 
-Status RigOptions::Check() const {
-  if (width < 16 || width > 16384) return InvalidArgument("width " + std::to_string(width) + " is outside 16..16384");
-  if (height < 16 || height > 16384) {
-    return InvalidArgument("height " + std::to_string(height) + " is outside 16..16384");
-  }
-  if (num_photos < 2 || num_photos > 1000) {
-    return InvalidArgument("photos " + std::to_string(num_photos) + " is outside 2..1000");
-  }
-  if (!(fov_x_deg > 10.0 && fov_x_deg < 150.0)) return InvalidArgument("fov_x_deg must be in (10, 150)");
-  if (!(radius_m >= 0.0 && radius_m <= 2.0)) return InvalidArgument("radius_m must be in [0, 2]");
-  if (!(yaw_span_deg >= 0.0 && yaw_span_deg <= 180.0)) return InvalidArgument("yaw_span_deg must be in [0, 180]");
-  if (!(pitch_span_deg >= 0.0 && pitch_span_deg <= 120.0)) {
-    return InvalidArgument("pitch_span_deg must be in [0, 120]");
-  }
-  if (!(ring_pitch_deg >= 0.0 && ring_pitch_deg <= 60.0)) return InvalidArgument("ring_pitch_deg must be in [0, 60]");
-  if (!(walk_distance_m >= 0.3 && walk_distance_m <= 20.0)) return InvalidArgument("walk_distance_m must be in [0.3, 20]");
-  if (!(jitter_deg >= 0.0 && jitter_deg <= 10.0)) return InvalidArgument("jitter_deg must be in [0, 10]");
-  if (!(jitter_m >= 0.0 && jitter_m <= 0.2)) return InvalidArgument("jitter_m must be in [0, 0.2]");
-  return Status::Ok();
-}
-
 Rig MakeRig(const RigOptions& options, const Eigen::Vector3d& centre) {
   Rig rig;
   rig.camera.camera_id = 1;

@@ -25,6 +25,7 @@
 #include "format/status.h"
 #include "reconstruct/geometry/camera.h"
 #include "reconstruct/geometry/pose.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::synth {
 
@@ -49,10 +50,34 @@ struct RigOptions {
   double jitter_m = 0.01;    // Hand-held position jitter (standard deviation), metres.
   uint64_t seed = 1;
 
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("kind", o.kind, R::Closed(0, 2), "Rig: partial, sphere or walk-around");
+    v.Field("width", o.width, R::Closed(16, 16384), "Photo width, pixels");
+    v.Field("height", o.height, R::Closed(16, 16384), "Photo height, pixels");
+    v.Field("num_photos", o.num_photos, R::Closed(2, 1000), "Number of photos");
+    v.Field("fov_x_deg", o.fov_x_deg, R::Open(10, 150), "Horizontal field of view, degrees");
+    v.Field("radius_m", o.radius_m, R::Closed(0, 2),
+            "Camera centres' distance from the rig centre, metres");
+    v.Field("yaw_span_deg", o.yaw_span_deg, R::Closed(0, 180),
+            "partial: yaw range of the grid; walk-around: of the arc; degrees");
+    v.Field("pitch_span_deg", o.pitch_span_deg, R::Closed(0, 120),
+            "partial: pitch range of the grid, degrees");
+    v.Field("ring_pitch_deg", o.ring_pitch_deg, R::Closed(0, 60),
+            "sphere: pitch of the upper (+) and lower (-) ring, degrees");
+    v.Field("walk_distance_m", o.walk_distance_m, R::Closed(0.3, 20),
+            "walk-around: the subject's distance ahead, metres");
+    v.Field("jitter_deg", o.jitter_deg, R::Closed(0, 10),
+            "Hand-held rotation jitter (standard deviation), degrees");
+    v.Field("jitter_m", o.jitter_m, R::Closed(0, 0.2),
+            "Hand-held position jitter (standard deviation), metres");
+    v.Field("seed", o.seed, R::Any(), "Seed of the jitter");
+  }
+
   // The defaults of a rig kind (size, photo count, field of view).
   static RigOptions Defaults(RigKind kind);
-  // Empty if valid; otherwise names the field and its valid range.
-  Status Check() const;  // Names the field and its range.
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
 
 struct Rig {

@@ -4,6 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include "reconstruct/synth/ground_truth_two_layer.h"
+#include "reconstruct/synth/render_photo.h"
+#include "reconstruct/synth/sparse_points.h"
+#include "reconstruct/util/options_fields_testing.h"
+
 namespace casual3d::synth {
 namespace {
 
@@ -98,6 +103,18 @@ TEST(RigTest, JitterIsSeededAndOptionsAreChecked) {
   EXPECT_TRUE(RigKindFromName("sphere", &kind));
   EXPECT_EQ(kind, RigKind::kSphere);
   EXPECT_FALSE(RigKindFromName("cube", &kind));
+}
+
+// The options structs of the synthetic capture's steps describe every field
+// (reconstruct/util/options_fields.h).
+TEST(SynthOptionStructs, EveryFieldIsDescribed) {
+  util::testing::ExpectEveryFieldDescribed<RigOptions>("RigOptions");
+  util::testing::ExpectEveryFieldDescribed<SparsePointOptions>("SparsePointOptions");
+  util::testing::ExpectEveryFieldDescribed<TwoLayerOptions>("TwoLayerOptions");
+  util::testing::ExpectEveryFieldDescribed<RenderOptions>("RenderOptions");
+  RigOptions rig = RigOptions::Defaults(RigKind::kPartial);
+  rig.fov_x_deg = 150;
+  EXPECT_EQ(rig.Check().message(), "fov_x_deg 150 outside (10, 150)");
 }
 
 }  // namespace

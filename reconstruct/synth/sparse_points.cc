@@ -17,13 +17,6 @@ struct Candidate {
 
 }  // namespace
 
-Status SparsePointOptions::Check() const {
-  if (step_px < 2 || step_px > 4096) return InvalidArgument("step_px " + std::to_string(step_px) + " is outside 2..4096");
-  if (min_track < 1) return InvalidArgument("min_track must be >= 1");
-  if (num_threads < 0) return InvalidArgument("num_threads must be >= 0");
-  return Status::Ok();
-}
-
 geometry::SparseModel MakeGroundTruthModel(const std::vector<Scene>& scenes, const Rig& rig,
                                            const std::vector<std::string>& names,
                                            const SparsePointOptions& options) {

@@ -16,6 +16,7 @@
 #include "reconstruct/geometry/colmap_model.h"
 #include "reconstruct/synth/rig.h"
 #include "reconstruct/synth/scene.h"
+#include "reconstruct/util/options_fields.h"
 
 namespace casual3d::synth {
 
@@ -24,7 +25,16 @@ struct SparsePointOptions {
   int min_track = 2;    // Minimum number of observing photos, >= 1.
   uint64_t seed = 1;    // Jitter of the seed pixels.
   int num_threads = 0;  // 0: all cores. Results do not depend on it.
-  Status Check() const;  // Names the field and its range.
+
+  template <typename Self, typename Visitor>
+  static void DescribeFields(Self& o, Visitor& v) {
+    using R = util::Rule;
+    v.Field("step_px", o.step_px, R::Closed(2, 4096), "Grid spacing of the seed pixels in each photo, pixels");
+    v.Field("min_track", o.min_track, R::AtLeast(1), "Minimum number of observing photos");
+    v.Field("seed", o.seed, R::Any(), "Seed of the seed pixels' jitter");
+    v.Field("num_threads", o.num_threads, R::AtLeast(0), "Worker threads; 0 = all cores", util::Keyed::kNo);
+  }
+  Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
 
 // `scenes[i]` is the scene as photo i saw it (the moving object displaced);
