@@ -90,11 +90,8 @@ struct MrfTermOptions {
 
 struct DenseOptions {
   double working_scale = 0.5;  // Sweep, envelope and MRF resolution relative to the photos. (0, 1].
-  // Neighbours per sweep. [1, 16]. 12: on the default synthetic capture
-  // (a partial rig, where a photo's content is seen by few of the others)
-  // 4 / 6 / 12 neighbours gave within 3% 74.1 / 80.7 / 86.8%, near floaters
-  // 3.71 / 2.72 / 0.99% and 16-photo wall times of 1.0 / 1.3 / 1.8 times
-  // 4's (docs/PERFORMANCE.md, "Neighbours"); 15 gained nothing over 12.
+  // Neighbours per sweep. [1, 16]. Why 12: docs/DECISIONS.md, "Dense: 12
+  // neighbours per sweep".
   int num_neighbors = 12;
   // Filter sizes below are given for a 900x1350 image (Sec. 4.3.2) and scaled
   // with the working image's diagonal.
