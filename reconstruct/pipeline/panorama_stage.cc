@@ -153,6 +153,62 @@ PanoramaFrame LoadOrComputeFrame(const std::string& sparse_dir) {
   return sfm::ComputePanoramaFrame(model, sfm::PanoramaFrameOptions());
 }
 
+namespace {
+
+// The photos warped at the panorama's size (`full`) and at the stitch's
+// solve size (`coarse`), with each photo's centre in the panorama frame.
+void WarpPhotos(const std::vector<PanoramaPhoto>& photos, const PanoramaFrame& frame,
+                const PanoramaStageOptions& options, int W, int H, std::vector<warp::WarpedView>* full,
+                std::vector<warp::WarpedView>* coarse, std::vector<stitch::ViewGeometry>* geometry) {
+  std::vector<warp::SourceView> views;
+  Eigen::Matrix3d R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = frame.rotation[3 * r + c];
+  const Eigen::Vector3d centre(frame.centre[0], frame.centre[1], frame.centre[2]);
+  for (const PanoramaPhoto& p : photos) {
+    views.push_back({&p.rgb, &p.depth, p.camera, p.pose});
+    const Eigen::Vector3d c = R * (p.pose.Center() - centre);
+    geometry->push_back({{c.x(), c.y(), c.z()}});
+  }
+  warp::WarpOptions warp_full = options.warp;
+  warp_full.pano_width = W;
+  warp_full.pano_height = H;
+  warp::WarpOptions warp_coarse = warp_full;
+  warp_coarse.pano_width = options.stitch.solve_width;
+  warp_coarse.pano_height = options.stitch.solve_height;
+  util::Progress progress("panorama: warping", 2);
+  *full = warp::WarpViews(views, frame, warp_full, options.num_threads);
+  progress.Advance();
+  *coarse = warp::WarpViews(views, frame, warp_coarse, options.num_threads);
+}
+
+void LogSealed(const fuse::SealStats& seal) {
+  util::LogInfo("panorama: sealed " + std::to_string(seal.open_quads_before - seal.open_quads_after) +
+                " of " + std::to_string(seal.open_quads_before) + " open quads (" +
+                std::to_string(seal.links_made) + " links, " +
+                std::to_string(seal.back_nodes_added) + " back nodes); front surfaces: " +
+                std::to_string(seal.front_surface_open_quads_before) + " -> " +
+                std::to_string(seal.front_surface_open_quads_after) + " open quads; back layer: " +
+                std::to_string(seal.back_open_quads_before) + " -> " +
+                std::to_string(seal.back_open_quads_after) + " open quads");
+}
+
+void LogViewAndCoverage(const ViewHints& hints, bool metric, const PanoramaStageReport& report) {
+  util::LogInfo("panorama: opens at yaw " + std::to_string(hints.yaw_deg) + ", pitch " +
+                std::to_string(hints.pitch_deg) + ", field of view " + std::to_string(hints.fov_deg) +
+                " deg; viewing volume radius " + std::to_string(hints.volume_radius) +
+                (metric ? " m" : " (model units)"));
+  for (const auto& [what, c] : {std::pair{"field of view", &report.front_fov},
+                                std::pair{"footprint", &report.front_footprint}}) {
+    util::LogInfo("panorama: front layer covers " + std::to_string(100.0 * c->covered_fraction) +
+                  "% of the photos' " + what + "; " + std::to_string(c->num_holes) +
+                  " holes, the largest " + std::to_string(100.0 * c->largest_hole_fraction) +
+                  "% of it");
+  }
+}
+
+}  // namespace
+
 TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::string& depth_dir,
                                   const std::string& out_dir, const PanoramaStageOptions& options,
                                   PanoramaStageReport* report_out) {
@@ -184,30 +240,9 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
 
   // Warp at the output and at the solve resolution.
   t = Clock::now();
-  std::vector<warp::SourceView> views;
   std::vector<stitch::ViewGeometry> geometry;
-  Eigen::Matrix3d R;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) R(r, c) = frame.rotation[3 * r + c];
-  const Eigen::Vector3d centre(frame.centre[0], frame.centre[1], frame.centre[2]);
-  for (const PanoramaPhoto& p : photos) {
-    views.push_back({&p.rgb, &p.depth, p.camera, p.pose});
-    const Eigen::Vector3d c = R * (p.pose.Center() - centre);
-    geometry.push_back({{c.x(), c.y(), c.z()}});
-  }
-  warp::WarpOptions warp_full = options.warp;
-  warp_full.pano_width = W;
-  warp_full.pano_height = H;
-  warp::WarpOptions warp_coarse = warp_full;
-  warp_coarse.pano_width = options.stitch.solve_width;
-  warp_coarse.pano_height = options.stitch.solve_height;
   std::vector<warp::WarpedView> full, coarse;
-  {
-    util::Progress progress("panorama: warping", 2);
-    full = warp::WarpViews(views, frame, warp_full, options.num_threads);
-    progress.Advance();
-    coarse = warp::WarpViews(views, frame, warp_coarse, options.num_threads);
-  }
+  WarpPhotos(photos, frame, options, W, H, &full, &coarse, &geometry);
   photos.clear();  // The warps hold everything needed from here on.
   const Image8 footprint = FootprintMask(full, W, H);
   report.seconds_warp = Seconds(t);
@@ -252,15 +287,7 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
                                      fuse_options, &report.fuse);
   if (options.seal_tears) {
     report.seal = fuse::SealTears(&pano, options.seal);
-    util::LogInfo("panorama: sealed " +
-                  std::to_string(report.seal.open_quads_before - report.seal.open_quads_after) +
-                  " of " + std::to_string(report.seal.open_quads_before) + " open quads (" +
-                  std::to_string(report.seal.links_made) + " links, " +
-                  std::to_string(report.seal.back_nodes_added) + " back nodes); front surfaces: " +
-                  std::to_string(report.seal.front_surface_open_quads_before) + " -> " +
-                  std::to_string(report.seal.front_surface_open_quads_after) + " open quads; back layer: " +
-                  std::to_string(report.seal.back_open_quads_before) + " -> " +
-                  std::to_string(report.seal.back_open_quads_after) + " open quads");
+    LogSealed(report.seal);
   }
   report.seconds_fuse = Seconds(t);
   t = Clock::now();
@@ -281,18 +308,7 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
       std::max(view_options.min_radius_over_near,
                std::min(view_options.max_radius_over_near, 0.8 * 2.0 * kPi * fuse_options.expansion_fraction));
   pano.view_hints() = ComputeViewHints(pano, fov, coverage_views, frame, metric, view_options);
-  const ViewHints& hints = *pano.view_hints();
-  util::LogInfo("panorama: opens at yaw " + std::to_string(hints.yaw_deg) + ", pitch " +
-                std::to_string(hints.pitch_deg) + ", field of view " + std::to_string(hints.fov_deg) +
-                " deg; viewing volume radius " + std::to_string(hints.volume_radius) +
-                (metric ? " m" : " (model units)"));
-  for (const auto& [what, c] : {std::pair{"field of view", &report.front_fov},
-                                std::pair{"footprint", &report.front_footprint}}) {
-    util::LogInfo("panorama: front layer covers " + std::to_string(100.0 * c->covered_fraction) +
-                  "% of the photos' " + what + "; " + std::to_string(c->num_holes) +
-                  " holes, the largest " + std::to_string(100.0 * c->largest_hole_fraction) +
-                  "% of it");
-  }
+  LogViewAndCoverage(*pano.view_hints(), metric, report);
 
   // Write.
   t = Clock::now();

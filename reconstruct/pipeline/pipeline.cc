@@ -127,6 +127,312 @@ Status PipelineOptions::Check() const {
   return Status::Ok();
 }
 
+namespace {
+
+// One run of the pipeline: its folders, the stages' cache keys, the previous
+// report.json and what this run's stages report.
+class PipelineRun {
+ public:
+  PipelineRun(const std::string& input, const std::string& out, const PipelineOptions& options)
+      : input_(input), options_(options), root_(out), work_(root_ / "work"),
+        dirs_{work_ / "sparse", work_ / "dense", work_ / "panorama", root_ / "web"} {
+    for (int s = 0; s < kNumStages; ++s) {
+      key_paths_[s] = work_ / (std::string(StageName(static_cast<Stage>(s))) + ".key");
+    }
+    MakeKeys();
+    ReadPreviousReport();
+  }
+
+  // Runs the selected stages in order (the capture measured before the
+  // dense stage), then writes report.json.
+  PipelineReport Run(Clock::time_point start) {
+    std::error_code ec;
+    for (int s = 0; s < kNumStages; ++s) {
+      const Stage stage = static_cast<Stage>(s);
+      if (stage == Stage::kDense) MeasureCapture();
+      StageRun run;
+      run.stage = StageName(stage);
+      const bool current = fs::exists(dirs_[s], ec) && ReadKey(key_paths_[s]) == keys_[s];
+      const bool selected = s >= static_cast<int>(options_.from) && s <= static_cast<int>(options_.to);
+      if (!selected) {
+        if (s < static_cast<int>(options_.from) && !current) {
+          throw std::runtime_error(std::string("stage ") + run.stage + " has no current output in " +
+                                   work_.string() + ": run it first (or drop --from)");
+        }
+        if (s > static_cast<int>(options_.to)) break;
+        run.cached = true;
+        report_.stages.push_back(run);
+        continue;
+      }
+      if (current && !options_.force) {
+        util::LogInfo(std::string("stage ") + run.stage + ": up to date, skipped");
+        run.cached = true;
+        report_.stages.push_back(run);
+        continue;
+      }
+      const auto t = Clock::now();
+      RunStage(stage);
+      run.ran = true;
+      run.seconds = std::chrono::duration<double>(Clock::now() - t).count();
+      report_.stages.push_back(run);
+    }
+    if (fs::exists(dirs_[3] / "manifest.json", ec)) report_.web_dir = dirs_[3].string();
+    report_.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
+    io::WriteFileAtomic((root_ / "report.json").string(), ReportJson().dump(2) + "\n");
+    return report_;
+  }
+
+ private:
+  // The stages' cache keys, each over the one before (pipeline.h, "Cache key").
+  void MakeKeys() {
+    // The canonical path, so that "a/../b" and "b" share the cache.
+    keys_[0] = HashHex(std::string(kStageVersions[0]) + "\n" +
+                       fs::weakly_canonical(fs::absolute(input_)).string() + "\n" +
+                       InputFingerprint(input_) + util::FieldsKeyText(options_.sparse));
+    keys_[1] = HashHex(
+        std::string(kStageVersions[1]) + "\n" + keys_[0] + "\n" + util::FieldsKeyText(options_.dense) +
+        (options_.holdout_every > 0 ? "\nholdout " + std::to_string(options_.holdout_every) : ""));
+    keys_[2] = HashHex(std::string(kStageVersions[2]) + "\n" + keys_[1] + "\n" +
+                       util::FieldsKeyText(options_.panorama));
+    keys_[3] =
+        HashHex(std::string(kStageVersions[3]) + "\n" + keys_[2] + "\n" +
+                std::to_string(options_.color_quality) + " " + std::to_string(options_.tile_size));
+  }
+
+  // The previous report.json, if any: cached stages keep the timings and
+  // results recorded when they ran (matched by their key).
+  void ReadPreviousReport() {
+    std::error_code ec;
+    if (!fs::exists(root_ / "report.json", ec)) return;
+    try {
+      previous_ = nlohmann::json::parse(io::ReadFile((root_ / "report.json").string()));
+    } catch (const std::exception&) {
+      previous_ = nullptr;  // Unreadable: start afresh.
+    }
+  }
+
+  // Stage s's entry in the previous report if it was made with today's key;
+  // null otherwise.
+  nlohmann::json PreviousStage(int s) const {
+    if (!previous_.is_object() || !previous_.contains("stages") || !previous_["stages"].is_array())
+      return nullptr;
+    for (const auto& e : previous_["stages"]) {
+      if (e.is_object() && e.value("stage", "") == StageName(static_cast<Stage>(s)) &&
+          e.value("key", "") == keys_[s])
+        return e;
+    }
+    return nullptr;
+  }
+
+  // The workspace the dense and panorama stages read: the training
+  // workspace (holdout.h) when photos are held out, written once the sparse
+  // output exists.
+  fs::path InputWorkspace() {
+    if (options_.holdout_every <= 0) return dirs_[0];
+    if (train_dir_.empty()) {
+      std::vector<std::string> names;
+      for (const auto& [id, image] : geometry::ReadModel((dirs_[0] / "sparse").string()).images)
+        names.push_back(image.name);
+      holdout_ = HoldoutNames(names, options_.holdout_every);
+      train_dir_ = work_ / "train";
+      WriteTrainingWorkspace(dirs_[0].string(), holdout_, train_dir_.string());
+    }
+    return train_dir_;
+  }
+
+  // The capture's shape and advice (capture_shape.h), once the sparse
+  // output is current; advice, not a requirement: a failure only warns.
+  void MeasureCapture() {
+    std::error_code ec;
+    if (!fs::exists(dirs_[0], ec) || ReadKey(key_paths_[0]) != keys_[0]) return;
+    try {
+      const CaptureShape shape = MeasureWorkspaceCaptureShape(dirs_[0].string());
+      capture_json_ = CaptureShapeJson(shape);
+      report_.capture_advice = shape.advice;
+      for (size_t k = 0; k < shape.advice.size(); ++k)
+        (k == 0 ? util::LogInfo : util::LogWarning)("capture: " + shape.advice[k]);
+    } catch (const std::exception& e) {
+      util::LogWarning(std::string("capture: not measured (") + e.what() + ")");
+    }
+  }
+
+  void RunStage(Stage stage) {
+    const int s = static_cast<int>(stage);
+    switch (stage) {
+      case Stage::kSparse:
+        RunSparse();
+        break;
+      case Stage::kDense:
+        RunIntoFolder(dirs_[s], key_paths_[s], keys_[s], [&](const fs::path& tmp) {
+          const depth::DenseReport r =
+              depth::RunDenseStage(InputWorkspace().string(), tmp.string(), options_.dense);
+          stage_json_["dense"] = {{"photos", r.photos.size()}, {"seconds", r.seconds_total}};
+        });
+        break;
+      case Stage::kPanorama:
+        RunIntoFolder(dirs_[s], key_paths_[s], keys_[s], [&](const fs::path& tmp) {
+          PanoramaStageReport r;
+          fresh_panorama_ = RunPanoramaStage(InputWorkspace().string(), dirs_[1].string(),
+                                             tmp.string(), options_.panorama, &r);
+          stage_json_["panorama"] = PanoramaResultJson(r);
+        });
+        break;
+      case Stage::kEncode:
+        RunEncode();
+        break;
+    }
+  }
+
+  static nlohmann::json PanoramaResultJson(const PanoramaStageReport& r) {
+    return {{"width", r.width},
+            {"front_coverage", r.front_coverage},
+            {"fov_covered_fraction", r.front_fov.covered_fraction},
+            {"fov_holes", r.front_fov.num_holes},
+            {"fov_largest_hole_fraction", r.front_fov.largest_hole_fraction},
+            {"footprint_covered_fraction", r.front_footprint.covered_fraction},
+            {"footprint_largest_hole_fraction", r.front_footprint.largest_hole_fraction},
+            {"back_nodes", r.fuse.back_nodes_in - r.fuse.back_nodes_redundant +
+                               r.fuse.back_nodes_hallucinated}};
+  }
+
+  void RunSparse() {
+    std::error_code ec;
+    // The sparse stage writes OUT.tmp-XXXX and renames it itself.
+    sfm::SparseStageOptions sparse = options_.sparse;
+    sparse.overwrite = true;
+    fs::remove(key_paths_[0], ec);
+    const sfm::SparseStageResult r = sfm::RunSparseStage(input_, dirs_[0].string(), sparse);
+    io::WriteFileAtomic(key_paths_[0].string(), keys_[0]);
+    nlohmann::json skipped = nlohmann::json::array();
+    for (const sfm::SkippedPhoto& p : r.skipped)
+      skipped.push_back({{"file", p.file}, {"reason", p.reason}});
+    stage_json_["sparse"] = {{"input_type", r.input_type},
+                             {"photos", r.num_photos},
+                             {"registered", r.num_registered},
+                             {"unregistered", r.unregistered},
+                             {"skipped", skipped},
+                             {"points", r.num_points},
+                             {"mean_reprojection_error_px", r.mean_reprojection_error_px}};
+    if (r.input_type == "video") {
+      stage_json_["sparse"]["video"] = {{"frames", r.video.frames_decoded},
+                                        {"picked", r.video.picked.size()},
+                                        {"blurred", r.video.blurred},
+                                        {"rotation_deg", r.video.rotation_deg},
+                                        {"frame_selection_seconds", r.video.seconds}};
+    }
+  }
+
+  // The web package, photo.c3d, and the archival master and previews next
+  // to them.
+  void RunEncode() {
+    std::error_code ec;
+    const int s = static_cast<int>(Stage::kEncode);
+    const fs::path master = dirs_[2] / "master.exr";
+    // The panorama this run made is the master file's content (its round
+    // trip is exact); only a cached one is read back.
+    StatusOr<TwoLayerPanorama> pano = fresh_panorama_
+                                          ? StatusOr<TwoLayerPanorama>(std::move(*fresh_panorama_))
+                                          : encoder::ReadMasterFile(master.string());
+    fresh_panorama_.reset();
+    if (!pano.ok()) throw std::runtime_error(pano.status().ToString());
+    encoder::PackageOptions package = encoder::DeliveryPackageOptions();
+    package.color_quality = options_.color_quality;
+    package.tile_size = options_.tile_size;
+    package.num_threads = options_.num_threads;
+    encoder::PackageStats stats;
+    auto files = encoder::EncodePackage(*pano, package, &stats);
+    if (!files.ok()) throw std::runtime_error(files.status().ToString());
+    fs::remove(key_paths_[s], ec);
+    Status st = encoder::WritePackageFolder(*files, dirs_[s].string());
+    if (!st.ok()) throw std::runtime_error(st.ToString());
+    if (options_.finish_web_package)
+      options_.finish_web_package(dirs_[s].string(), report_.capture_advice);
+    st = encoder::WritePackageSingleFile(*files, (root_ / "photo.c3d").string());
+    if (!st.ok()) throw std::runtime_error(st.ToString());
+    io::WriteFileAtomic((root_ / "master.exr").string(), io::ReadFile(master.string()));
+    const fs::path preview = dirs_[2] / "preview";
+    if (fs::exists(preview, ec)) {
+      fs::create_directories(root_ / "preview", ec);
+      for (const auto& entry : fs::directory_iterator(preview, ec)) {
+        io::WriteFileAtomic((root_ / "preview" / entry.path().filename()).string(),
+                            io::ReadFile(entry.path().string()));
+      }
+    }
+    report_.package_bytes = stats.total_bytes;
+    io::WriteFileAtomic(key_paths_[s].string(), keys_[s]);
+    stage_json_["encode"] = {{"package_bytes", stats.total_bytes}, {"files", stats.num_files}};
+  }
+
+  // report.json: the stages (a cached one with the time and results of the
+  // run that made it), every option, the capture, skipped files, held-out
+  // photos.
+  nlohmann::json ReportJson() {
+    std::error_code ec;
+    nlohmann::json j;
+    j["input"] = fs::absolute(input_).string();
+    j["seconds_total"] = report_.seconds_total;
+    for (size_t s = 0; s < report_.stages.size(); ++s) {
+      const StageRun& r = report_.stages[s];
+      nlohmann::json e = {{"stage", r.stage},
+                          {"cached", r.cached},
+                          {"ran", r.ran},
+                          {"seconds", r.seconds},
+                          {"key", keys_[s]}};
+      // A cached stage reports the time it took when it ran, and its results.
+      if (r.cached) {
+        const nlohmann::json old = PreviousStage(static_cast<int>(s));
+        if (old.is_object() && old.contains("seconds") && old["seconds"].is_number()) {
+          e["seconds"] = old["seconds"];
+          if (previous_.contains("results") && previous_["results"].contains(r.stage) &&
+              !stage_json_.contains(r.stage))
+            stage_json_[r.stage] = previous_["results"][r.stage];
+        }
+      }
+      j["stages"].push_back(e);
+    }
+    // Stages after --to keep their entries while their inputs are unchanged.
+    for (int s = static_cast<int>(report_.stages.size()); s < kNumStages; ++s) {
+      const nlohmann::json old = PreviousStage(s);
+      if (!old.is_object()) continue;
+      j["stages"].push_back(old);
+      const std::string name = StageName(static_cast<Stage>(s));
+      if (previous_.contains("results") && previous_["results"].contains(name))
+        stage_json_[name] = previous_["results"][name];
+    }
+    j["results"] = stage_json_;
+    // Every option of the stages, as their descriptions give them.
+    j["options"] = {{"sparse", util::FieldsJson(options_.sparse)},
+                    {"dense", util::FieldsJson(options_.dense)},
+                    {"panorama", util::FieldsJson(options_.panorama)}};
+    if (!capture_json_.is_null()) j["capture"] = capture_json_;
+    // Files of the input the import left out (bad or duplicate), at the top level.
+    if (stage_json_.contains("sparse") && stage_json_["sparse"].contains("skipped"))
+      j["skipped"] = stage_json_["sparse"]["skipped"];
+    if (options_.holdout_every > 0 && fs::exists(dirs_[0] / "sparse", ec)) {
+      InputWorkspace();
+      j["holdout_every"] = options_.holdout_every;
+      j["holdout"] = holdout_;
+    }
+    return j;
+  }
+
+  const std::string input_;
+  const PipelineOptions options_;
+  const fs::path root_, work_;
+  const fs::path dirs_[kNumStages];
+  fs::path key_paths_[kNumStages];
+  std::string keys_[kNumStages];
+  nlohmann::json previous_;
+  std::vector<std::string> holdout_;
+  fs::path train_dir_;
+  PipelineReport report_;
+  nlohmann::json stage_json_ = nlohmann::json::object();
+  std::optional<TwoLayerPanorama> fresh_panorama_;  // Made by this run's panorama stage.
+  nlohmann::json capture_json_;
+};
+
+}  // namespace
+
 PipelineReport RunPipeline(const std::string& input, const std::string& out,
                            const PipelineOptions& options_in) {
   if (const Status st = options_in.Check(); !st.ok()) throw std::invalid_argument(st.message());
@@ -140,257 +446,10 @@ PipelineReport RunPipeline(const std::string& input, const std::string& out,
   if (!fs::is_directory(input, ec) && !sfm::IsVideoFileName(input)) {
     throw std::runtime_error(input + ": not a folder of photos, a video or a COLMAP workspace");
   }
-  const fs::path root(out);
-  const fs::path work = root / "work";
-  fs::create_directories(work, ec);
+  fs::create_directories(fs::path(out) / "work", ec);
   if (ec)
     throw std::runtime_error(out + ": cannot create the output folder (" + ec.message() + ")");
-
-  const fs::path dirs[kNumStages] = {work / "sparse", work / "dense", work / "panorama",
-                                     root / "web"};
-  fs::path key_paths[kNumStages];
-  std::string keys[kNumStages];
-  for (int s = 0; s < kNumStages; ++s) {
-    key_paths[s] = work / (std::string(StageName(static_cast<Stage>(s))) + ".key");
-  }
-  // The canonical path, so that "a/../b" and "b" share the cache.
-  keys[0] = HashHex(std::string(kStageVersions[0]) + "\n" +
-                    fs::weakly_canonical(fs::absolute(input)).string() + "\n" +
-                    InputFingerprint(input) + util::FieldsKeyText(options.sparse));
-  keys[1] = HashHex(
-      std::string(kStageVersions[1]) + "\n" + keys[0] + "\n" + util::FieldsKeyText(options.dense) +
-      (options.holdout_every > 0 ? "\nholdout " + std::to_string(options.holdout_every) : ""));
-  // The dense and panorama stages read the training workspace (holdout.h)
-  // when photos are held out, written once the sparse output exists.
-  std::vector<std::string> holdout;
-  fs::path train_dir;
-  const auto input_workspace = [&]() -> fs::path {
-    if (options.holdout_every <= 0) return dirs[0];
-    if (train_dir.empty()) {
-      std::vector<std::string> names;
-      for (const auto& [id, image] : geometry::ReadModel((dirs[0] / "sparse").string()).images)
-        names.push_back(image.name);
-      holdout = HoldoutNames(names, options.holdout_every);
-      train_dir = work / "train";
-      WriteTrainingWorkspace(dirs[0].string(), holdout, train_dir.string());
-    }
-    return train_dir;
-  };
-  keys[2] = HashHex(std::string(kStageVersions[2]) + "\n" + keys[1] + "\n" +
-                    util::FieldsKeyText(options.panorama));
-  keys[3] =
-      HashHex(std::string(kStageVersions[3]) + "\n" + keys[2] + "\n" +
-              std::to_string(options.color_quality) + " " + std::to_string(options.tile_size));
-
-  // The previous report.json, if any: cached stages keep the timings and
-  // results recorded when they ran (matched by their key).
-  nlohmann::json previous;
-  if (fs::exists(root / "report.json", ec)) {
-    try {
-      previous = nlohmann::json::parse(io::ReadFile((root / "report.json").string()));
-    } catch (const std::exception&) {
-      previous = nullptr;  // Unreadable: start afresh.
-    }
-  }
-  const auto previous_stage = [&](int s) -> nlohmann::json {
-    if (!previous.is_object() || !previous.contains("stages") || !previous["stages"].is_array())
-      return nullptr;
-    for (const auto& e : previous["stages"]) {
-      if (e.is_object() && e.value("stage", "") == StageName(static_cast<Stage>(s)) &&
-          e.value("key", "") == keys[s])
-        return e;
-    }
-    return nullptr;
-  };
-
-  PipelineReport report;
-  nlohmann::json stage_json = nlohmann::json::object();
-  std::optional<TwoLayerPanorama> fresh_panorama;  // Made by this run's panorama stage.
-  // The capture's shape and advice (capture_shape.h), once the sparse
-  // output is current; advice, not a requirement: a failure only warns.
-  nlohmann::json capture_json;
-  const auto measure_capture = [&] {
-    if (!fs::exists(dirs[0], ec) || ReadKey(key_paths[0]) != keys[0]) return;
-    try {
-      const CaptureShape shape = MeasureWorkspaceCaptureShape(dirs[0].string());
-      capture_json = CaptureShapeJson(shape);
-      report.capture_advice = shape.advice;
-      for (size_t k = 0; k < shape.advice.size(); ++k)
-        (k == 0 ? util::LogInfo : util::LogWarning)("capture: " + shape.advice[k]);
-    } catch (const std::exception& e) {
-      util::LogWarning(std::string("capture: not measured (") + e.what() + ")");
-    }
-  };
-  for (int s = 0; s < kNumStages; ++s) {
-    const Stage stage = static_cast<Stage>(s);
-    if (stage == Stage::kDense) measure_capture();
-    StageRun run;
-    run.stage = StageName(stage);
-    const bool current = fs::exists(dirs[s], ec) && ReadKey(key_paths[s]) == keys[s];
-    const bool selected = s >= static_cast<int>(options.from) && s <= static_cast<int>(options.to);
-    if (!selected) {
-      if (s < static_cast<int>(options.from) && !current) {
-        throw std::runtime_error(std::string("stage ") + run.stage + " has no current output in " +
-                                 work.string() + ": run it first (or drop --from)");
-      }
-      if (s > static_cast<int>(options.to)) break;
-      run.cached = true;
-      report.stages.push_back(run);
-      continue;
-    }
-    if (current && !options.force) {
-      util::LogInfo(std::string("stage ") + run.stage + ": up to date, skipped");
-      run.cached = true;
-      report.stages.push_back(run);
-      continue;
-    }
-    const auto t = Clock::now();
-    switch (stage) {
-      case Stage::kSparse: {
-        // The sparse stage writes OUT.tmp-XXXX and renames it itself.
-        sfm::SparseStageOptions sparse = options.sparse;
-        sparse.overwrite = true;
-        fs::remove(key_paths[s], ec);
-        const sfm::SparseStageResult r = sfm::RunSparseStage(input, dirs[s].string(), sparse);
-        io::WriteFileAtomic(key_paths[s].string(), keys[s]);
-        nlohmann::json skipped = nlohmann::json::array();
-        for (const sfm::SkippedPhoto& p : r.skipped)
-          skipped.push_back({{"file", p.file}, {"reason", p.reason}});
-        stage_json["sparse"] = {{"input_type", r.input_type},
-                                {"photos", r.num_photos},
-                                {"registered", r.num_registered},
-                                {"unregistered", r.unregistered},
-                                {"skipped", skipped},
-                                {"points", r.num_points},
-                                {"mean_reprojection_error_px", r.mean_reprojection_error_px}};
-        if (r.input_type == "video") {
-          stage_json["sparse"]["video"] = {{"frames", r.video.frames_decoded},
-                                           {"picked", r.video.picked.size()},
-                                           {"blurred", r.video.blurred},
-                                           {"rotation_deg", r.video.rotation_deg},
-                                           {"frame_selection_seconds", r.video.seconds}};
-        }
-        break;
-      }
-      case Stage::kDense: {
-        RunIntoFolder(dirs[s], key_paths[s], keys[s], [&](const fs::path& tmp) {
-          const depth::DenseReport r =
-              depth::RunDenseStage(input_workspace().string(), tmp.string(), options.dense);
-          stage_json["dense"] = {{"photos", r.photos.size()}, {"seconds", r.seconds_total}};
-        });
-        break;
-      }
-      case Stage::kPanorama: {
-        RunIntoFolder(dirs[s], key_paths[s], keys[s], [&](const fs::path& tmp) {
-          PanoramaStageReport r;
-          fresh_panorama = RunPanoramaStage(input_workspace().string(), dirs[1].string(),
-                                            tmp.string(), options.panorama, &r);
-          stage_json["panorama"] = {
-              {"width", r.width},
-              {"front_coverage", r.front_coverage},
-              {"fov_covered_fraction", r.front_fov.covered_fraction},
-              {"fov_holes", r.front_fov.num_holes},
-              {"fov_largest_hole_fraction", r.front_fov.largest_hole_fraction},
-              {"footprint_covered_fraction", r.front_footprint.covered_fraction},
-              {"footprint_largest_hole_fraction", r.front_footprint.largest_hole_fraction},
-              {"back_nodes", r.fuse.back_nodes_in - r.fuse.back_nodes_redundant +
-                                 r.fuse.back_nodes_hallucinated}};
-        });
-        break;
-      }
-      case Stage::kEncode: {
-        const fs::path master = dirs[2] / "master.exr";
-        // The panorama this run made is the master file's content (its round
-        // trip is exact); only a cached one is read back.
-        StatusOr<TwoLayerPanorama> pano = fresh_panorama
-                                              ? StatusOr<TwoLayerPanorama>(std::move(*fresh_panorama))
-                                              : encoder::ReadMasterFile(master.string());
-        fresh_panorama.reset();
-        if (!pano.ok()) throw std::runtime_error(pano.status().ToString());
-        encoder::PackageOptions package = encoder::DeliveryPackageOptions();
-        package.color_quality = options.color_quality;
-        package.tile_size = options.tile_size;
-        package.num_threads = options.num_threads;
-        encoder::PackageStats stats;
-        auto files = encoder::EncodePackage(*pano, package, &stats);
-        if (!files.ok()) throw std::runtime_error(files.status().ToString());
-        fs::remove(key_paths[s], ec);
-        Status st = encoder::WritePackageFolder(*files, dirs[s].string());
-        if (!st.ok()) throw std::runtime_error(st.ToString());
-        if (options.finish_web_package)
-          options.finish_web_package(dirs[s].string(), report.capture_advice);
-        st = encoder::WritePackageSingleFile(*files, (root / "photo.c3d").string());
-        if (!st.ok()) throw std::runtime_error(st.ToString());
-        // The archival master and the previews next to the package.
-        io::WriteFileAtomic((root / "master.exr").string(), io::ReadFile(master.string()));
-        const fs::path preview = dirs[2] / "preview";
-        if (fs::exists(preview, ec)) {
-          fs::create_directories(root / "preview", ec);
-          for (const auto& entry : fs::directory_iterator(preview, ec)) {
-            io::WriteFileAtomic((root / "preview" / entry.path().filename()).string(),
-                                io::ReadFile(entry.path().string()));
-          }
-        }
-        report.package_bytes = stats.total_bytes;
-        io::WriteFileAtomic(key_paths[s].string(), keys[s]);
-        stage_json["encode"] = {{"package_bytes", stats.total_bytes}, {"files", stats.num_files}};
-        break;
-      }
-    }
-    run.ran = true;
-    run.seconds = std::chrono::duration<double>(Clock::now() - t).count();
-    report.stages.push_back(run);
-  }
-  if (fs::exists(dirs[3] / "manifest.json", ec)) report.web_dir = dirs[3].string();
-  report.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
-
-  nlohmann::json j;
-  j["input"] = fs::absolute(input).string();
-  j["seconds_total"] = report.seconds_total;
-  for (size_t s = 0; s < report.stages.size(); ++s) {
-    const StageRun& r = report.stages[s];
-    nlohmann::json e = {{"stage", r.stage},
-                        {"cached", r.cached},
-                        {"ran", r.ran},
-                        {"seconds", r.seconds},
-                        {"key", keys[s]}};
-    // A cached stage reports the time it took when it ran, and its results.
-    if (r.cached) {
-      const nlohmann::json old = previous_stage(static_cast<int>(s));
-      if (old.is_object() && old.contains("seconds") && old["seconds"].is_number()) {
-        e["seconds"] = old["seconds"];
-        if (previous.contains("results") && previous["results"].contains(r.stage) &&
-            !stage_json.contains(r.stage))
-          stage_json[r.stage] = previous["results"][r.stage];
-      }
-    }
-    j["stages"].push_back(e);
-  }
-  // Stages after --to keep their entries while their inputs are unchanged.
-  for (int s = static_cast<int>(report.stages.size()); s < kNumStages; ++s) {
-    const nlohmann::json old = previous_stage(s);
-    if (!old.is_object()) continue;
-    j["stages"].push_back(old);
-    const std::string name = StageName(static_cast<Stage>(s));
-    if (previous.contains("results") && previous["results"].contains(name))
-      stage_json[name] = previous["results"][name];
-  }
-  j["results"] = stage_json;
-  // Every option of the stages, as their descriptions give them.
-  j["options"] = {{"sparse", util::FieldsJson(options.sparse)},
-                  {"dense", util::FieldsJson(options.dense)},
-                  {"panorama", util::FieldsJson(options.panorama)}};
-  if (!capture_json.is_null()) j["capture"] = capture_json;
-  // Files of the input the import left out (bad or duplicate), at the top level.
-  if (stage_json.contains("sparse") && stage_json["sparse"].contains("skipped"))
-    j["skipped"] = stage_json["sparse"]["skipped"];
-  if (options.holdout_every > 0 && fs::exists(dirs[0] / "sparse", ec)) {
-    input_workspace();
-    j["holdout_every"] = options.holdout_every;
-    j["holdout"] = holdout;
-  }
-  io::WriteFileAtomic((root / "report.json").string(), j.dump(2) + "\n");
-  return report;
+  return PipelineRun(input, out, options).Run(start);
 }
 
 }  // namespace casual3d::pipeline

@@ -58,12 +58,11 @@ bool IsPhotoFileName(const std::string& name) {
           EndsWith(l, ".heif"));
 }
 
-PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output_dir,
-                         const PhotoImportOptions& options,
-                         const std::function<void(int, int)>& on_photo) {
-  const Status status = options.Check();
-  if (!status.ok()) throw std::invalid_argument("photo import options: " + status.message());
+namespace {
 
+// The photo files of `input_dir` (by extension; regular files only), sorted;
+// throws if fewer than options.min_photos.
+std::vector<std::string> ListPhotoFiles(const std::string& input_dir, const PhotoImportOptions& options) {
   DIR* dir = ::opendir(input_dir.c_str());
   if (dir == nullptr) {
     throw std::runtime_error(input_dir + ": cannot open the photo folder: " + std::strerror(errno));
@@ -85,93 +84,104 @@ PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output
                              std::to_string(options.min_photos) +
                              " overlapping photos (the paper's captures have 20 to 200)");
   }
+  return names;
+}
 
-  PhotoImport result;
-  std::map<std::string, std::string> first_with_hash;  // SHA-256 of the bytes -> file name.
-  int done = 0;
-  for (const std::string& name : names) {
-    const std::string path = input_dir + "/" + name;
-    const auto skip = [&](const std::string& reason) {
-      result.skipped.push_back({name, reason});
-      if (on_photo) on_photo(++done, static_cast<int>(names.size()));
-    };
-    std::string bytes;
-    try {
-      bytes = io::ReadFile(path);
-    } catch (const std::exception& e) {
-      skip(std::string(e.what()).substr(path.size() + 2));  // The reason after "path: ".
-      continue;
-    }
-    const std::string hash =
-        Sha256Hex(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
-    if (!bytes.empty()) {
-      const auto [it, fresh] = first_with_hash.emplace(hash, name);
-      if (!fresh) {
-        skip("same bytes as " + it->second);
-        continue;
-      }
-    }
-    ImportedPhoto photo;
-    photo.source = name;
-    photo.exif = ExifFromFileBytes(bytes);
-    Image8 image;
-    io::DecodedImageInfo info;
-    try {
-      io::ReadImageOptions read_options;
-      read_options.apply_exif_orientation = true;
-      // Large JPEGs come out of libjpeg at 1/2..1/8 size, never below the working size.
-      read_options.min_decoded_pixels = static_cast<int64_t>(options.working_megapixels * 1e6);
-      image = io::DecodeImage(bytes, name, read_options, &info);
-    } catch (const std::exception& e) {
-      skip(std::string(e.what()).substr(name.size() + 2));
-      continue;
-    }
-    bytes.clear();
-    bytes.shrink_to_fit();
-    photo.original_width = info.full_width;
-    photo.original_height = info.full_height;
-    const double pixels = static_cast<double>(image.width()) * image.height();
-    const double full_pixels = static_cast<double>(info.full_width) * info.full_height;
-    const double scale = std::min(1.0, std::sqrt(options.working_megapixels * 1e6 / full_pixels));
-    const std::string lower = Lower(name);
-    const bool png = EndsWith(lower, ".png");
-    const bool keep_name = png || EndsWith(lower, ".jpg") || EndsWith(lower, ".jpeg");
-    photo.name = keep_name ? name : name + ".jpg";
-    const std::string out_path = output_dir + "/" + photo.name;
-    const int target_width = std::max(1, static_cast<int>(std::lround(info.full_width * scale)));
-    const int target_height = std::max(1, static_cast<int>(std::lround(info.full_height * scale)));
-    if (target_width < image.width() && target_height < image.height() &&
-        target_width * static_cast<double>(target_height) < pixels) {
-      photo.width = target_width;
-      photo.height = target_height;
-      Image8 small(photo.width, photo.height, image.channels());
-      cv::Mat dst = io::ToMat(small);
-      cv::resize(io::ToMat(image), dst, dst.size(), 0, 0, cv::INTER_AREA);
-      image = std::move(small);
-    } else {
-      photo.width = image.width();
-      photo.height = image.height();
-    }
-    if (png) {
-      io::WritePng(out_path, std::as_const(image).view());
-    } else {
-      io::JpegOptions jpeg;
-      jpeg.quality = options.jpeg_quality;
-      io::WriteJpeg(out_path, std::as_const(image).view(), jpeg);
-    }
-    const int long_side = std::max(photo.original_width, photo.original_height);
-    if (options.focal_px > 0) {
-      // The prior scales with the working size (sizes are rounded per axis;
-      // the long side carries the least relative rounding).
-      photo.focal_px = options.focal_px * std::max(photo.width, photo.height) / long_side;
-    } else {
-      photo.focal_px = FocalPixelsFromExif(photo.exif, photo.width, photo.height, long_side);
-    }
-    photo.device = DeviceName(photo.exif);
-    result.photos.push_back(photo);
-    if (on_photo) on_photo(++done, static_cast<int>(names.size()));
+// Writes `image` (decoded from a file of info.full_width x full_height) into
+// OUTPUT_DIR at the working size, as PNG if it was one, else as JPEG; sets
+// the photo's name and working size.
+void WriteWorkingPhoto(Image8 image, const io::DecodedImageInfo& info, const std::string& name,
+                       const std::string& output_dir, const PhotoImportOptions& options,
+                       ImportedPhoto* photo) {
+  const double pixels = static_cast<double>(image.width()) * image.height();
+  const double full_pixels = static_cast<double>(info.full_width) * info.full_height;
+  const double scale = std::min(1.0, std::sqrt(options.working_megapixels * 1e6 / full_pixels));
+  const std::string lower = Lower(name);
+  const bool png = EndsWith(lower, ".png");
+  const bool keep_name = png || EndsWith(lower, ".jpg") || EndsWith(lower, ".jpeg");
+  photo->name = keep_name ? name : name + ".jpg";
+  const std::string out_path = output_dir + "/" + photo->name;
+  const int target_width = std::max(1, static_cast<int>(std::lround(info.full_width * scale)));
+  const int target_height = std::max(1, static_cast<int>(std::lround(info.full_height * scale)));
+  if (target_width < image.width() && target_height < image.height() &&
+      target_width * static_cast<double>(target_height) < pixels) {
+    photo->width = target_width;
+    photo->height = target_height;
+    Image8 small(photo->width, photo->height, image.channels());
+    cv::Mat dst = io::ToMat(small);
+    cv::resize(io::ToMat(image), dst, dst.size(), 0, 0, cv::INTER_AREA);
+    image = std::move(small);
+  } else {
+    photo->width = image.width();
+    photo->height = image.height();
   }
+  if (png) {
+    io::WritePng(out_path, std::as_const(image).view());
+  } else {
+    io::JpegOptions jpeg;
+    jpeg.quality = options.jpeg_quality;
+    io::WriteJpeg(out_path, std::as_const(image).view(), jpeg);
+  }
+}
 
+// Imports the photo file `name`: read, checked against the files before it
+// (`first_with_hash`: SHA-256 of the bytes -> file name), decoded upright,
+// written at the working size, with its device and focal prior. Returns
+// false with the reason it was skipped.
+bool ImportPhoto(const std::string& input_dir, const std::string& name, const std::string& output_dir,
+                 const PhotoImportOptions& options, std::map<std::string, std::string>* first_with_hash,
+                 ImportedPhoto* photo, std::string* skipped) {
+  const std::string path = input_dir + "/" + name;
+  std::string bytes;
+  try {
+    bytes = io::ReadFile(path);
+  } catch (const std::exception& e) {
+    *skipped = std::string(e.what()).substr(path.size() + 2);  // The reason after "path: ".
+    return false;
+  }
+  const std::string hash = Sha256Hex(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+  if (!bytes.empty()) {
+    const auto [it, fresh] = first_with_hash->emplace(hash, name);
+    if (!fresh) {
+      *skipped = "same bytes as " + it->second;
+      return false;
+    }
+  }
+  photo->source = name;
+  photo->exif = ExifFromFileBytes(bytes);
+  Image8 image;
+  io::DecodedImageInfo info;
+  try {
+    io::ReadImageOptions read_options;
+    read_options.apply_exif_orientation = true;
+    // Large JPEGs come out of libjpeg at 1/2..1/8 size, never below the working size.
+    read_options.min_decoded_pixels = static_cast<int64_t>(options.working_megapixels * 1e6);
+    image = io::DecodeImage(bytes, name, read_options, &info);
+  } catch (const std::exception& e) {
+    *skipped = std::string(e.what()).substr(name.size() + 2);
+    return false;
+  }
+  bytes.clear();
+  bytes.shrink_to_fit();
+  photo->original_width = info.full_width;
+  photo->original_height = info.full_height;
+  WriteWorkingPhoto(std::move(image), info, name, output_dir, options, photo);
+  const int long_side = std::max(photo->original_width, photo->original_height);
+  if (options.focal_px > 0) {
+    // The prior scales with the working size (sizes are rounded per axis;
+    // the long side carries the least relative rounding).
+    photo->focal_px = options.focal_px * std::max(photo->width, photo->height) / long_side;
+  } else {
+    photo->focal_px = FocalPixelsFromExif(photo->exif, photo->width, photo->height, long_side);
+  }
+  photo->device = DeviceName(photo->exif);
+  return true;
+}
+
+// Throws if unreadable files were skipped and options.skip_unreadable is
+// off, or if fewer than options.min_photos photos are usable.
+void CheckUsable(const std::string& input_dir, size_t num_files, const PhotoImport& result,
+                 const PhotoImportOptions& options) {
   std::vector<std::string> unreadable;
   for (const SkippedPhoto& s : result.skipped) {
     if (s.reason.rfind("same bytes as ", 0) != 0) unreadable.push_back(s.file + ": " + s.reason);
@@ -184,14 +194,19 @@ PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output
     std::vector<std::string> why;
     for (const SkippedPhoto& s : result.skipped) why.push_back(s.file + ": " + s.reason);
     throw std::runtime_error(input_dir + ": " + std::to_string(result.photos.size()) +
-                             " usable photos of " + std::to_string(names.size()) + "; at least " +
+                             " usable photos of " + std::to_string(num_files) + "; at least " +
                              std::to_string(options.min_photos) + " are needed (left out: " +
                              JoinList(why, 4) + ")");
   }
+}
 
-  // Devices by EXIF make and model. Sizes alone do not make another device: a
-  // phone writes photos of several sizes, and every size is its own camera group.
-  // Photos without EXIF (PNG, TIFF, edited copies) may come from any of them.
+// Devices by EXIF make and model. Sizes alone do not make another device: a
+// phone writes photos of several sizes, and every size is its own camera group.
+// Photos without EXIF (PNG, TIFF, edited copies) may come from any of them.
+// Throws if several devices took the photos and options.allow_mixed_devices
+// is off.
+void CheckOneDevice(const std::string& input_dir, const PhotoImport& result,
+                    const PhotoImportOptions& options) {
   std::map<std::string, std::vector<std::string>> devices;
   for (const auto& p : result.photos) {
     if (p.exif.present && p.device != "unknown camera") devices[p.device].push_back(p.source);
@@ -207,11 +222,13 @@ PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output
                              "; capture with one camera, or pass --mixed-cameras to calibrate "
                              "each camera separately");
   }
+}
 
-  // Camera groups: device, upright working size and focal prior (0.1 px bins).
+// Camera groups: device, upright working size and focal prior (0.1 px bins).
+void GroupCameras(PhotoImport* result) {
   std::map<std::tuple<std::string, int, int, long>, int> group_of;
-  for (size_t i = 0; i < result.photos.size(); ++i) {
-    ImportedPhoto& p = result.photos[i];
+  for (size_t i = 0; i < result->photos.size(); ++i) {
+    ImportedPhoto& p = result->photos[i];
     const auto key = std::make_tuple(p.device, p.width, p.height, std::lround(p.focal_px * 10));
     auto it = group_of.find(key);
     if (it == group_of.end()) {
@@ -220,12 +237,37 @@ PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output
       g.width = p.width;
       g.height = p.height;
       g.focal_px = p.focal_px;
-      result.groups.push_back(g);
-      it = group_of.emplace(key, static_cast<int>(result.groups.size()) - 1).first;
+      result->groups.push_back(g);
+      it = group_of.emplace(key, static_cast<int>(result->groups.size()) - 1).first;
     }
     p.group = it->second;
-    result.groups[it->second].photos.push_back(static_cast<int>(i));
+    result->groups[it->second].photos.push_back(static_cast<int>(i));
   }
+}
+
+}  // namespace
+
+PhotoImport ImportPhotos(const std::string& input_dir, const std::string& output_dir,
+                         const PhotoImportOptions& options,
+                         const std::function<void(int, int)>& on_photo) {
+  const Status status = options.Check();
+  if (!status.ok()) throw std::invalid_argument("photo import options: " + status.message());
+  const std::vector<std::string> names = ListPhotoFiles(input_dir, options);
+  PhotoImport result;
+  std::map<std::string, std::string> first_with_hash;  // SHA-256 of the bytes -> file name.
+  int done = 0;
+  for (const std::string& name : names) {
+    ImportedPhoto photo;
+    std::string skipped;
+    if (ImportPhoto(input_dir, name, output_dir, options, &first_with_hash, &photo, &skipped))
+      result.photos.push_back(photo);
+    else
+      result.skipped.push_back({name, skipped});
+    if (on_photo) on_photo(++done, static_cast<int>(names.size()));
+  }
+  CheckUsable(input_dir, names.size(), result, options);
+  CheckOneDevice(input_dir, result, options);
+  GroupCameras(&result);
   return result;
 }
 

@@ -296,222 +296,236 @@ Json OptionsJson(const SparseStageOptions& o) {
             {"min_partial_resultant", o.frame.min_partial_resultant}}}};
 }
 
-}  // namespace
-
-SparseStageResult RunSparseStage(const std::string& input, const std::string& output,
-                                 const SparseStageOptions& options) {
-  const Status status = options.Check();
-  if (!status.ok()) throw std::invalid_argument("sparse stage options: " + status.message());
-  const auto stage_start = std::chrono::steady_clock::now();
-
-  // Inputs first: cheap checks before any work.
+// Whether `input` is read as a COLMAP workspace (images/ and a model) rather
+// than as photos; throws if a workspace is required and this is none.
+bool IsWorkspace(const std::string& input, const std::string& video,
+                 const std::vector<fs::path>& workspace_models, SparseInputType type) {
   const fs::path input_path(input);
   std::error_code ec;
-  const std::string video =
-      options.input_type == SparseInputType::kWorkspace ? "" : VideoOf(input);
-  if (!fs::is_directory(input_path, ec) && video.empty()) {
-    throw std::runtime_error(input + ": not a folder or a video; give a folder of photos, a video "
-                             "clip (.mp4, .mov) or a COLMAP workspace (images/ and sparse/)");
-  }
-  const fs::path output_path = fs::absolute(fs::path(output)).lexically_normal();
-  if (fs::exists(output_path, ec) && !options.overwrite) {
-    throw std::runtime_error(output + ": already exists; pass --overwrite or choose another folder");
-  }
-  const std::vector<fs::path> workspace_models = WorkspaceModels(input_path);
-  bool workspace = false;
-  switch (options.input_type) {
+  switch (type) {
     case SparseInputType::kAuto:
-      workspace = video.empty() && !workspace_models.empty() &&
-                  fs::is_directory(input_path / "images", ec);
-      break;
+      return video.empty() && !workspace_models.empty() && fs::is_directory(input_path / "images", ec);
     case SparseInputType::kWorkspace:
       if (workspace_models.empty() || !fs::is_directory(input_path / "images", ec)) {
         throw std::runtime_error(input + ": not a COLMAP workspace (expected images/ and a model "
                                  "in sparse/ or sparse/0 with cameras, images and points3D files)");
       }
-      workspace = true;
-      break;
+      return true;
     case SparseInputType::kPhotos:
       break;
   }
-  const std::string colmap = FindColmap(options.colmap_path);
-  const std::string threads = std::to_string(options.num_threads == 0 ? -1 : options.num_threads);
+  return false;
+}
 
-  ScopedInterruptHandler interrupt_handler;
-  StagingDir staging(output_path);
-  const fs::path tmp = staging.path();
-  const fs::path work = tmp / "work";
-  fs::create_directories(work / "images");
-  const std::string log_path = (tmp / "sparse_log.txt").string();
-  AppendLog(log_path, "casual3d sparse: input " + input + ", output " + output);
-
-  SparseStageResult result;
-  result.input_type = workspace ? "workspace" : video.empty() ? "photos" : "video";
+// What the registration starts from: the photos' folder, the model's folder
+// and the model, and the names of every input photo.
+struct RawModel {
   fs::path image_dir;
   fs::path model_dir;
-  geometry::SparseModel raw_model;
+  geometry::SparseModel model;
   std::vector<std::string> all_names;
+};
 
-  if (workspace) {
-    image_dir = input_path / "images";
-    auto [dir, model] = LargestModel(workspace_models);
-    model_dir = dir;
-    raw_model = std::move(model);
-    for (const auto& [id, image] : raw_model.images) {
-      all_names.push_back(image.name);
-      if (!fs::exists(image_dir / image.name, ec)) {
-        throw std::runtime_error((image_dir / image.name).string() +
-                                 ": missing; the workspace's model " + model_dir.string() +
-                                 " lists it");
-      }
-    }
-    AppendLog(log_path, "workspace model " + model_dir.string());
-  } else {
-    // 1. Import the photos at the working resolution (a video's picked frames first).
-    std::string photo_dir = input;
-    if (!video.empty()) {
-      const fs::path frames = work / "video_frames";
-      fs::create_directories(frames);
-      result.video = ExtractVideoFrames(video, frames.string(), options.video);
-      const VideoFrames& v = result.video;
-      char line[256];
-      std::snprintf(line, sizeof(line),
-                    "frame selection: %d frames of %dx%d at %.3g fps (rotation %d degrees), "
-                    "%d blurred, motion %.2f frame diagonals; picked %zu in %.1f s",
-                    v.frames_decoded, v.width, v.height, v.fps, v.rotation_deg, v.blurred,
-                    v.motion_diagonals, v.picked.size(), v.seconds);
-      AppendLog(log_path, line);
-      util::LogInfo(line);
-      result.timings_s.emplace_back("frame_selection", v.seconds);
-      photo_dir = frames.string();
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    PhotoImport photos;
-    {
-      util::Progress progress("import photos", 1000);
-      photos = ImportPhotos(photo_dir, (work / "images").string(), options.import,
-                            [&](int done, int total) {
-                              if (InterruptRequested()) throw std::runtime_error("interrupted");
-                              progress.Set(static_cast<int64_t>(done) * 1000 / std::max(total, 1));
-                            });
-    }
-    result.skipped = photos.skipped;
-    for (const auto& s : photos.skipped) {
-      util::LogWarning("skipped " + s.file + ": " + s.reason);
-      AppendLog(log_path, "skipped " + s.file + ": " + s.reason);
-    }
-    for (const auto& p : photos.photos) all_names.push_back(p.name);
-    result.timings_s.emplace_back("import", SecondsSince(t0));
-    image_dir = work / "images";
-    const int n = static_cast<int>(photos.photos.size());
-    ColmapSteps steps(colmap, log_path, n, &result);
-    const bool focal_unknown = std::any_of(photos.groups.begin(), photos.groups.end(),
-                                           [](const CameraGroup& g) { return !(g.focal_px > 0); });
-    steps.nothing_registered = NothingRegisteredMessage(n, result.input_type, focal_unknown);
-
-    // 2. Features, one extractor run per camera group so each gets its own
-    // calibration and focal prior (TOOLCHAIN.md: resized photos lost their EXIF).
-    const std::string db = (work / "database.db").string();
-    for (size_t g = 0; g < photos.groups.size(); ++g) {
-      const CameraGroup& group = photos.groups[g];
-      const fs::path list = work / ("group" + std::to_string(g) + ".txt");
-      {
-        std::ofstream out(list);
-        for (int i : group.photos) out << photos.photos[i].name << "\n";
-        if (!out) throw std::runtime_error(list.string() + ": cannot write (disk full?)");
-      }
-      std::vector<std::string> args = {
-          "--database_path", db, "--image_path", image_dir.string(), "--image_list_path",
-          list.string(), "--ImageReader.camera_model", options.camera_model,
-          "--ImageReader.single_camera", options.shared_camera ? "1" : "0",
-          "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
-          "--SiftExtraction.max_num_features", std::to_string(options.max_features),
-          "--SiftExtraction.first_octave", std::to_string(options.sift_first_octave)};
-      if (group.focal_px > 0) {
-        args.push_back("--ImageReader.camera_params");
-        args.push_back(CameraParams(options.camera_model, group.focal_px, group.width, group.height));
-      }
-      AppendLog(log_path, "camera group " + std::to_string(g) + ": " + group.device + ", " +
-                              std::to_string(group.width) + "x" + std::to_string(group.height) +
-                              ", focal prior " +
-                              (group.focal_px > 0 ? FormatNumber(group.focal_px) + " px" : "none"));
-      steps.Run("feature_extractor", args, "features");
-    }
-
-    // 3. Matching.
-    const bool exhaustive =
-        options.matcher == MatcherType::kExhaustive ||
-        (options.matcher == MatcherType::kAuto && n <= options.exhaustive_max_photos);
-    result.matcher = exhaustive ? "exhaustive" : "sequential";
-    if (options.native_matching) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const std::string summary =
-          MatchIntoDatabase(db, exhaustive, options.sequential_overlap, options.num_threads);
-      const double seconds = SecondsSince(t0);
-      char took[32];
-      std::snprintf(took, sizeof(took), " in %.1f s", seconds);
-      AppendLog(log_path, "descriptor matching: " + summary + took);
-      steps.Add("descriptor_matching", seconds);
-    }
-    std::vector<std::string> match_args = {"--database_path", db, "--SiftMatching.use_gpu", "0",
-                                           "--SiftMatching.num_threads", threads};
-    if (!exhaustive) {
-      match_args.insert(match_args.end(),
-                        {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
-                         "--SequentialMatching.loop_detection", "0"});
-    }
-    steps.Run(exhaustive ? "exhaustive_matcher" : "sequential_matcher", match_args, "matching");
-
-    // 4. Mapping; keep the largest model.
-    const fs::path mapped = work / "sparse";
-    fs::create_directories(mapped);
-    steps.Run("mapper",
-              {"--database_path", db, "--image_path", image_dir.string(), "--output_path",
-               mapped.string(), "--Mapper.num_threads", threads, "--Mapper.init_min_tri_angle",
-               FormatNumber(options.init_min_tri_angle_deg)},
-              "mapping");
-    std::vector<fs::path> models;
-    for (const auto& entry : fs::directory_iterator(mapped, ec)) {
-      if (entry.is_directory() && HasModelFiles(entry.path())) models.push_back(entry.path());
-    }
-    std::sort(models.begin(), models.end());
-    if (models.empty()) throw std::runtime_error(steps.nothing_registered);
-    auto [dir, model] = LargestModel(models);
-    model_dir = dir;
-    raw_model = std::move(model);
-    if (models.size() > 1) {
-      AppendLog(log_path, std::to_string(models.size()) + " models; kept " + model_dir.string());
+// A workspace's largest model, whose photos must all be in its images/.
+RawModel WorkspaceModel(const fs::path& input_path, const std::vector<fs::path>& workspace_models,
+                        const std::string& log_path) {
+  std::error_code ec;
+  RawModel raw;
+  raw.image_dir = input_path / "images";
+  auto [dir, model] = LargestModel(workspace_models);
+  raw.model_dir = dir;
+  raw.model = std::move(model);
+  for (const auto& [id, image] : raw.model.images) {
+    raw.all_names.push_back(image.name);
+    if (!fs::exists(raw.image_dir / image.name, ec)) {
+      throw std::runtime_error((raw.image_dir / image.name).string() +
+                               ": missing; the workspace's model " + raw.model_dir.string() +
+                               " lists it");
     }
   }
+  AppendLog(log_path, "workspace model " + raw.model_dir.string());
+  return raw;
+}
 
-  // Registration check.
+// 1. The photos imported into WORK/images at the working resolution (a
+// video's picked frames first), skipped files logged.
+PhotoImport ImportInput(const std::string& input, const std::string& video,
+                        const SparseStageOptions& options, const fs::path& work,
+                        const std::string& log_path, SparseStageResult* result) {
+  std::string photo_dir = input;
+  if (!video.empty()) {
+    const fs::path frames = work / "video_frames";
+    fs::create_directories(frames);
+    result->video = ExtractVideoFrames(video, frames.string(), options.video);
+    const VideoFrames& v = result->video;
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "frame selection: %d frames of %dx%d at %.3g fps (rotation %d degrees), "
+                  "%d blurred, motion %.2f frame diagonals; picked %zu in %.1f s",
+                  v.frames_decoded, v.width, v.height, v.fps, v.rotation_deg, v.blurred,
+                  v.motion_diagonals, v.picked.size(), v.seconds);
+    AppendLog(log_path, line);
+    util::LogInfo(line);
+    result->timings_s.emplace_back("frame_selection", v.seconds);
+    photo_dir = frames.string();
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  PhotoImport photos;
+  {
+    util::Progress progress("import photos", 1000);
+    photos = ImportPhotos(photo_dir, (work / "images").string(), options.import,
+                          [&](int done, int total) {
+                            if (InterruptRequested()) throw std::runtime_error("interrupted");
+                            progress.Set(static_cast<int64_t>(done) * 1000 / std::max(total, 1));
+                          });
+  }
+  result->skipped = photos.skipped;
+  for (const auto& s : photos.skipped) {
+    util::LogWarning("skipped " + s.file + ": " + s.reason);
+    AppendLog(log_path, "skipped " + s.file + ": " + s.reason);
+  }
+  result->timings_s.emplace_back("import", SecondsSince(t0));
+  return photos;
+}
+
+// 2. Features, one extractor run per camera group so each gets its own
+// calibration and focal prior (TOOLCHAIN.md: resized photos lost their EXIF).
+void ExtractFeatures(const PhotoImport& photos, const SparseStageOptions& options, const std::string& db,
+                     const fs::path& image_dir, const fs::path& work, const std::string& threads,
+                     const std::string& log_path, ColmapSteps* steps) {
+  for (size_t g = 0; g < photos.groups.size(); ++g) {
+    const CameraGroup& group = photos.groups[g];
+    const fs::path list = work / ("group" + std::to_string(g) + ".txt");
+    {
+      std::ofstream out(list);
+      for (int i : group.photos) out << photos.photos[i].name << "\n";
+      if (!out) throw std::runtime_error(list.string() + ": cannot write (disk full?)");
+    }
+    std::vector<std::string> args = {
+        "--database_path", db, "--image_path", image_dir.string(), "--image_list_path",
+        list.string(), "--ImageReader.camera_model", options.camera_model,
+        "--ImageReader.single_camera", options.shared_camera ? "1" : "0",
+        "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
+        "--SiftExtraction.max_num_features", std::to_string(options.max_features),
+        "--SiftExtraction.first_octave", std::to_string(options.sift_first_octave)};
+    if (group.focal_px > 0) {
+      args.push_back("--ImageReader.camera_params");
+      args.push_back(CameraParams(options.camera_model, group.focal_px, group.width, group.height));
+    }
+    AppendLog(log_path, "camera group " + std::to_string(g) + ": " + group.device + ", " +
+                            std::to_string(group.width) + "x" + std::to_string(group.height) +
+                            ", focal prior " +
+                            (group.focal_px > 0 ? FormatNumber(group.focal_px) + " px" : "none"));
+    steps->Run("feature_extractor", args, "features");
+  }
+}
+
+// 3. Matching: casual3d's descriptor matching (native_matching), then
+// COLMAP's matcher, which verifies the stored matches.
+void MatchFeatures(int n, const SparseStageOptions& options, const std::string& db,
+                   const std::string& threads, const std::string& log_path, ColmapSteps* steps,
+                   SparseStageResult* result) {
+  const bool exhaustive =
+      options.matcher == MatcherType::kExhaustive ||
+      (options.matcher == MatcherType::kAuto && n <= options.exhaustive_max_photos);
+  result->matcher = exhaustive ? "exhaustive" : "sequential";
+  if (options.native_matching) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string summary =
+        MatchIntoDatabase(db, exhaustive, options.sequential_overlap, options.num_threads);
+    const double seconds = SecondsSince(t0);
+    char took[32];
+    std::snprintf(took, sizeof(took), " in %.1f s", seconds);
+    AppendLog(log_path, "descriptor matching: " + summary + took);
+    steps->Add("descriptor_matching", seconds);
+  }
+  std::vector<std::string> match_args = {"--database_path", db, "--SiftMatching.use_gpu", "0",
+                                         "--SiftMatching.num_threads", threads};
+  if (!exhaustive) {
+    match_args.insert(match_args.end(),
+                      {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
+                       "--SequentialMatching.loop_detection", "0"});
+  }
+  steps->Run(exhaustive ? "exhaustive_matcher" : "sequential_matcher", match_args, "matching");
+}
+
+// Steps 1 to 4 on photos: import, features, matching, then the mapper; the
+// largest model it makes.
+RawModel RegisterPhotos(const std::string& input, const std::string& video,
+                        const SparseStageOptions& options, const std::string& colmap,
+                        const std::string& threads, const fs::path& work, const std::string& log_path,
+                        SparseStageResult* result) {
+  std::error_code ec;
+  const PhotoImport photos = ImportInput(input, video, options, work, log_path, result);
+  RawModel raw;
+  for (const auto& p : photos.photos) raw.all_names.push_back(p.name);
+  raw.image_dir = work / "images";
+  const int n = static_cast<int>(photos.photos.size());
+  ColmapSteps steps(colmap, log_path, n, result);
+  const bool focal_unknown = std::any_of(photos.groups.begin(), photos.groups.end(),
+                                         [](const CameraGroup& g) { return !(g.focal_px > 0); });
+  steps.nothing_registered = NothingRegisteredMessage(n, result->input_type, focal_unknown);
+  const std::string db = (work / "database.db").string();
+  ExtractFeatures(photos, options, db, raw.image_dir, work, threads, log_path, &steps);
+  MatchFeatures(n, options, db, threads, log_path, &steps, result);
+
+  // 4. Mapping; keep the largest model.
+  const fs::path mapped = work / "sparse";
+  fs::create_directories(mapped);
+  steps.Run("mapper",
+            {"--database_path", db, "--image_path", raw.image_dir.string(), "--output_path",
+             mapped.string(), "--Mapper.num_threads", threads, "--Mapper.init_min_tri_angle",
+             FormatNumber(options.init_min_tri_angle_deg)},
+            "mapping");
+  std::vector<fs::path> models;
+  for (const auto& entry : fs::directory_iterator(mapped, ec)) {
+    if (entry.is_directory() && HasModelFiles(entry.path())) models.push_back(entry.path());
+  }
+  std::sort(models.begin(), models.end());
+  if (models.empty()) throw std::runtime_error(steps.nothing_registered);
+  auto [dir, model] = LargestModel(models);
+  raw.model_dir = dir;
+  raw.model = std::move(model);
+  if (models.size() > 1) {
+    AppendLog(log_path, std::to_string(models.size()) + " models; kept " + raw.model_dir.string());
+  }
+  return raw;
+}
+
+// Registration check: which photos the model holds; throws if fewer than
+// min_registered_fraction of them (and at least 3).
+void CheckRegistration(const RawModel& raw, const SparseStageOptions& options, SparseStageResult* result) {
   std::set<std::string> registered;
-  for (const auto& [id, image] : raw_model.images) registered.insert(image.name);
-  result.num_photos = static_cast<int>(all_names.size());
-  result.num_registered = static_cast<int>(registered.size());
-  for (const auto& name : all_names) {
-    if (!registered.count(name)) result.unregistered.push_back(name);
+  for (const auto& [id, image] : raw.model.images) registered.insert(image.name);
+  result->num_photos = static_cast<int>(raw.all_names.size());
+  result->num_registered = static_cast<int>(registered.size());
+  for (const auto& name : raw.all_names) {
+    if (!registered.count(name)) result->unregistered.push_back(name);
   }
   const int needed = std::max(
-      3, static_cast<int>(std::ceil(options.min_registered_fraction * result.num_photos - 1e-9)));
-  if (result.num_registered < needed) {
+      3, static_cast<int>(std::ceil(options.min_registered_fraction * result->num_photos - 1e-9)));
+  if (result->num_registered < needed) {
     throw std::runtime_error(
-        "COLMAP registered only " + std::to_string(result.num_registered) + " of " +
-        std::to_string(result.num_photos) + " photos (need " + std::to_string(needed) +
-        "); not registered: " + JoinNames(result.unregistered, 8) +
+        "COLMAP registered only " + std::to_string(result->num_registered) + " of " +
+        std::to_string(result->num_photos) + " photos (need " + std::to_string(needed) +
+        "); not registered: " + JoinNames(result->unregistered, 8) +
         ". Retake with more overlap between neighbouring photos and a more textured scene");
   }
-  if (!result.unregistered.empty()) {
-    util::LogWarning("COLMAP registered " + std::to_string(result.num_registered) + " of " +
-                     std::to_string(result.num_photos) +
-                     " photos; left out: " + JoinNames(result.unregistered, 8));
+  if (!result->unregistered.empty()) {
+    util::LogWarning("COLMAP registered " + std::to_string(result->num_registered) + " of " +
+                     std::to_string(result->num_photos) +
+                     " photos; left out: " + JoinNames(result->unregistered, 8));
   }
+}
 
-  // 5. Undistortion into PINHOLE cameras.
-  ColmapSteps steps(colmap, log_path, result.num_registered, &result);
+// 5. Undistortion into PINHOLE cameras: TMP/images and TMP/sparse (binary
+// and text).
+void Undistort(const RawModel& raw, const std::string& colmap, const std::string& log_path,
+               const fs::path& tmp, const fs::path& work, SparseStageResult* result) {
+  ColmapSteps steps(colmap, log_path, result->num_registered, result);
   const fs::path undistorted = work / "undistorted";
   steps.Run("image_undistorter",
-            {"--image_path", image_dir.string(), "--input_path", model_dir.string(),
+            {"--image_path", raw.image_dir.string(), "--input_path", raw.model_dir.string(),
              "--output_path", undistorted.string(), "--output_type", "COLMAP"},
             "undistorting");
   fs::rename(undistorted / "images", tmp / "images");
@@ -523,25 +537,27 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
             {"--input_path", (tmp / "sparse").string(), "--output_path", (tmp / "sparse").string(),
              "--output_type", "TXT"},
             "writing model");
+}
 
-  // 6. Scene set-up: frame and depth ranges.
+// 6. Scene set-up: the model's points, the panorama frame and the depth
+// ranges (TMP/frame.json, TMP/depth_ranges.json).
+void SetUpScene(const fs::path& tmp, const SparseStageOptions& options, SparseStageResult* result) {
   const auto t_setup = std::chrono::steady_clock::now();
   const geometry::SparseModel model = geometry::ReadModel((tmp / "sparse").string());
-  result.num_points = static_cast<int>(model.points.size());
+  result->num_points = static_cast<int>(model.points.size());
   double error_sum = 0;
   for (const auto& [id, p] : model.points) error_sum += p.error;
-  result.mean_reprojection_error_px = model.points.empty() ? 0.0 : error_sum / model.points.size();
-  const PanoramaFrame frame = ComputePanoramaFrame(model, options.frame, &result.frame);
-  WritePanoramaFrame(frame, (tmp / "frame.json").string(), &result.frame);
+  result->mean_reprojection_error_px = model.points.empty() ? 0.0 : error_sum / model.points.size();
+  const PanoramaFrame frame = ComputePanoramaFrame(model, options.frame, &result->frame);
+  WritePanoramaFrame(frame, (tmp / "frame.json").string(), &result->frame);
   WriteDepthRanges(ComputeDepthRanges(model, options.depth_ranges),
                    (tmp / "depth_ranges.json").string());
-  result.timings_s.emplace_back("scene_setup", SecondsSince(t_setup));
+  result->timings_s.emplace_back("scene_setup", SecondsSince(t_setup));
+}
 
-  if (!options.keep_work) {
-    fs::remove_all(work, ec);
-  }
-  result.timings_s.emplace_back("total", SecondsSince(stage_start));
-
+// stage.json: what the stage did, with its options and timings.
+Json StageJson(const fs::path& input_path, const std::string& colmap, const std::string& video,
+               const SparseStageOptions& options, const SparseStageResult& result) {
   Json stage_video;
   Json skipped = Json::array();
   for (const SkippedPhoto& s : result.skipped) skipped.push_back({{"file", s.file}, {"reason", s.reason}});
@@ -569,7 +585,57 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
                 {"mean_reprojection_error_px", result.mean_reprojection_error_px},
                 {"timings_s", timings}};
   if (!stage_video.is_null()) stage["video"] = stage_video;
-  io::WriteFileAtomic((tmp / "stage.json").string(), stage.dump(2) + "\n");
+  return stage;
+}
+
+}  // namespace
+
+SparseStageResult RunSparseStage(const std::string& input, const std::string& output,
+                                 const SparseStageOptions& options) {
+  const Status status = options.Check();
+  if (!status.ok()) throw std::invalid_argument("sparse stage options: " + status.message());
+  const auto stage_start = std::chrono::steady_clock::now();
+
+  // Inputs first: cheap checks before any work.
+  const fs::path input_path(input);
+  std::error_code ec;
+  const std::string video =
+      options.input_type == SparseInputType::kWorkspace ? "" : VideoOf(input);
+  if (!fs::is_directory(input_path, ec) && video.empty()) {
+    throw std::runtime_error(input + ": not a folder or a video; give a folder of photos, a video "
+                             "clip (.mp4, .mov) or a COLMAP workspace (images/ and sparse/)");
+  }
+  const fs::path output_path = fs::absolute(fs::path(output)).lexically_normal();
+  if (fs::exists(output_path, ec) && !options.overwrite) {
+    throw std::runtime_error(output + ": already exists; pass --overwrite or choose another folder");
+  }
+  const std::vector<fs::path> workspace_models = WorkspaceModels(input_path);
+  const bool workspace = IsWorkspace(input, video, workspace_models, options.input_type);
+  const std::string colmap = FindColmap(options.colmap_path);
+  const std::string threads = std::to_string(options.num_threads == 0 ? -1 : options.num_threads);
+
+  ScopedInterruptHandler interrupt_handler;
+  StagingDir staging(output_path);
+  const fs::path tmp = staging.path();
+  const fs::path work = tmp / "work";
+  fs::create_directories(work / "images");
+  const std::string log_path = (tmp / "sparse_log.txt").string();
+  AppendLog(log_path, "casual3d sparse: input " + input + ", output " + output);
+
+  SparseStageResult result;
+  result.input_type = workspace ? "workspace" : video.empty() ? "photos" : "video";
+  const RawModel raw = workspace ? WorkspaceModel(input_path, workspace_models, log_path)
+                                 : RegisterPhotos(input, video, options, colmap, threads, work, log_path, &result);
+  CheckRegistration(raw, options, &result);
+  Undistort(raw, colmap, log_path, tmp, work, &result);
+  SetUpScene(tmp, options, &result);
+
+  if (!options.keep_work) {
+    fs::remove_all(work, ec);
+  }
+  result.timings_s.emplace_back("total", SecondsSince(stage_start));
+  io::WriteFileAtomic((tmp / "stage.json").string(),
+                      StageJson(input_path, colmap, video, options, result).dump(2) + "\n");
   AppendLog(log_path, "done: " + std::to_string(result.num_registered) + "/" +
                           std::to_string(result.num_photos) + " registered, " +
                           std::to_string(result.num_points) + " points");
