@@ -183,13 +183,10 @@ bool WindowSums(const PlaneHomography& H, const ImageF& J, int m8, int centre, c
   return true;
 }
 
-}  // namespace
-
-ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeCamera& camera,
-                         const ImageF& depth, const std::vector<RefineNeighbor>& neighbors, double inv_step,
-                         const BoundaryRelabelOptions& options, int num_threads, long long* changed) {
-  const Status st = options.Check();
-  if (!st.ok()) throw std::invalid_argument("boundary relabelling: " + st.message());
+// Throws std::invalid_argument unless the images, depth map, camera and
+// neighbours agree in size and channels and inv_step > 0.
+void CheckRelabelInputs(const ImageF& color, const ImageF& gray, const PinholeCamera& camera,
+                        const ImageF& depth, const std::vector<RefineNeighbor>& neighbors, double inv_step) {
   const int w = gray.width(), h = gray.height();
   if (color.width() != w || color.height() != h || color.channels() != 3 || depth.width() != w ||
       depth.height() != h || camera.width != w || camera.height != h)
@@ -201,185 +198,272 @@ ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeC
     if (!nb.gray || nb.gray->channels() != 1 || nb.gray->width() != nb.camera.width ||
         nb.gray->height() != nb.camera.height)
       throw std::invalid_argument("boundary relabelling: a neighbour's image and camera differ in size");
+}
+
+// The band: pixels within `radius` (a window of `diameter`) of a depth edge,
+// two 4-neighbours whose inverse depths differ by more than `jump` (the
+// upsampling's weighted median leaves steps there). A slope spans as much
+// over the band window but has no such step, and is left alone.
+std::vector<uint8_t> EdgeBand(const ImageF& inv_image, float jump, int diameter) {
+  const int w = inv_image.width(), h = inv_image.height();
+  const size_t n = static_cast<size_t>(w) * h;
+  std::vector<uint8_t> near_edge(n, 0);
+  ImageF neg_edge(w, h, 1, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t p = static_cast<size_t>(y) * w + x;
+      const float a = inv_image.data()[p];
+      if ((x + 1 < w && std::abs(a - inv_image.data()[p + 1]) > jump) ||
+          (y + 1 < h && std::abs(a - inv_image.data()[p + w]) > jump))
+        neg_edge.data()[p] = -1.0f;
+    }
+  const ImageF band = MinFilter(neg_edge, diameter);
+  for (size_t i = 0; i < n; ++i) near_edge[i] = band.data()[i] < -0.5f;
+  return near_edge;
+}
+
+// What every pixel's relabelling reads.
+struct RelabelContext {
+  const ImageF& color;
+  const ImageF& gray;
+  const std::vector<RefineNeighbor>& neighbors;
+  const std::vector<PlaneHomography>& homs;  // The first K neighbours'.
+  const BoundaryRelabelOptions& options;
+  const float* inv;      // Inverse depth.
+  const float* inv_min;  // Its minimum over the band window.
+  float same;            // One label of inverse depth.
+};
+
+// Relabels the pixels of rows, one at a time, with its own scratch buffers.
+class PixelRelabeller {
+ public:
+  explicit PixelRelabeller(const RelabelContext& c) : c_(c) {
+    const BoundaryRelabelOptions& o = c.options;
+    K_ = static_cast<int>(c.homs.size());
+    r_ = o.window_radius;
+    step_ = o.window_step;
+    // Window samples at multiples of step within r of the centre (the centre
+    // included): `side` per row and column.
+    reach_ = (r_ / step_) * step_;
+    const int side = 2 * (r_ / step_) + 1;
+    inv2s2_ = static_cast<float>(1.0 / (2.0 * o.sigma_color * o.sigma_color));
+    eps_ = static_cast<float>(o.ncc_epsilon);
+    best_k_ = std::min(o.best_k, K_);
+    trunc_ = static_cast<float>(o.occlusion_truncation);
+    tex_s2_ = o.texture_sigma * o.texture_sigma;
+    // The window's samples, padded to a multiple of 8 with zero weights:
+    // the cost's loops run on eight samples at a time.
+    padded_ = (side * side + 7) & ~7;
+    wgt_.assign(padded_, 0.0f);
+    ival_.assign(padded_, 0.0f);
+    sx_.assign(padded_, 0.0f);
+    sy_.assign(padded_, 0.0f);
+    us_.resize(padded_);
+    vs_.resize(padded_);
+    wk_.resize(padded_);
+    jv_.resize(padded_);
+    costs_.resize(K_);
+    // Colours of the samples whose colour weights are computed together.
+    const int band_side = 2 * o.radius / kBandStep + 1;  // Samples along a side of the band window, at most.
+    const size_t max_samples = std::max<size_t>(padded_, static_cast<size_t>(band_side) * band_side);
+    pr_.resize(max_samples);
+    pg_.resize(max_samples);
+    pb_.resize(max_samples);
+    pw_.resize(max_samples);
+    pinv_.resize(max_samples);
+  }
+
+  // Whether band pixel (x, y) takes a farther surface: a candidate that
+  // matches the neighbours better by min_gain; its inverse depth in *inv.
+  bool Relabel(int x, int y, float* inv) {
+    const int w = c_.gray.width();
+    const size_t p = static_cast<size_t>(y) * w + x;
+    // Only a farther surface at least a label away counts: most pixels of
+    // a band are already on that side.
+    const float cur = c_.inv[p];
+    if (cur - c_.inv_min[p] < c_.same) return false;
+    c0_ = &c_.color.at(x, y, 0);
+    if (!ReferenceWindow(x, y)) return false;
+    const float base = Cost(cur);
+    // No candidate can beat a cost below min_gain by min_gain (costs are
+    // >= 0): skip the candidates.
+    if (base < c_.options.min_gain) return false;
+    float cands[2];
+    int num_cands = 0;
+    if (FartherMedian(x, y, cur, &cands[0])) ++num_cands;
+    cands[num_cands++] = c_.inv_min[p];
+    float best_inv = cur, best_cost = base;
+    for (int ci = 0; ci < num_cands; ++ci) {
+      const float cand = cands[ci];
+      if (std::abs(cand - cur) < c_.same) continue;
+      if (ci > 0 && std::abs(cand - cands[0]) < 0.5f * c_.same) continue;
+      const float cost = Cost(cand);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_inv = cand;
+      }
+    }
+    if (!(best_inv != cur && base - best_cost >= c_.options.min_gain && best_inv > 0)) return false;
+    *inv = best_inv;
+    return true;
+  }
+
+ private:
+  static constexpr int kBandStep = 4;  // The band window: every 4th pixel.
+
+  void GatherColor(int i, int u, int v) {
+    const float* c = &c_.color.at(u, v, 0);
+    pr_[i] = c[0];
+    pg_[i] = c[1];
+    pb_[i] = c[2];
+  }
+
+  // The colour-weighted window of the reference: pixel (u, v) weighs
+  // exp(-|c_uv - c_xy|^2 / (2 sigma_color^2)). False if it is too
+  // textureless to judge (below min_texture).
+  bool ReferenceWindow(int x, int y) {
+    const int w = c_.gray.width(), h = c_.gray.height();
+    int m = 0;
+    centre_ = 0;
+    for (int dv = -reach_; dv <= reach_; dv += step_) {
+      const int v = y + dv;
+      if (v < 0 || v >= h) continue;
+      for (int du = -reach_; du <= reach_; du += step_) {
+        const int u = x + du;
+        if (u < 0 || u >= w) continue;
+        if (du == 0 && dv == 0) centre_ = m;
+        GatherColor(m, u, v);
+        ival_[m] = c_.gray.at(u, v);
+        sx_[m] = static_cast<float>(u);
+        sy_[m] = static_cast<float>(v);
+        ++m;
+      }
+    }
+    ColorWeights(pr_.data(), pg_.data(), pb_.data(), m, c0_, inv2s2_, wgt_.data());
+    double si = 0, sii = 0;
+    sw_ = 0;
+    for (int i = 0; i < m; ++i) {
+      sw_ += wgt_[i];
+      si += wgt_[i] * ival_[i];
+      sii += wgt_[i] * ival_[i] * ival_[i];
+    }
+    for (int i = m; i < padded_; ++i) wgt_[i] = ival_[i] = sx_[i] = sy_[i] = 0.0f;
+    m8_ = (m + 7) & ~7;
+    mi_ = si / sw_;
+    vi_ = std::max(0.0, sii / sw_ - mi_ * mi_);
+    return vi_ / (vi_ + tex_s2_) >= c_.options.min_texture;
+  }
+
+  // The matching cost of inverse depth inv_c: the mean of the best_k
+  // neighbours' 1 - weighted ZNCC, each truncated at the best plus
+  // occlusion_truncation; 1 if no neighbour sees the window.
+  float Cost(float inv_c) {
+    int valid = 0;
+    for (int k = 0; k < K_; ++k) {
+      double sums[4];
+      if (!WindowSums(c_.homs[k], *c_.neighbors[k].gray, m8_, centre_, sx_.data(), sy_.data(), wgt_.data(),
+                      ival_.data(), inv_c, us_.data(), vs_.data(), wk_.data(), jv_.data(), sums))
+        continue;
+      const double swk = sums[0], sj = sums[1], sjj = sums[2], sij = sums[3];
+      if (swk < 0.5 * sw_) continue;
+      // Weighted ZNCC over the pixels the neighbour sees.
+      const double mj = sj / swk;
+      const double vj = std::max(0.0, sjj / swk - mj * mj);
+      const double cov = sij / swk - mi_ * mj;
+      const double z = cov / std::sqrt((vi_ + eps_) * (vj + eps_));
+      costs_[valid++] = static_cast<float>(std::min(1.0, std::max(0.0, 1.0 - z)));
+    }
+    if (valid == 0) return 1.0f;
+    std::sort(costs_.begin(), costs_.begin() + valid);
+    const int kk = std::min(best_k_, valid);
+    float s = 0;
+    for (int i = 0; i < kk; ++i) s += std::min(costs_[i], costs_[0] + trunc_);
+    return s / kk;
+  }
+
+  // The colour-weighted median of the farther inverse depths in the band
+  // window (the surface of the pixel's own colour beyond the edge); false if
+  // they weigh too little.
+  bool FartherMedian(int x, int y, float cur, float* median) {
+    const int w = c_.gray.width(), h = c_.gray.height();
+    const int R = c_.options.radius;
+    int ns = 0;
+    for (int v = std::max(0, y - R); v <= std::min(h - 1, y + R); v += kBandStep)
+      for (int u = std::max(0, x - R); u <= std::min(w - 1, x + R); u += kBandStep) {
+        const size_t q = static_cast<size_t>(v) * w + u;
+        if (cur - c_.inv[q] < c_.same) continue;
+        GatherColor(ns, u, v);
+        pinv_[ns++] = c_.inv[q];
+      }
+    ColorWeights(pr_.data(), pg_.data(), pb_.data(), ns, c0_, inv2s2_, pw_.data());
+    samples_.clear();
+    double total = 0;
+    for (int i = 0; i < ns; ++i) {
+      samples_.push_back({pinv_[i], pw_[i]});
+      total += pw_[i];
+    }
+    if (!(total > 0.5)) return false;
+    std::sort(samples_.begin(), samples_.end());
+    double acc = 0;
+    for (const auto& sm : samples_) {
+      acc += sm.second;
+      if (acc >= 0.5 * total) {
+        *median = sm.first;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  const RelabelContext& c_;
+  int K_, r_, step_, reach_, best_k_, padded_;
+  float inv2s2_, eps_, trunc_;
+  double tex_s2_;
+  std::vector<float> wgt_, ival_, sx_, sy_, us_, vs_, wk_, jv_, costs_;
+  std::vector<float> pr_, pg_, pb_, pw_, pinv_;
+  std::vector<std::pair<float, float>> samples_;
+  // The current pixel's reference window.
+  const float* c0_ = nullptr;
+  int centre_ = 0, m8_ = 0;
+  double sw_ = 0, mi_ = 0, vi_ = 0;
+};
+
+}  // namespace
+
+ImageF RelabelBoundaries(const ImageF& color, const ImageF& gray, const PinholeCamera& camera,
+                         const ImageF& depth, const std::vector<RefineNeighbor>& neighbors, double inv_step,
+                         const BoundaryRelabelOptions& options, int num_threads, long long* changed) {
+  const Status st = options.Check();
+  if (!st.ok()) throw std::invalid_argument("boundary relabelling: " + st.message());
+  CheckRelabelInputs(color, gray, camera, depth, neighbors, inv_step);
+  const int w = gray.width(), h = gray.height();
   if (changed) *changed = 0;
   if (!options.enabled || neighbors.empty()) return depth;
   const size_t n = static_cast<size_t>(w) * h;
-  // Inverse depth and its minimum and maximum over the band window.
+  // Inverse depth and its minimum over the band window.
   ImageF inv_image(w, h, 1);
   for (size_t i = 0; i < n; ++i) inv_image.data()[i] = 1.0f / depth.data()[i];
   const int diameter = 2 * options.radius + 1;
   const ImageF min_image = MinFilter(inv_image, diameter);
-  const float* inv = inv_image.data();
-  const float* inv_min = min_image.data();
   const float jump = static_cast<float>(options.min_jump_labels * inv_step);
-  const float same = static_cast<float>(inv_step);
-  // The band: pixels within `radius` of a depth edge, two 4-neighbours
-  // whose inverse depths differ by more than `jump` (the upsampling's
-  // weighted median leaves steps there). A slope spans as much over the band
-  // window but has no such step, and is left alone.
-  std::vector<uint8_t> near_edge(n, 0);
-  {
-    ImageF neg_edge(w, h, 1, 0.0f);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const size_t p = static_cast<size_t>(y) * w + x;
-        const float a = inv_image.data()[p];
-        if ((x + 1 < w && std::abs(a - inv_image.data()[p + 1]) > jump) ||
-            (y + 1 < h && std::abs(a - inv_image.data()[p + w]) > jump))
-          neg_edge.data()[p] = -1.0f;
-      }
-    const ImageF band = MinFilter(neg_edge, diameter);
-    for (size_t i = 0; i < n; ++i) near_edge[i] = band.data()[i] < -0.5f;
-  }
+  const std::vector<uint8_t> near_edge = EdgeBand(inv_image, jump, diameter);
 
   // The first max_neighbors neighbours.
   const int K = std::min(static_cast<int>(neighbors.size()), options.max_neighbors);
   std::vector<PlaneHomography> homs;
   for (int k = 0; k < K; ++k) homs.push_back(ComputePlaneHomography(camera, neighbors[k].camera));
-  const int r = options.window_radius;
-  const int step = options.window_step;
-  // Window samples at multiples of step within r of the centre (the centre
-  // included): `side` per row and column.
-  const int reach = (r / step) * step;
-  const int side = 2 * (r / step) + 1;
-  const float inv2s2 = static_cast<float>(1.0 / (2.0 * options.sigma_color * options.sigma_color));
-  const float eps = static_cast<float>(options.ncc_epsilon);
-  const int best_k = std::min(options.best_k, K);
-  const float trunc = static_cast<float>(options.occlusion_truncation);
-  const double tex_s2 = options.texture_sigma * options.texture_sigma;
-
+  const RelabelContext context{color,           gray,           neighbors, homs, options, inv_image.data(),
+                               min_image.data(), static_cast<float>(inv_step)};
   ImageF out = depth;
   std::vector<long long> changed_rows(h, 0);
   base::ParallelFor(0, h, std::max(1, num_threads), [&](int64_t yy) {
     const int y = static_cast<int>(yy);
-    // The window's samples, padded to a multiple of 8 with zero weights:
-    // the cost's loops run on eight samples at a time.
-    const int padded = (side * side + 7) & ~7;
-    std::vector<float> wgt(padded, 0.0f), ival(padded, 0.0f), sx(padded, 0.0f), sy(padded, 0.0f);
-    std::vector<float> us(padded), vs(padded), wk(padded), jv(padded);
-    std::vector<float> costs(K);
-    std::vector<std::pair<float, float>> samples;
-    // Colours of the samples whose colour weights are computed together.
-    const int R = options.radius, cs = 4;  // The band window: every 4th pixel.
-    const int band_side = 2 * R / cs + 1;  // Samples along a side of the band window, at most.
-    const size_t max_samples = std::max<size_t>(padded, static_cast<size_t>(band_side) * band_side);
-    std::vector<float> pr(max_samples), pg(max_samples), pb(max_samples), pw(max_samples), pinv(max_samples);
+    PixelRelabeller relabeller(context);
     for (int x = 0; x < w; ++x) {
       const size_t p = static_cast<size_t>(y) * w + x;
       if (!near_edge[p]) continue;
-      // Only a farther surface at least a label away counts: most pixels of
-      // a band are already on that side.
-      const float cur = inv[p];
-      if (cur - inv_min[p] < same) continue;
-      // The colour-weighted window of the reference: pixel (u, v) weighs
-      // exp(-|c_uv - c_xy|^2 / (2 sigma_color^2)).
-      const float* c0 = &color.at(x, y, 0);
-      auto gather_color = [&](int i, int u, int v) {
-        const float* c = &color.at(u, v, 0);
-        pr[i] = c[0];
-        pg[i] = c[1];
-        pb[i] = c[2];
-      };
-      int m = 0, centre = 0;
-      for (int dv = -reach; dv <= reach; dv += step) {
-        const int v = y + dv;
-        if (v < 0 || v >= h) continue;
-        for (int du = -reach; du <= reach; du += step) {
-          const int u = x + du;
-          if (u < 0 || u >= w) continue;
-          if (du == 0 && dv == 0) centre = m;
-          gather_color(m, u, v);
-          ival[m] = gray.at(u, v);
-          sx[m] = static_cast<float>(u);
-          sy[m] = static_cast<float>(v);
-          ++m;
-        }
-      }
-      ColorWeights(pr.data(), pg.data(), pb.data(), m, c0, inv2s2, wgt.data());
-      double sw = 0, si = 0, sii = 0;
-      for (int i = 0; i < m; ++i) {
-        sw += wgt[i];
-        si += wgt[i] * ival[i];
-        sii += wgt[i] * ival[i] * ival[i];
-      }
-      for (int i = m; i < padded; ++i) wgt[i] = ival[i] = sx[i] = sy[i] = 0.0f;
-      const int m8 = (m + 7) & ~7;
-      const double mi = si / sw;
-      const double vi = std::max(0.0, sii / sw - mi * mi);
-      if (vi / (vi + tex_s2) < options.min_texture) continue;
-      auto cost_of = [&](float inv_c) {
-        int valid = 0;
-        for (int k = 0; k < K; ++k) {
-          double sums[4];
-          if (!WindowSums(homs[k], *neighbors[k].gray, m8, centre, sx.data(), sy.data(), wgt.data(),
-                          ival.data(), inv_c, us.data(), vs.data(), wk.data(), jv.data(), sums))
-            continue;
-          const double swk = sums[0], sj = sums[1], sjj = sums[2], sij = sums[3];
-          if (swk < 0.5 * sw) continue;
-          // Weighted ZNCC over the pixels the neighbour sees.
-          const double mj = sj / swk;
-          const double vj = std::max(0.0, sjj / swk - mj * mj);
-          const double cov = sij / swk - mi * mj;
-          const double z = cov / std::sqrt((vi + eps) * (vj + eps));
-          costs[valid++] = static_cast<float>(std::min(1.0, std::max(0.0, 1.0 - z)));
-        }
-        if (valid == 0) return 1.0f;
-        std::sort(costs.begin(), costs.begin() + valid);
-        const int kk = std::min(best_k, valid);
-        float s = 0;
-        for (int i = 0; i < kk; ++i) s += std::min(costs[i], costs[0] + trunc);
-        return s / kk;
-      };
-      const float base = cost_of(cur);
-      // No candidate can beat a cost below min_gain by min_gain (costs are
-      // >= 0): skip the candidates.
-      if (base < options.min_gain) continue;
-      // Candidates: the colour-weighted median of the farther depths in the
-      // band window (the surface of the pixel's own colour beyond the edge),
-      // and the farthest depth.
-      float cands[2];
-      int num_cands = 0;
-      {
-        int ns = 0;
-        for (int v = std::max(0, y - R); v <= std::min(h - 1, y + R); v += cs)
-          for (int u = std::max(0, x - R); u <= std::min(w - 1, x + R); u += cs) {
-            const size_t q = static_cast<size_t>(v) * w + u;
-            if (cur - inv[q] < same) continue;
-            gather_color(ns, u, v);
-            pinv[ns++] = inv[q];
-          }
-        ColorWeights(pr.data(), pg.data(), pb.data(), ns, c0, inv2s2, pw.data());
-        samples.clear();
-        double total = 0;
-        for (int i = 0; i < ns; ++i) {
-          samples.push_back({pinv[i], pw[i]});
-          total += pw[i];
-        }
-        if (total > 0.5) {
-          std::sort(samples.begin(), samples.end());
-          double acc = 0;
-          for (const auto& sm : samples) {
-            acc += sm.second;
-            if (acc >= 0.5 * total) {
-              cands[num_cands++] = sm.first;
-              break;
-            }
-          }
-        }
-      }
-      cands[num_cands++] = inv_min[p];
-      float best_inv = cur, best_cost = base;
-      for (int ci = 0; ci < num_cands; ++ci) {
-        const float cand = cands[ci];
-        if (std::abs(cand - cur) < same) continue;
-        if (ci > 0 && std::abs(cand - cands[0]) < 0.5f * same) continue;
-        const float c = cost_of(cand);
-        if (c < best_cost) {
-          best_cost = c;
-          best_inv = cand;
-        }
-      }
-      if (best_inv != cur && base - best_cost >= options.min_gain && best_inv > 0) {
+      float best_inv;
+      if (relabeller.Relabel(x, y, &best_inv)) {
         out.data()[p] = 1.0f / best_inv;
         ++changed_rows[y];
       }

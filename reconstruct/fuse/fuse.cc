@@ -122,11 +122,9 @@ void ClearNode(LayerData* layer, size_t i) {
 
 bool ValidDepth(float d) { return d > 0 && std::isfinite(d); }
 
-}  // namespace
-
-TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options, FuseStats* stats_out) {
-  if (const Status st = options.Check(); !st.ok())
-    throw std::invalid_argument("fuse options: " + st.message());
+// Throws std::invalid_argument unless the four panoramas are present, of one
+// size, 1-channel depth and RGB colour, twice as wide as high.
+void CheckInput(const FuseInput& input) {
   if (!input.front_rgb || !input.front_depth_m || !input.back_rgb || !input.back_depth_m) {
     throw std::invalid_argument("fuse: front and back colour and depth are required");
   }
@@ -142,16 +140,15 @@ TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options, FuseSt
     }
   }
   if (W != 2 * H || W <= 0) throw std::invalid_argument("fuse: panorama width must be 2 * height");
+}
 
-  FuseStats stats;
-  const float tau = static_cast<float>(options.tau_dratio);
-  TwoLayerPanorama pano(W, H);
-  pano.frame() = input.frame;
-  LayerData& F = pano.layer(kFront);
-  LayerData& B = pano.layer(kBack);
-  const size_t n = static_cast<size_t>(W) * H;
-  // Colour of the back stitch where it repeated the front surface (step 1),
-  // used by fringe removal (step 4).
+// Step 1: the nodes of both stitches. Returns, per pixel, 1 where the back
+// stitch repeated the front surface (its colour is used by fringe removal).
+std::vector<uint8_t> PlaceNodes(const FuseInput& input, float tau, TwoLayerPanorama* pano,
+                                FuseStats* stats) {
+  LayerData& F = pano->layer(kFront);
+  LayerData& B = pano->layer(kBack);
+  const size_t n = static_cast<size_t>(pano->width()) * pano->height();
   std::vector<uint8_t> redundant(n, 0);
   auto put = [](LayerData* layer, size_t i, const Image8& rgb, float depth, NodeLabel label) {
     layer->present[i] = 1;
@@ -165,39 +162,41 @@ TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options, FuseSt
     const bool has_front = ValidDepth(df), has_back = ValidDepth(db);
     if (has_front) {
       put(&F, i, *input.front_rgb, df, NodeLabel::kF);
-      ++stats.front_nodes;
+      ++stats->front_nodes;
     }
     if (!has_back) continue;
-    ++stats.back_nodes_in;
+    ++stats->back_nodes_in;
     if (!has_front) {
       put(&F, i, *input.back_rgb, db, NodeLabel::kB);  // Only the back stitch saw it.
     } else if (DepthRatio(df, db) > tau) {
       redundant[i] = 1;  // Step 1.
-      ++stats.back_nodes_redundant;
+      ++stats->back_nodes_redundant;
     } else if (db > df) {
       put(&B, i, *input.back_rgb, db, NodeLabel::kB);
     }
   }
+  return redundant;
+}
 
-  // Step 2: connectivity of every edge (right and down cover all of them).
-  Graph graph(&pano, options);
-  for (int y = 0; y < H; ++y) {
-    for (int x = 0; x < W; ++x) {
-      graph.ConnectEdge(x, y, kRight);
-      graph.ConnectEdge(x, y, kDown);
-    }
-  }
+// A node that spreads to its unlinked neighbours in the next ring.
+struct Spawner {
+  size_t pixel;
+  int layer;
+};
 
-  // Step 3: grow the back layer one ring at a time.
-  const int rings = static_cast<int>(std::lround(options.expansion_fraction * W));
-  struct Spawner {
-    size_t pixel;
-    int layer;
-  };
+// Step 3: grows the back layer one ring at a time, `rings` rings: a pixel with
+// a front node and no back node takes the mean depth and colour of the
+// unlinked nodes beside it that lie clearly behind its front node, and keeps
+// it only if it links to a neighbour.
+void GrowBackLayer(int rings, float tau, Graph* graph, TwoLayerPanorama* pano, FuseStats* stats) {
+  const int W = pano->width();
+  LayerData& F = pano->layer(kFront);
+  LayerData& B = pano->layer(kBack);
+  const size_t n = static_cast<size_t>(W) * pano->height();
   std::vector<Spawner> frontier;
   for (size_t i = 0; i < n; ++i) {
     for (int l = 0; l < kNumLayers; ++l) {
-      if (pano.layer(l).present[i]) frontier.push_back({i, l});
+      if (pano->layer(l).present[i]) frontier.push_back({i, l});
     }
   }
   std::vector<float> sum_depth(n, 0.0f), sum_rgb(3 * n, 0.0f);
@@ -207,13 +206,13 @@ TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options, FuseSt
     touched.clear();
     for (const Spawner& s : frontier) {
       const int x = static_cast<int>(s.pixel % W), y = static_cast<int>(s.pixel / W);
-      const LayerData& layer = pano.layer(s.layer);
+      const LayerData& layer = pano->layer(s.layer);
       for (int d = 0; d < kNumDirections; ++d) {
         const Direction dir = static_cast<Direction>(d);
         if (GetLink(layer.links[s.pixel], dir) != Link::kNone) continue;
         int nx, ny;
-        if (!pano.Neighbour(x, y, dir, &nx, &ny)) continue;
-        const size_t q = pano.index(nx, ny);
+        if (!pano->Neighbour(x, y, dir, &nx, &ny)) continue;
+        const size_t q = pano->index(nx, ny);
         if (!F.present[q] || B.present[q]) continue;
         // Only a candidate clearly behind q's front node can be kept.
         const float ds = layer.depth_m[s.pixel];
@@ -242,58 +241,99 @@ TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options, FuseSt
       for (int c = 0; c < 3; ++c) B.rgb[3 * q + c] = rgb[c];
       B.label[q] = static_cast<uint8_t>(NodeLabel::kB);
       const int x = static_cast<int>(q % W), y = static_cast<int>(q / W);
-      graph.ConnectAround(x, y);
+      graph->ConnectAround(x, y);
       // Keep the candidate only if it links to a neighbour: an unlinked one
       // would be an isolated fragment of hallucinated surface.
       if (B.links[q] == 0) {
         ClearNode(&B, q);
-        graph.ConnectAround(x, y);
+        graph->ConnectAround(x, y);
         continue;
       }
-      ++stats.back_nodes_hallucinated;
+      ++stats->back_nodes_hallucinated;
       next.push_back({q, kBack});
     }
     frontier.swap(next);
   }
+}
 
-  // Step 4: spread the B label from B nodes onto linked front nodes.
-  const int fringe_rings = static_cast<int>(std::lround(options.fringe_fraction * W));
+// Step 4: spreads the B label from B nodes onto linked front nodes, `rings`
+// rings; a relabelled front node where the back stitch repeated it
+// (`redundant`) takes the back stitch's colour.
+void SpreadBackLabel(int rings, const std::vector<uint8_t>& redundant, const Image8& back_rgb,
+                     TwoLayerPanorama* pano, FuseStats* stats) {
+  const int W = pano->width();
+  LayerData& F = pano->layer(kFront);
+  const LayerData& B = pano->layer(kBack);
+  const size_t n = static_cast<size_t>(W) * pano->height();
   std::vector<Spawner> wave;
   for (size_t i = 0; i < n; ++i) {
     if (B.present[i]) wave.push_back({i, kBack});
     if (F.present[i] && F.label[i] == static_cast<uint8_t>(NodeLabel::kB)) wave.push_back({i, kFront});
   }
-  for (int ring = 0; ring < fringe_rings && !wave.empty(); ++ring) {
+  for (int ring = 0; ring < rings && !wave.empty(); ++ring) {
     std::vector<Spawner> next;
     for (const Spawner& s : wave) {
       const int x = static_cast<int>(s.pixel % W), y = static_cast<int>(s.pixel / W);
-      const uint8_t links = pano.layer(s.layer).links[s.pixel];
+      const uint8_t links = pano->layer(s.layer).links[s.pixel];
       for (int d = 0; d < kNumDirections; ++d) {
         if (GetLink(links, static_cast<Direction>(d)) != Link::kFront) continue;
         int nx, ny;
-        if (!pano.Neighbour(x, y, static_cast<Direction>(d), &nx, &ny)) continue;
-        const size_t q = pano.index(nx, ny);
+        if (!pano->Neighbour(x, y, static_cast<Direction>(d), &nx, &ny)) continue;
+        const size_t q = pano->index(nx, ny);
         if (F.label[q] == static_cast<uint8_t>(NodeLabel::kB)) continue;
         F.label[q] = static_cast<uint8_t>(NodeLabel::kB);
-        ++stats.front_nodes_relabelled;
+        ++stats->front_nodes_relabelled;
         if (redundant[q]) {
-          for (int c = 0; c < 3; ++c) F.rgb[3 * q + c] = input.back_rgb->data()[3 * q + c];
+          for (int c = 0; c < 3; ++c) F.rgb[3 * q + c] = back_rgb.data()[3 * q + c];
         }
         next.push_back({q, kFront});
       }
     }
     wave.swap(next);
   }
+}
 
+// Undirected links of both layers, each counted once (from its right and
+// down ends).
+int64_t CountLinks(const TwoLayerPanorama& pano) {
+  const size_t n = static_cast<size_t>(pano.width()) * pano.height();
+  int64_t links = 0;
   for (int l = 0; l < kNumLayers; ++l) {
     const LayerData& layer = pano.layer(l);
     for (size_t i = 0; i < n; ++i) {
       if (!layer.present[i]) continue;
-      // Count each undirected link once: from its right and down ends.
-      stats.links += GetLink(layer.links[i], kRight) != Link::kNone;
-      stats.links += GetLink(layer.links[i], kDown) != Link::kNone;
+      links += GetLink(layer.links[i], kRight) != Link::kNone;
+      links += GetLink(layer.links[i], kDown) != Link::kNone;
     }
   }
+  return links;
+}
+
+}  // namespace
+
+TwoLayerPanorama Fuse(const FuseInput& input, const FuseOptions& options, FuseStats* stats_out) {
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("fuse options: " + st.message());
+  CheckInput(input);
+  const int W = input.front_depth_m->width(), H = input.front_depth_m->height();
+  FuseStats stats;
+  const float tau = static_cast<float>(options.tau_dratio);
+  TwoLayerPanorama pano(W, H);
+  pano.frame() = input.frame;
+  const std::vector<uint8_t> redundant = PlaceNodes(input, tau, &pano, &stats);
+
+  // Step 2: connectivity of every edge (right and down cover all of them).
+  Graph graph(&pano, options);
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      graph.ConnectEdge(x, y, kRight);
+      graph.ConnectEdge(x, y, kDown);
+    }
+  }
+  GrowBackLayer(static_cast<int>(std::lround(options.expansion_fraction * W)), tau, &graph, &pano, &stats);
+  SpreadBackLabel(static_cast<int>(std::lround(options.fringe_fraction * W)), redundant, *input.back_rgb,
+                  &pano, &stats);
+  stats.links += CountLinks(pano);
   if (stats_out) *stats_out = stats;
   return pano;
 }

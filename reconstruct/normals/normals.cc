@@ -103,16 +103,11 @@ Eigen::Matrix3f MinimalRotation(const Vec3& a, const Vec3& b) {
   return Eigen::Quaternionf::FromTwoVectors(a, b).toRotationMatrix();
 }
 
-}  // namespace
-
-NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options) {
-  if (const Status st = options.Check(); !st.ok())
-    throw std::invalid_argument("normal options: " + st.message());
-  const NodeGraph g = BuildGraph(*pano);
+// 1. Forward-difference normals, oriented towards the centre, then smoothed
+// over the link graph (Eq. 5, binary weights):
+// x_i = (w_i x'_i + s sum_j x_j) / (w_i + s deg_i).
+std::vector<Vec3> SmoothBaseNormals(const NodeGraph& g, const NormalOptions& options) {
   const size_t num_nodes = 2 * g.n;
-  NormalStats stats;
-
-  // 1. Forward-difference normals, oriented towards the centre.
   std::vector<Vec3> raw(num_nodes, Vec3::Zero());
   std::vector<float> weight(num_nodes, 0.0f);
   ParallelNodes(num_nodes, [&](size_t node) {
@@ -128,7 +123,6 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
     weight[node] = 1.0f;
   });
 
-  // Smoothing (Eq. 5, binary weights): x_i = (w_i x'_i + s sum_j x_j) / (w_i + s deg_i).
   const float s = static_cast<float>(options.smoothness);
   std::vector<Vec3> base = raw, next(num_nodes, Vec3::Zero());
   for (int it = 0; it < options.iterations; ++it) {
@@ -146,11 +140,15 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
     });
     base.swap(next);
   }
+  return base;
+}
 
-  // 2. Detail: high-pass luminance over the link graph (a graph box blur
-  // repeated detail_radius times), then its gradient along the links.
+// 2. Detail: the luminance's low pass over the link graph (a graph box blur
+// repeated detail_radius times); the detail is luminance minus this.
+std::vector<float> LowPassLuminance(const NodeGraph& g, int detail_radius) {
+  const size_t num_nodes = 2 * g.n;
   std::vector<float> low = g.luminance, low_next(num_nodes, 0.0f);
-  for (int it = 0; it < options.detail_radius; ++it) {
+  for (int it = 0; it < detail_radius; ++it) {
     ParallelNodes(num_nodes, [&](size_t node) {
       if (!g.present[node]) return;
       float sum = low[node];
@@ -166,6 +164,14 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
     });
     low.swap(low_next);
   }
+  return low;
+}
+
+// 3. Combine (Eq. 14 to 16): each node's base normal tilted by the gradient of
+// the luminance detail along the links.
+std::vector<Vec3> CombineWithDetail(const NodeGraph& g, const std::vector<Vec3>& base,
+                                    const std::vector<float>& low, const NormalOptions& options) {
+  const size_t num_nodes = 2 * g.n;
   auto detail = [&](int64_t node) { return g.luminance[node] - low[node]; };
   auto derivative = [&](size_t node, int forward, int backward) {
     const int64_t f = g.next(node, forward), b = g.next(node, backward);
@@ -174,8 +180,6 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
     if (b >= 0) return detail(node) - detail(b);
     return 0.0f;
   };
-
-  // 3. Combine (Eq. 14 to 16) and 4. write, leaving sky for below.
   const float k = static_cast<float>(options.detail_strength);
   std::vector<Vec3> result(num_nodes, Vec3::Zero());
   ParallelNodes(num_nodes, [&](size_t node) {
@@ -204,64 +208,91 @@ NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options)
     }
     result[node] = n;
   });
+  return result;
+}
 
-  // 4. Sky: far, untextured front nodes connected to the top of the content.
+// Sky candidates: front nodes beyond `far` whose luminance spread over the
+// pixel and its linked neighbours is at most sky_max_texture, and whose colour
+// is bluish or bright.
+std::vector<uint8_t> SkyCandidates(const NodeGraph& g, const LayerData& front, float far,
+                                   const NormalOptions& options) {
+  std::vector<uint8_t> candidate(g.n, 0);
+  for (size_t i = 0; i < g.n; ++i) {
+    if (!front.present[i] || front.depth_m[i] < far) continue;
+    // Texture: luminance spread over the pixel and its linked neighbours.
+    float sum = g.luminance[i], sum2 = sum * sum;
+    int count = 1;
+    for (int d = 0; d < kNumDirections; ++d) {
+      const int64_t j = g.next(i, d);
+      if (j < 0) continue;
+      sum += g.luminance[j];
+      sum2 += g.luminance[j] * g.luminance[j];
+      ++count;
+    }
+    const float mean = sum / count;
+    const float var = std::max(0.0f, sum2 / count - mean * mean);
+    const uint8_t* c = &front.rgb[3 * i];
+    const bool sky_color = c[2] >= c[0] || mean > 0.6f;
+    candidate[i] = std::sqrt(var) <= options.sky_max_texture && sky_color;
+  }
+  return candidate;
+}
+
+// 4. Sky: far, untextured front nodes connected to the top of the content
+// (1 per pixel).
+std::vector<uint8_t> DetectSky(const NodeGraph& g, const TwoLayerPanorama& pano,
+                               const NormalOptions& options) {
   std::vector<uint8_t> sky(g.n, 0);
-  if (options.detect_sky) {
-    std::vector<float> depths;
-    depths.reserve(g.n);
-    const LayerData& front = pano->layer(kFront);
-    for (size_t i = 0; i < g.n; ++i)
-      if (front.present[i]) depths.push_back(front.depth_m[i]);
-    if (!depths.empty()) {
-      const size_t k99 = depths.size() * 99 / 100;
-      std::nth_element(depths.begin(), depths.begin() + k99, depths.end());
-      const float far = depths[k99] * static_cast<float>(options.sky_depth_fraction);
-      std::vector<uint8_t> candidate(g.n, 0);
-      for (size_t i = 0; i < g.n; ++i) {
-        if (!front.present[i] || front.depth_m[i] < far) continue;
-        // Texture: luminance spread over the pixel and its linked neighbours.
-        float sum = g.luminance[i], sum2 = sum * sum;
-        int count = 1;
-        for (int d = 0; d < kNumDirections; ++d) {
-          const int64_t j = g.next(i, d);
-          if (j < 0) continue;
-          sum += g.luminance[j];
-          sum2 += g.luminance[j] * g.luminance[j];
-          ++count;
-        }
-        const float mean = sum / count;
-        const float var = std::max(0.0f, sum2 / count - mean * mean);
-        const uint8_t* c = &front.rgb[3 * i];
-        const bool sky_color = c[2] >= c[0] || mean > 0.6f;
-        candidate[i] = std::sqrt(var) <= options.sky_max_texture && sky_color;
-      }
-      // Flood fill from candidates at the top of the content (no front node above).
-      std::vector<size_t> stack;
-      for (size_t i = 0; i < g.n; ++i) {
-        const size_t y = i / g.width;
-        if (candidate[i] && (y == 0 || !front.present[i - g.width])) {
-          sky[i] = 1;
-          stack.push_back(i);
-        }
-      }
-      while (!stack.empty()) {
-        const size_t i = stack.back();
-        stack.pop_back();
-        const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
-        for (int d = 0; d < kNumDirections; ++d) {
-          int nx, ny;
-          if (!pano->Neighbour(x, y, static_cast<Direction>(d), &nx, &ny)) continue;
-          const size_t j = pano->index(nx, ny);
-          if (candidate[j] && !sky[j]) {
-            sky[j] = 1;
-            stack.push_back(j);
-          }
-        }
+  if (!options.detect_sky) return sky;
+  std::vector<float> depths;
+  depths.reserve(g.n);
+  const LayerData& front = pano.layer(kFront);
+  for (size_t i = 0; i < g.n; ++i)
+    if (front.present[i]) depths.push_back(front.depth_m[i]);
+  if (depths.empty()) return sky;
+  const size_t k99 = depths.size() * 99 / 100;
+  std::nth_element(depths.begin(), depths.begin() + k99, depths.end());
+  const float far = depths[k99] * static_cast<float>(options.sky_depth_fraction);
+  const std::vector<uint8_t> candidate = SkyCandidates(g, front, far, options);
+  // Flood fill from candidates at the top of the content (no front node above).
+  std::vector<size_t> stack;
+  for (size_t i = 0; i < g.n; ++i) {
+    const size_t y = i / g.width;
+    if (candidate[i] && (y == 0 || !front.present[i - g.width])) {
+      sky[i] = 1;
+      stack.push_back(i);
+    }
+  }
+  while (!stack.empty()) {
+    const size_t i = stack.back();
+    stack.pop_back();
+    const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
+    for (int d = 0; d < kNumDirections; ++d) {
+      int nx, ny;
+      if (!pano.Neighbour(x, y, static_cast<Direction>(d), &nx, &ny)) continue;
+      const size_t j = pano.index(nx, ny);
+      if (candidate[j] && !sky[j]) {
+        sky[j] = 1;
+        stack.push_back(j);
       }
     }
   }
+  return sky;
+}
 
+}  // namespace
+
+NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options) {
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("normal options: " + st.message());
+  const NodeGraph g = BuildGraph(*pano);
+  const std::vector<Vec3> base = SmoothBaseNormals(g, options);
+  const std::vector<float> low = LowPassLuminance(g, options.detail_radius);
+  const std::vector<Vec3> result = CombineWithDetail(g, base, low, options);
+  const std::vector<uint8_t> sky = DetectSky(g, *pano, options);
+
+  // Write the normals; sky nodes are unlit (0, 0, 0).
+  NormalStats stats;
   for (int l = 0; l < kNumLayers; ++l) {
     LayerData& layer = pano->layer(l);
     for (size_t i = 0; i < g.n; ++i) {

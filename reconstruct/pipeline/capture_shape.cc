@@ -140,51 +140,22 @@ std::string NameRuns(const std::vector<std::string>& names, const std::vector<st
   return out;
 }
 
-CaptureShape MeasureCaptureShape(const geometry::SparseModel& model, const PanoramaFrame& frame,
-                                 const std::vector<std::string>& unregistered, bool metric,
-                                 const CaptureShapeOptions& options) {
-  if (const Status st = options.Check(); !st.ok()) throw std::invalid_argument("capture shape options: " + st.message());
-  CaptureShape s;
-  s.metric = metric;
-  s.unregistered = unregistered;
-  std::sort(s.unregistered.begin(), s.unregistered.end());
+namespace {
 
-  // Registered photos in name order, with their cameras.
-  std::vector<const geometry::ModelImage*> images;
-  for (const auto& [id, image] : model.images) {
-    if (model.cameras.count(image.camera_id)) images.push_back(&image);
-  }
-  std::sort(images.begin(), images.end(),
-            [](const auto* a, const auto* b) { return a->name < b->name; });
-  const int n = static_cast<int>(images.size());
-  s.num_registered = n;
-  s.num_photos = n + static_cast<int>(s.unregistered.size());
-  std::vector<std::string> order;
-  for (const auto* image : images) order.push_back(image->name);
-  order.insert(order.end(), s.unregistered.begin(), s.unregistered.end());
-  std::sort(order.begin(), order.end());
-  if (n == 0) {
-    AddAdvice(order, &s);
-    return s;
-  }
-
-  std::vector<CoverageView> views;
-  std::map<int, int> index_of;  // image_id -> index in `images`.
-  for (int i = 0; i < n; ++i) {
-    views.push_back({model.cameras.at(images[i]->camera_id).PinholePart(), images[i]->pose});
-    index_of[images[i]->image_id] = i;
-  }
-
-  // Where the cameras were: spread, extent, off-axis distances from the
-  // pivot.
-  s.spread = CameraSpread(views, frame);
+// Where the cameras were: spread, extent, the pivot the optical axes meet
+// at, off-axis distances from it, and whether the camera turned about it,
+// walked around the subject or along it.
+void MeasureCameraCentres(const std::vector<CoverageView>& views, const PanoramaFrame& frame,
+                          const CaptureShapeOptions& options, CaptureShape* s) {
+  const int n = static_cast<int>(views.size());
+  s->spread = CameraSpread(views, frame);
   std::vector<Eigen::Vector3d> centres, axes;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (int i = 0; i < n; ++i) {
     centres.push_back(views[i].pose.Center());
     axes.push_back(views[i].pose.R().row(2).transpose());
     mean += centres.back() / n;
-    for (int j = 0; j < i; ++j) s.extent = std::max(s.extent, (centres[i] - centres[j]).norm());
+    for (int j = 0; j < i; ++j) s->extent = std::max(s->extent, (centres[i] - centres[j]).norm());
   }
   // The pivot: the point nearest (least squares) to every optical axis's
   // line, pulled slightly towards the mean centre so that parallel axes
@@ -207,25 +178,31 @@ CaptureShape MeasureCaptureShape(const geometry::SparseModel& model, const Panor
     ahead += (pivot - centres[i]).dot(axes[i]) / n;
     for (int j = 0; j < i; ++j) axis_span = std::min(axis_span, axes[i].dot(axes[j]));
   }
-  s.turned = ahead <= 0 && (pivot - mean).norm() <= s.extent;
+  s->turned = ahead <= 0 && (pivot - mean).norm() <= s->extent;
   std::vector<double> off_axis;
   for (int i = 0; i < n; ++i) {
-    if (!s.turned) {
+    if (!s->turned) {
       off_axis.push_back((centres[i] - mean).norm());
       continue;
     }
     const Eigen::Vector3d offset = centres[i] - pivot;
     off_axis.push_back((offset - std::max(0.0, offset.dot(axes[i])) * axes[i]).norm());
   }
-  s.off_axis = Quantile(&off_axis, options.off_axis_percentile);
-  s.axis_span_deg = std::acos(std::clamp(axis_span, -1.0, 1.0)) * 180.0 / kPi;
+  s->off_axis = Quantile(&off_axis, options.off_axis_percentile);
+  s->axis_span_deg = std::acos(std::clamp(axis_span, -1.0, 1.0)) * 180.0 / kPi;
   // Axes that meet ahead of the cameras from directions far apart: the
   // camera walked around the subject.
-  s.around = !s.turned && ahead > 0 && s.axis_span_deg >= 30.0;
+  s->around = !s->turned && ahead > 0 && s->axis_span_deg >= 30.0;
+}
 
-  // Near depth: camera-frame depths of every observation.
+// Near depth: a low percentile of the camera-frame depths of every
+// observation; with it, whether the camera walked.
+void MeasureNearDepth(const geometry::SparseModel& model,
+                      const std::vector<const geometry::ModelImage*>& images,
+                      const std::vector<CoverageView>& views, const CaptureShapeOptions& options,
+                      CaptureShape* s) {
   std::vector<double> depths;
-  for (int i = 0; i < n; ++i) {
+  for (size_t i = 0; i < images.size(); ++i) {
     const Eigen::Matrix3d R = views[i].pose.R();
     for (const geometry::Observation2D& o : images[i]->points2d) {
       if (o.point3d_id == geometry::kInvalidPoint3DId) continue;
@@ -235,14 +212,19 @@ CaptureShape MeasureCaptureShape(const geometry::SparseModel& model, const Panor
       if (z > 0) depths.push_back(z);
     }
   }
-  s.near_depth = Quantile(&depths, options.near_percentile);
-  if (s.near_depth > 0) {
-    s.off_axis_over_near = s.off_axis / s.near_depth;
-    s.spread_over_near = s.spread / s.near_depth;
+  s->near_depth = Quantile(&depths, options.near_percentile);
+  if (s->near_depth > 0) {
+    s->off_axis_over_near = s->off_axis / s->near_depth;
+    s->spread_over_near = s->spread / s->near_depth;
   }
-  s.walked = s.near_depth > 0 && s.off_axis_over_near > options.max_off_axis_over_near;
+  s->walked = s->near_depth > 0 && s->off_axis_over_near > options.max_off_axis_over_near;
+}
 
-  // Coverage of the sphere of directions.
+// Coverage of the sphere of directions: by all photos, by the median photo,
+// and whether they all look one way.
+void MeasureCoverage(const std::vector<CoverageView>& views, const CaptureShapeOptions& options,
+                     CaptureShape* s) {
+  const int n = static_cast<int>(views.size());
   const std::vector<Eigen::Vector3d> dirs = SphereDirections(options.sphere_samples);
   std::vector<uint8_t> seen(dirs.size(), 0);
   std::vector<double> photo_fractions;
@@ -256,11 +238,19 @@ CaptureShape MeasureCaptureShape(const geometry::SparseModel& model, const Panor
     }
     photo_fractions.push_back(static_cast<double>(count) / dirs.size());
   }
-  s.sphere_fraction = static_cast<double>(std::count(seen.begin(), seen.end(), 1)) / dirs.size();
-  s.photo_sphere_fraction = Quantile(&photo_fractions, 0.5);
-  s.narrow = n > 1 && s.sphere_fraction < options.min_sweep * s.photo_sphere_fraction;
+  s->sphere_fraction = static_cast<double>(std::count(seen.begin(), seen.end(), 1)) / dirs.size();
+  s->photo_sphere_fraction = Quantile(&photo_fractions, 0.5);
+  s->narrow = n > 1 && s->sphere_fraction < options.min_sweep * s->photo_sphere_fraction;
+}
 
-  // Overlap: points shared by each pair of photos, groups of linked photos.
+// Overlap: points shared by each pair of photos, and the groups of linked
+// photos (largest first) with the strongest link of each other group to the
+// largest.
+void GroupLinkedPhotos(const geometry::SparseModel& model,
+                       const std::vector<const geometry::ModelImage*>& images,
+                       const std::map<int, int>& index_of, const CaptureShapeOptions& options,
+                       CaptureShape* s) {
+  const int n = static_cast<int>(images.size());
   std::vector<int> shared(static_cast<size_t>(n) * n, 0), points(n, 0);
   std::vector<int> seen_by;
   for (const auto& [id, point] : model.points) {
@@ -296,13 +286,55 @@ CaptureShape MeasureCaptureShape(const geometry::SparseModel& model, const Panor
   for (size_t g = 0; g < groups.size(); ++g) {
     std::vector<std::string> names;
     for (int i : groups[g]) names.push_back(images[i]->name);
-    s.groups.push_back(names);
+    s->groups.push_back(names);
     if (g == 0) continue;
     int most = 0;
     for (int i : groups[g])
       for (int j : groups[0]) most = std::max(most, shared[size_t(i) * n + j]);
-    s.group_links.push_back(most);
+    s->group_links.push_back(most);
   }
+}
+
+}  // namespace
+
+CaptureShape MeasureCaptureShape(const geometry::SparseModel& model, const PanoramaFrame& frame,
+                                 const std::vector<std::string>& unregistered, bool metric,
+                                 const CaptureShapeOptions& options) {
+  if (const Status st = options.Check(); !st.ok()) throw std::invalid_argument("capture shape options: " + st.message());
+  CaptureShape s;
+  s.metric = metric;
+  s.unregistered = unregistered;
+  std::sort(s.unregistered.begin(), s.unregistered.end());
+
+  // Registered photos in name order, with their cameras.
+  std::vector<const geometry::ModelImage*> images;
+  for (const auto& [id, image] : model.images) {
+    if (model.cameras.count(image.camera_id)) images.push_back(&image);
+  }
+  std::sort(images.begin(), images.end(),
+            [](const auto* a, const auto* b) { return a->name < b->name; });
+  const int n = static_cast<int>(images.size());
+  s.num_registered = n;
+  s.num_photos = n + static_cast<int>(s.unregistered.size());
+  std::vector<std::string> order;
+  for (const auto* image : images) order.push_back(image->name);
+  order.insert(order.end(), s.unregistered.begin(), s.unregistered.end());
+  std::sort(order.begin(), order.end());
+  if (n == 0) {
+    AddAdvice(order, &s);
+    return s;
+  }
+
+  std::vector<CoverageView> views;
+  std::map<int, int> index_of;  // image_id -> index in `images`.
+  for (int i = 0; i < n; ++i) {
+    views.push_back({model.cameras.at(images[i]->camera_id).PinholePart(), images[i]->pose});
+    index_of[images[i]->image_id] = i;
+  }
+  MeasureCameraCentres(views, frame, options, &s);
+  MeasureNearDepth(model, images, views, options, &s);
+  MeasureCoverage(views, options, &s);
+  GroupLinkedPhotos(model, images, index_of, options, &s);
   AddAdvice(order, &s);
   return s;
 }

@@ -66,28 +66,13 @@ double ParallaxDeg(const Vec3d& dir, double depth, const Vec3d& camera) {
   return std::acos(std::clamp(c, -1.0, 1.0)) * kRadToDeg;
 }
 
-StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
-                          const std::vector<warp::WarpedView>& coarse,
-                          const std::vector<ViewGeometry>& views, int pano_width,
-                          const StitchedLayer* front, const StitchOptions& options) {
-  if (const Status st = options.Check(); !st.ok())
-    throw std::invalid_argument("stitch options: " + st.message());
-  if (full.size() != coarse.size() || full.size() != views.size() || full.empty()) {
-    throw std::invalid_argument("stitch: full, coarse warps and views must be equally many (>0)");
-  }
-  if (full.size() > 32000) throw std::invalid_argument("stitch: more than 32000 photos");
-  const int sw = options.solve_width, sh = options.solve_height;
-  const int W = pano_width, H = pano_width / 2;
-  const int L = static_cast<int>(full.size());
-  const int n = sw * sh;
-
-  CoarseStack stack;
-  FillStack(coarse, back, sw, sh, &stack);
-  // Any-surface depths for the back layer's consistency check.
-  CoarseStack front_stack;
-  if (back) FillStack(coarse, false, sw, sh, &front_stack);
-
-  GridMrf mrf(sw, sh, L, /*wrap_x=*/true);
+// The data term of every label at every solve pixel (Sec. 4.4.2): stretch,
+// parallax and, with lambda_gc, too few other photos agreeing on the depth.
+// `front` (back layer only): a label nearer than the front layer is invalid.
+void SetDataCosts(bool back, const CoarseStack& stack, const CoarseStack& front_stack,
+                  const std::vector<ViewGeometry>& views, const StitchedLayer* front,
+                  const StitchOptions& options, GridMrf* mrf) {
+  const int sw = stack.width, sh = stack.height, L = stack.num_labels;
   const float tol = static_cast<float>(options.gc_depth_tolerance);
   base::ParallelFor(0, sh, base::ResolveThreads(0), [&](int64_t y64) {
     const int y = static_cast<int>(y64);
@@ -117,27 +102,184 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
           cost += options.lambda_gc *
                   std::max(0.0, 1.0 - static_cast<double>(support) / options.gc_min_support);
         }
-        mrf.data_cost(p, l) = static_cast<float>(cost);
+        mrf->data_cost(p, l) = static_cast<float>(cost);
       }
     }
   });
+}
 
+// The seam cost of labels a and b on the solve pixels p and q: colour and
+// log-depth differences of the two warps there, or lambda_seam_invalid where
+// either lacks a depth.
+float SeamCost(const CoarseStack& stack, const StitchOptions& options, float inv_scale, int p, int q,
+               int a, int b) {
+  const size_t ap = stack.at(a, p), bp = stack.at(b, p), aq = stack.at(a, q), bq = stack.at(b, q);
+  if (!(stack.depth[ap] > 0 && stack.depth[bp] > 0 && stack.depth[aq] > 0 &&
+        stack.depth[bq] > 0)) {
+    return static_cast<float>(options.lambda_seam_invalid);
+  }
+  int color = 0;
+  for (int c = 0; c < 3; ++c) {
+    color += std::abs(stack.rgb[3 * ap + c] - stack.rgb[3 * bp + c]) +
+             std::abs(stack.rgb[3 * aq + c] - stack.rgb[3 * bq + c]);
+  }
+  const float depth = std::abs(stack.log_depth[ap] - stack.log_depth[bp]) +
+                      std::abs(stack.log_depth[aq] - stack.log_depth[bq]);
+  return static_cast<float>(options.lambda_seam_color) * color / (6.0f * 255.0f) +
+         static_cast<float>(options.lambda_seam_depth) * std::min(1.0f, 0.5f * depth * inv_scale);
+}
+
+// One layer's full-resolution warps, as the label upsampling and the blending
+// read them.
+struct FullWarps {
+  bool back;
+  const std::vector<warp::WarpedView>& full;
+  int width;  // Of the panorama.
+  double back_tolerance;
+
+  const warp::WarpedLayer& layer(int l) const { return back ? full[l].back : full[l].front; }
+  // Whether label l's warp has a depth at pixel (x, y) (its crop coordinates
+  // in lx, ly) that this layer may take: for the back layer, not nearer than
+  // the front.
+  bool Usable(int l, int x, int y, float front_depth, int* lx, int* ly) const {
+    const warp::WarpedLayer& w = layer(l);
+    if (!w.ToCrop(x, y, width, lx, ly)) return false;
+    const float d = w.depth_m.at(*lx, *ly);
+    if (!(d > 0)) return false;
+    return !(back && front_depth > 0 && d < front_depth * (1.0 - back_tolerance));
+  }
+};
+
+// Edge-aware label upsampling of pixel (x, y): among the labels of the nearby
+// solve-resolution pixels, the one whose full-resolution warp best matches
+// the colours those pixels show, weighted by distance; where none reaches the
+// pixel, the least stretched usable warp; -1 if no warp is usable.
+int UpsampleLabel(const FullWarps& warps, const StitchedLayer& out, const Image8& solve_rgb, int x, int y,
+                  float front_depth, const StitchOptions& options, std::vector<int>* candidates,
+                  std::vector<double>* scores) {
+  const int sw = out.solve_label.width(), sh = out.solve_label.height();
+  const double scale = static_cast<double>(sw) / warps.width;
+  const int r = options.upsample_radius;
+  const double inv_two_sigma2 =
+      1.0 / (2.0 * options.upsample_sigma_color * options.upsample_sigma_color);
+  const double fy = (y + 0.5) * scale - 0.5;
+  const int cy0 = static_cast<int>(std::lround(fy));
+  const double fx = (x + 0.5) * scale - 0.5;
+  const int cx0 = static_cast<int>(std::lround(fx));
+  candidates->clear();
+  scores->clear();
+  for (int dy = -r; dy <= r; ++dy) {
+    const int qy = cy0 + dy;
+    if (qy < 0 || qy >= sh) continue;
+    for (int dx = -r; dx <= r; ++dx) {
+      const int qx = WrapColumn(cx0 + dx, sw);
+      const int l = out.solve_label.at(qx, qy);
+      if (l < 0) continue;
+      const warp::WarpedLayer& layer = warps.layer(l);
+      int lx, ly;
+      if (!warps.Usable(l, x, y, front_depth, &lx, &ly)) continue;
+      double diff2 = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double e = layer.rgb.at(lx, ly, c) - solve_rgb.at(qx, qy, c);
+        diff2 += e * e;
+      }
+      const double ddx = (cx0 + dx) - fx, ddy = qy - fy;
+      // Stretched fragments (depth-edge triangles) almost never win.
+      const double w = std::exp(-(ddx * ddx + ddy * ddy) * 0.5) *
+                       std::exp(-diff2 / 3.0 * inv_two_sigma2) *
+                       std::exp(-kUpsampleStretchWeight * layer.stretch.at(lx, ly));
+      auto it = std::find(candidates->begin(), candidates->end(), l);
+      if (it == candidates->end()) {
+        candidates->push_back(l);
+        scores->push_back(w + 1e-12);
+      } else {
+        (*scores)[it - candidates->begin()] += w;
+      }
+    }
+  }
+  int best = -1;
+  double best_score = -1;
+  for (size_t i = 0; i < candidates->size(); ++i) {
+    if ((*scores)[i] > best_score) {
+      best_score = (*scores)[i];
+      best = (*candidates)[i];
+    }
+  }
+  if (best >= 0) return best;
+  // No nearby label reaches this pixel: take the least stretched warp.
+  float best_stretch = 2.0f;
+  for (int l = 0; l < static_cast<int>(warps.full.size()); ++l) {
+    const warp::WarpedLayer& layer = warps.layer(l);
+    int lx, ly;
+    if (!warps.Usable(l, x, y, front_depth, &lx, &ly)) continue;
+    if (layer.stretch.at(lx, ly) < best_stretch) {
+      best_stretch = layer.stretch.at(lx, ly);
+      best = l;
+    }
+  }
+  return best;
+}
+
+// Writes pixel (x, y) of `out` from label `best`: its depth and colour, or
+// with blend_depth_tolerance > 0 the mean colour and the geometric mean depth
+// of the warps that agree with it, stretched fragments weighing less.
+void WritePixel(const FullWarps& warps, int best, int x, int y, float front_depth,
+                const StitchOptions& options, StitchedLayer* out) {
+  const warp::WarpedLayer& layer = warps.layer(best);
+  int lx, ly;
+  layer.ToCrop(x, y, warps.width, &lx, &ly);
+  out->label.at(x, y) = static_cast<int16_t>(best);
+  const float depth = layer.depth_m.at(lx, ly);
+  out->depth_m.at(x, y) = depth;
+  if (!(options.blend_depth_tolerance > 0)) {
+    for (int c = 0; c < 3; ++c) out->rgb.at(x, y, c) = layer.rgb.at(lx, ly, c);
+    return;
+  }
+  double sum[3] = {0, 0, 0}, weight = 0, dsum = 0;
+  for (int l = 0; l < static_cast<int>(warps.full.size()); ++l) {
+    const warp::WarpedLayer& other = warps.layer(l);
+    int ox, oy;
+    // The same tests the chosen photo passed (on the back layer, not in
+    // front of the front), then the depth agreement.
+    if (!warps.Usable(l, x, y, front_depth, &ox, &oy)) continue;
+    const float d = other.depth_m.at(ox, oy);
+    if (std::abs(d - depth) > options.blend_depth_tolerance * depth) continue;
+    const double w = std::exp(-kUpsampleStretchWeight * other.stretch.at(ox, oy));
+    for (int c = 0; c < 3; ++c) sum[c] += w * other.rgb.at(ox, oy, c);
+    dsum += w * std::log(d);
+    weight += w;
+  }
+  out->depth_m.at(x, y) = static_cast<float>(std::exp(dsum / weight));
+  for (int c = 0; c < 3; ++c)
+    out->rgb.at(x, y, c) = static_cast<uint8_t>(std::clamp(std::lround(sum[c] / weight), 0L, 255L));
+}
+
+StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
+                          const std::vector<warp::WarpedView>& coarse,
+                          const std::vector<ViewGeometry>& views, int pano_width,
+                          const StitchedLayer* front, const StitchOptions& options) {
+  if (const Status st = options.Check(); !st.ok())
+    throw std::invalid_argument("stitch options: " + st.message());
+  if (full.size() != coarse.size() || full.size() != views.size() || full.empty()) {
+    throw std::invalid_argument("stitch: full, coarse warps and views must be equally many (>0)");
+  }
+  if (full.size() > 32000) throw std::invalid_argument("stitch: more than 32000 photos");
+  const int sw = options.solve_width, sh = options.solve_height;
+  const int W = pano_width, H = pano_width / 2;
+  const int L = static_cast<int>(full.size());
+  const int n = sw * sh;
+
+  // 1. Labels at the solve resolution (an MRF over the coarse warps).
+  CoarseStack stack;
+  FillStack(coarse, back, sw, sh, &stack);
+  // Any-surface depths for the back layer's consistency check.
+  CoarseStack front_stack;
+  if (back) FillStack(coarse, false, sw, sh, &front_stack);
+  GridMrf mrf(sw, sh, L, /*wrap_x=*/true);
+  SetDataCosts(back, stack, front_stack, views, front, options, &mrf);
   const float inv_scale = static_cast<float>(1.0 / options.seam_depth_scale);
   auto pairwise = [&](int p, int q, int a, int b) -> float {
-    const size_t ap = stack.at(a, p), bp = stack.at(b, p), aq = stack.at(a, q), bq = stack.at(b, q);
-    if (!(stack.depth[ap] > 0 && stack.depth[bp] > 0 && stack.depth[aq] > 0 &&
-          stack.depth[bq] > 0)) {
-      return static_cast<float>(options.lambda_seam_invalid);
-    }
-    int color = 0;
-    for (int c = 0; c < 3; ++c) {
-      color += std::abs(stack.rgb[3 * ap + c] - stack.rgb[3 * bp + c]) +
-               std::abs(stack.rgb[3 * aq + c] - stack.rgb[3 * bq + c]);
-    }
-    const float depth = std::abs(stack.log_depth[ap] - stack.log_depth[bp]) +
-                        std::abs(stack.log_depth[aq] - stack.log_depth[bq]);
-    return static_cast<float>(options.lambda_seam_color) * color / (6.0f * 255.0f) +
-           static_cast<float>(options.lambda_seam_depth) * std::min(1.0f, 0.5f * depth * inv_scale);
+    return SeamCost(stack, options, inv_scale, p, q, a, b);
   };
   const std::vector<int> labels = mrf.Solve(pairwise, options.solver);
 
@@ -154,118 +296,20 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
     for (int c = 0; c < 3; ++c) solve_rgb.vector()[3 * p + c] = stack.rgb[3 * stack.at(l, p) + c];
   }
 
-  // Edge-aware label upsampling: each full-resolution pixel takes, among the
-  // labels of the nearby solve-resolution pixels, the one whose full-resolution
-  // warp best matches the colours those pixels show, weighted by distance.
+  // 2. The labels upsampled to full resolution, and each pixel's colour and
+  // depth from its label's warp (blended with the warps that agree).
   out.rgb = Image8(W, H, 3, 0);
   out.depth_m = ImageF(W, H, 1, 0.0f);
   out.label = Image<int16_t>(W, H, 1, -1);
-  const double scale = static_cast<double>(sw) / W;
-  const int r = options.upsample_radius;
-  const double inv_two_sigma2 =
-      1.0 / (2.0 * options.upsample_sigma_color * options.upsample_sigma_color);
-  // Whether label l's warp has a depth at pixel (x, y) (its crop coordinates
-  // in lx, ly) that this layer may take: for the back layer, not nearer than
-  // the front.
-  const auto usable = [&](int l, int x, int y, float front_depth, int* lx, int* ly) {
-    const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
-    if (!layer.ToCrop(x, y, W, lx, ly)) return false;
-    const float d = layer.depth_m.at(*lx, *ly);
-    if (!(d > 0)) return false;
-    return !(back && front_depth > 0 && d < front_depth * (1.0 - options.back_tolerance));
-  };
+  const FullWarps warps{back, full, W, options.back_tolerance};
   base::ParallelFor(0, H, base::ResolveThreads(0), [&](int64_t y64) {
     const int y = static_cast<int>(y64);
     std::vector<int> candidates;
     std::vector<double> scores;
-    const double fy = (y + 0.5) * scale - 0.5;
-    const int cy0 = static_cast<int>(std::lround(fy));
     for (int x = 0; x < W; ++x) {
-      const double fx = (x + 0.5) * scale - 0.5;
-      const int cx0 = static_cast<int>(std::lround(fx));
-      candidates.clear();
-      scores.clear();
       const float front_depth = front ? front->depth_m.at(x, y) : 0.0f;
-      for (int dy = -r; dy <= r; ++dy) {
-        const int qy = cy0 + dy;
-        if (qy < 0 || qy >= sh) continue;
-        for (int dx = -r; dx <= r; ++dx) {
-          const int qx = WrapColumn(cx0 + dx, sw);
-          const int l = out.solve_label.at(qx, qy);
-          if (l < 0) continue;
-          const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
-          int lx, ly;
-          if (!usable(l, x, y, front_depth, &lx, &ly)) continue;
-          double diff2 = 0;
-          for (int c = 0; c < 3; ++c) {
-            const double e = layer.rgb.at(lx, ly, c) - solve_rgb.at(qx, qy, c);
-            diff2 += e * e;
-          }
-          const double ddx = (cx0 + dx) - fx, ddy = qy - fy;
-          // Stretched fragments (depth-edge triangles) almost never win.
-          const double w = std::exp(-(ddx * ddx + ddy * ddy) * 0.5) *
-                           std::exp(-diff2 / 3.0 * inv_two_sigma2) *
-                           std::exp(-kUpsampleStretchWeight * layer.stretch.at(lx, ly));
-          auto it = std::find(candidates.begin(), candidates.end(), l);
-          if (it == candidates.end()) {
-            candidates.push_back(l);
-            scores.push_back(w + 1e-12);
-          } else {
-            scores[it - candidates.begin()] += w;
-          }
-        }
-      }
-      int best = -1;
-      double best_score = -1;
-      for (size_t i = 0; i < candidates.size(); ++i) {
-        if (scores[i] > best_score) {
-          best_score = scores[i];
-          best = candidates[i];
-        }
-      }
-      if (best < 0) {
-        // No nearby label reaches this pixel: take the least stretched warp.
-        float best_stretch = 2.0f;
-        for (int l = 0; l < L; ++l) {
-          const warp::WarpedLayer& layer = back ? full[l].back : full[l].front;
-          int lx, ly;
-          if (!usable(l, x, y, front_depth, &lx, &ly)) continue;
-          if (layer.stretch.at(lx, ly) < best_stretch) {
-            best_stretch = layer.stretch.at(lx, ly);
-            best = l;
-          }
-        }
-        if (best < 0) continue;
-      }
-      const warp::WarpedLayer& layer = back ? full[best].back : full[best].front;
-      int lx, ly;
-      layer.ToCrop(x, y, W, &lx, &ly);
-      out.label.at(x, y) = static_cast<int16_t>(best);
-      const float depth = layer.depth_m.at(lx, ly);
-      out.depth_m.at(x, y) = depth;
-      // Blending: the mean colour and the geometric mean depth of the warps
-      // that agree with the chosen one, stretched fragments weighing less.
-      if (!(options.blend_depth_tolerance > 0)) {
-        for (int c = 0; c < 3; ++c) out.rgb.at(x, y, c) = layer.rgb.at(lx, ly, c);
-        continue;
-      }
-      double sum[3] = {0, 0, 0}, weight = 0, dsum = 0;
-      for (int l = 0; l < L; ++l) {
-        const warp::WarpedLayer& other = back ? full[l].back : full[l].front;
-        int ox, oy;
-        // The same tests the chosen photo passed (on the back layer, not in
-        // front of the front), then the depth agreement.
-        if (!usable(l, x, y, front_depth, &ox, &oy)) continue;
-        const float d = other.depth_m.at(ox, oy);
-        if (std::abs(d - depth) > options.blend_depth_tolerance * depth) continue;
-        const double w = std::exp(-kUpsampleStretchWeight * other.stretch.at(ox, oy));
-        for (int c = 0; c < 3; ++c) sum[c] += w * other.rgb.at(ox, oy, c);
-        dsum += w * std::log(d);
-        weight += w;
-      }
-      out.depth_m.at(x, y) = static_cast<float>(std::exp(dsum / weight));
-      for (int c = 0; c < 3; ++c)
-        out.rgb.at(x, y, c) = static_cast<uint8_t>(std::clamp(std::lround(sum[c] / weight), 0L, 255L));
+      const int best = UpsampleLabel(warps, out, solve_rgb, x, y, front_depth, options, &candidates, &scores);
+      if (best >= 0) WritePixel(warps, best, x, y, front_depth, options, &out);
     }
   });
   return out;
