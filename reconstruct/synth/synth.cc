@@ -64,120 +64,110 @@ Status SynthOptions::Check() const {
   return ResolvedRig().Check();
 }
 
-CaptureSummary GenerateCapture(const SynthOptions& options, const std::string& dir) {
-  if (const Status st = options.Check(); !st.ok()) throw std::invalid_argument(st.message());
-  const Clock::time_point start = Clock::now();
-  const RigOptions rig_options = options.ResolvedRig();
-  const Eigen::Vector3d centre = DefaultRigCentre();
-  const Rig rig = MakeRig(rig_options, centre);
-  const Scene scene = BuildDefaultScene(options.seed);
-  const int n = rig_options.num_photos;
+namespace {
 
-  io::CreateDirectories(dir);
-  for (const char* sub : {"images", "depth", "sparse", "ground_truth"}) {
-    io::CreateDirectories(dir + "/" + sub);
-  }
-
-  CaptureSummary summary;
-  summary.num_photos = n;
-  summary.width = rig.camera.width;
-  summary.height = rig.camera.height;
+// The photos of a capture, as rendered.
+struct RenderedPhotos {
+  std::vector<Scene> scenes;  // Per photo (the moving object displaced).
+  std::vector<std::string> names;
+  std::vector<double> exposures;
+  std::vector<Eigen::Vector3d> offsets;  // Of the moving object.
   double depth_lo = std::numeric_limits<double>::infinity(), depth_hi = 0;
+};
 
-  // Photos and their depth maps.
+// Renders the photos into DIR/images (JPEG with a phone's EXIF) and their
+// depth maps into DIR/depth.
+RenderedPhotos RenderPhotos(const SynthOptions& options, const RigOptions& rig_options, const Rig& rig,
+                            const Scene& scene, const std::string& dir) {
+  const int n = rig_options.num_photos;
   RenderOptions render;
   render.edge_samples = options.edge_samples;
   render.num_threads = options.num_threads;
-  std::vector<Scene> scenes;
-  std::vector<std::string> names;
-  std::vector<double> exposures;
-  std::vector<Eigen::Vector3d> offsets;
-  const Clock::time_point photos_start = Clock::now();
-  {
-    util::Progress progress("synth: rendering photos", n);
-    for (int i = 0; i < n; ++i) {
-      const Eigen::Vector3d offset =
-          options.moving_object ? Eigen::Vector3d(options.moving_step_m * i, 0, 0)
-                                : Eigen::Vector3d::Zero();
-      scenes.push_back(scene.Displaced(offset));
-      offsets.push_back(offset);
-      const PhotoRender r = RenderPhoto(scenes.back(), rig.camera, rig.poses[i], render);
-      DevelopOptions develop;
-      const double u = HashToUnit(Hash(options.seed, 0xE4905E, i));
-      develop.exposure = std::exp2(options.exposure_jitter_stops * (2.0 * u - 1.0));
-      develop.noise_sigma = options.noise_sigma;
-      develop.seed = Hash(options.seed, 0x401, i);
-      exposures.push_back(develop.exposure);
-      const Image8 photo = Develop(r.radiance, develop);
-      names.push_back(PhotoName(i) + ".jpg");
-      // EXIF as a phone writes it (5.6 mm wide sensor), so that the sparse
-      // stage finds the focal length as it would for real photos.
-      io::ExifFields exif;
-      exif.make = "casual3d";
-      exif.model = std::string("synthetic ") + RigKindName(rig_options.kind);
-      exif.focal_plane_px_per_mm = rig.camera.width / 5.6;
-      exif.focal_mm = rig.camera.FocalX() / exif.focal_plane_px_per_mm;
-      io::WriteFileAtomic(dir + "/images/" + names.back(),
-                          io::InsertExif(io::EncodeJpeg(photo.view(), {options.jpeg_quality}), exif));
-      io::WriteExr(dir + "/depth/" + PhotoName(i) + ".exr", r.depth_m.view(), {"Z"});
-      UpdateRange(r.depth_m, 0, &depth_lo, &depth_hi);
-      progress.Advance();
-    }
+  RenderedPhotos out;
+  util::Progress progress("synth: rendering photos", n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d offset =
+        options.moving_object ? Eigen::Vector3d(options.moving_step_m * i, 0, 0)
+                              : Eigen::Vector3d::Zero();
+    out.scenes.push_back(scene.Displaced(offset));
+    out.offsets.push_back(offset);
+    const PhotoRender r = RenderPhoto(out.scenes.back(), rig.camera, rig.poses[i], render);
+    DevelopOptions develop;
+    const double u = HashToUnit(Hash(options.seed, 0xE4905E, i));
+    develop.exposure = std::exp2(options.exposure_jitter_stops * (2.0 * u - 1.0));
+    develop.noise_sigma = options.noise_sigma;
+    develop.seed = Hash(options.seed, 0x401, i);
+    out.exposures.push_back(develop.exposure);
+    const Image8 photo = Develop(r.radiance, develop);
+    out.names.push_back(PhotoName(i) + ".jpg");
+    // EXIF as a phone writes it (5.6 mm wide sensor), so that the sparse
+    // stage finds the focal length as it would for real photos.
+    io::ExifFields exif;
+    exif.make = "casual3d";
+    exif.model = std::string("synthetic ") + RigKindName(rig_options.kind);
+    exif.focal_plane_px_per_mm = rig.camera.width / 5.6;
+    exif.focal_mm = rig.camera.FocalX() / exif.focal_plane_px_per_mm;
+    io::WriteFileAtomic(dir + "/images/" + out.names.back(),
+                        io::InsertExif(io::EncodeJpeg(photo.view(), {options.jpeg_quality}), exif));
+    io::WriteExr(dir + "/depth/" + PhotoName(i) + ".exr", r.depth_m.view(), {"Z"});
+    UpdateRange(r.depth_m, 0, &out.depth_lo, &out.depth_hi);
+    progress.Advance();
   }
-  summary.seconds_photos = Seconds(photos_start);
+  return out;
+}
 
-  // Ground-truth sparse model.
+// Writes the ground-truth sparse model (COLMAP text and binary) into
+// DIR/sparse; fills the summary's point count and mean track length.
+void WriteGroundTruthSparse(const SynthOptions& options, const Rig& rig, const RenderedPhotos& photos,
+                            const std::string& dir, CaptureSummary* summary) {
   SparsePointOptions sparse;
   sparse.step_px = options.sparse_step_px;
   sparse.seed = options.seed;
   sparse.num_threads = options.num_threads;
-  const geometry::SparseModel model = MakeGroundTruthModel(scenes, rig, names, sparse);
+  const geometry::SparseModel model = MakeGroundTruthModel(photos.scenes, rig, photos.names, sparse);
   geometry::WriteModelText(model, dir + "/sparse");
   geometry::WriteModelBinary(model, dir + "/sparse");
-  summary.num_points = model.points.size();
+  summary->num_points = model.points.size();
   size_t observations = 0;
   for (const auto& [id, p] : model.points) observations += p.track.size();
-  summary.mean_track_length =
+  summary->mean_track_length =
       model.points.empty() ? 0.0 : static_cast<double>(observations) / model.points.size();
+}
 
-  // Ground-truth panorama from the rig centre (panorama frame = world axes).
-  const Clock::time_point pano_start = Clock::now();
-  PanoramaFrame frame;
-  for (int k = 0; k < 3; ++k) frame.centre[k] = centre[k];
+// Writes DIR/ground_truth/panorama.exr (depths as float, colours and
+// normals as half floats: enough for 8-bit colour and normals to ~1e-3) and,
+// with write_master, master.exr. Returns the panorama's front depth range.
+void WriteGroundTruthPanorama(const SynthOptions& options, const Scene& scene, const PanoramaFrame& frame,
+                              const TwoLayerOptions& two_layer_options, const std::string& dir,
+                              double* pano_lo, double* pano_hi, CaptureSummary* summary) {
   const int pano_w = options.panorama_width, pano_h = options.panorama_width / 2;
-  const GroundTruthPanorama gt =
-      RenderGroundTruthPanorama(scenes.front(), frame, pano_w, pano_h, options.num_threads);
-  {
-    const auto& channel_names = PanoramaChannelNames();
-    io::ExrWriteOptions exr;
-    exr.num_threads = options.num_threads;
-    // Depths exactly (float); colours and normals as half floats (enough for
-    // 8-bit colour and normals to ~1e-3).
-    for (int c = 0; c < kNumPanoramaChannels; ++c) {
-      exr.channel_types.push_back(c == kFrontZ || c == kBackZ ? io::ExrPixelType::kFloat
-                                                              : io::ExrPixelType::kHalf);
-    }
-    io::WriteExr(dir + "/ground_truth/panorama.exr", gt.pixels.view(),
-                 std::vector<std::string>(channel_names.begin(), channel_names.end()), exr);
+  const GroundTruthPanorama gt = RenderGroundTruthPanorama(scene, frame, pano_w, pano_h, options.num_threads);
+  const auto& channel_names = PanoramaChannelNames();
+  io::ExrWriteOptions exr;
+  exr.num_threads = options.num_threads;
+  for (int c = 0; c < kNumPanoramaChannels; ++c) {
+    exr.channel_types.push_back(c == kFrontZ || c == kBackZ ? io::ExrPixelType::kFloat
+                                                            : io::ExrPixelType::kHalf);
   }
-  double pano_lo = std::numeric_limits<double>::infinity(), pano_hi = 0;
-  UpdateRange(gt.pixels, kFrontZ, &pano_lo, &pano_hi);
-  TwoLayerOptions two_layer_options;
+  io::WriteExr(dir + "/ground_truth/panorama.exr", gt.pixels.view(),
+               std::vector<std::string>(channel_names.begin(), channel_names.end()), exr);
+  UpdateRange(gt.pixels, kFrontZ, pano_lo, pano_hi);
   if (options.write_master) {
     const TwoLayerPanorama two_layer = GroundTruthToTwoLayer(gt, two_layer_options);
-    const Status status =
-        encoder::WriteMasterFile(two_layer, dir + "/ground_truth/master.exr");
+    const Status status = encoder::WriteMasterFile(two_layer, dir + "/ground_truth/master.exr");
     if (!status.ok()) throw std::runtime_error(status.ToString());
-    summary.wrote_master = true;
+    summary->wrote_master = true;
   }
-  summary.seconds_panorama = Seconds(pano_start);
-  summary.panorama_width = pano_w;
-  summary.panorama_height = pano_h;
-  summary.depth_min_m = std::min(depth_lo, pano_lo);
-  summary.depth_max_m = std::max(depth_hi, pano_hi);
+}
 
-  // capture.json: everything a later stage needs to know (no timings, so that
-  // the bytes are reproducible).
+// capture.json: everything a later stage needs to know (no timings, so that
+// the bytes are reproducible).
+nlohmann::ordered_json CaptureJson(const SynthOptions& options, const RigOptions& rig_options, const Rig& rig,
+                                   const PanoramaFrame& frame, const RenderedPhotos& photos,
+                                   const TwoLayerOptions& two_layer_options, double pano_lo, double pano_hi,
+                                   const CaptureSummary& summary) {
+  const int n = rig_options.num_photos;
+  const int pano_w = options.panorama_width, pano_h = options.panorama_width / 2;
   nlohmann::ordered_json j;
   j["format"] = "casual3d-capture";
   j["version"] = "1.0";
@@ -218,18 +208,63 @@ CaptureSummary GenerateCapture(const SynthOptions& options, const std::string& d
                         std::max(two_layer_options.sky_depth_m, 2.0 * pano_hi)},
                        {"tau_dratio", two_layer_options.tau_dratio},
                        {"link_ratio", two_layer_options.link_ratio}};
-  nlohmann::ordered_json photos = nlohmann::ordered_json::array();
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d c = rig.poses[i].Center();
-    photos.push_back({{"name", names[i]},
-                      {"image_id", i + 1},
-                      {"depth", "depth/" + PhotoName(i) + ".exr"},
-                      {"centre", {c.x(), c.y(), c.z()}},
-                      {"exposure", exposures[i]},
-                      {"moving_object_offset_m", {offsets[i].x(), offsets[i].y(), offsets[i].z()}}});
+    const Eigen::Vector3d& offset = photos.offsets[i];
+    list.push_back({{"name", photos.names[i]},
+                    {"image_id", i + 1},
+                    {"depth", "depth/" + PhotoName(i) + ".exr"},
+                    {"centre", {c.x(), c.y(), c.z()}},
+                    {"exposure", photos.exposures[i]},
+                    {"moving_object_offset_m", {offset.x(), offset.y(), offset.z()}}});
   }
-  j["photos"] = photos;
+  j["photos"] = list;
   j["sparse_points"] = summary.num_points;
+  return j;
+}
+
+}  // namespace
+
+CaptureSummary GenerateCapture(const SynthOptions& options, const std::string& dir) {
+  if (const Status st = options.Check(); !st.ok()) throw std::invalid_argument(st.message());
+  const Clock::time_point start = Clock::now();
+  const RigOptions rig_options = options.ResolvedRig();
+  const Eigen::Vector3d centre = DefaultRigCentre();
+  const Rig rig = MakeRig(rig_options, centre);
+  const Scene scene = BuildDefaultScene(options.seed);
+
+  io::CreateDirectories(dir);
+  for (const char* sub : {"images", "depth", "sparse", "ground_truth"}) {
+    io::CreateDirectories(dir + "/" + sub);
+  }
+
+  CaptureSummary summary;
+  summary.num_photos = rig_options.num_photos;
+  summary.width = rig.camera.width;
+  summary.height = rig.camera.height;
+
+  const Clock::time_point photos_start = Clock::now();
+  const RenderedPhotos photos = RenderPhotos(options, rig_options, rig, scene, dir);
+  summary.seconds_photos = Seconds(photos_start);
+  WriteGroundTruthSparse(options, rig, photos, dir, &summary);
+
+  // Ground-truth panorama from the rig centre (panorama frame = world axes).
+  const Clock::time_point pano_start = Clock::now();
+  PanoramaFrame frame;
+  for (int k = 0; k < 3; ++k) frame.centre[k] = centre[k];
+  double pano_lo = std::numeric_limits<double>::infinity(), pano_hi = 0;
+  const TwoLayerOptions two_layer_options;
+  WriteGroundTruthPanorama(options, photos.scenes.front(), frame, two_layer_options, dir, &pano_lo, &pano_hi,
+                           &summary);
+  summary.seconds_panorama = Seconds(pano_start);
+  summary.panorama_width = options.panorama_width;
+  summary.panorama_height = options.panorama_width / 2;
+  summary.depth_min_m = std::min(photos.depth_lo, pano_lo);
+  summary.depth_max_m = std::max(photos.depth_hi, pano_hi);
+
+  const nlohmann::ordered_json j = CaptureJson(options, rig_options, rig, frame, photos, two_layer_options,
+                                               pano_lo, pano_hi, summary);
   io::WriteFileAtomic(dir + "/capture.json", j.dump(2) + "\n");
   summary.seconds_total = Seconds(start);
   return summary;
