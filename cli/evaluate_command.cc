@@ -26,27 +26,26 @@
 
 namespace casual3d::cli {
 
-void AddEvaluateCommand(CLI::App& app) {
-  struct Args {
-    std::string capture;
-    std::vector<std::string> photo3d;
-    std::string html = "report.html";
-    std::string json;
-    eval::EvaluateOptions options;
-    eval::ReportOptions report;
-    std::vector<std::string> labels;
-    std::vector<std::string> references;
-    bool no_viewer_views = false;
-    bool no_backdrop = false;
-    std::string viewer_images;
-    std::string rephoto_images;
-    std::string write_cameras;
-  };
-  auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand(
-      "evaluate",
-      "Virtual rephotography: render 3D photos from the photos' poses and compare them with the "
-      "photos (error, completeness, PSNR, SSIM; depth error on synthetic captures)");
+namespace {
+
+struct EvaluateArgs {
+  std::string capture;
+  std::vector<std::string> photo3d;
+  std::string html = "report.html";
+  std::string json;
+  eval::EvaluateOptions options;
+  eval::ReportOptions report;
+  std::vector<std::string> labels;
+  std::vector<std::string> references;
+  bool no_viewer_views = false;
+  bool no_backdrop = false;
+  std::string viewer_images;
+  std::string rephoto_images;
+  std::string write_cameras;
+};
+
+// The flags of `casual3d evaluate`, bound to `args`.
+void AddEvaluateFlags(CLI::App* cmd, const std::shared_ptr<EvaluateArgs>& args) {
   cmd->add_option("capture", args->capture,
                   "The capture: photo folder, capture folder or COLMAP workspace")
       ->required();
@@ -96,112 +95,138 @@ void AddEvaluateCommand(CLI::App& app) {
                   "matrices in the panorama frame, which is glTF's) for rendering them elsewhere; "
                   "one 3D photo only");
   AddDescribedOption(cmd, "--rendered", args->options, args->options.rendered_dir);
-  cmd->callback([args] {
-    args->options.viewer_views = !args->no_viewer_views;
-    args->options.backdrop = !args->no_backdrop;
-    if (const Status st = args->options.Check(); !st.ok())
-      throw std::invalid_argument("evaluate: " + st.message());
-    if (!args->labels.empty() && args->labels.size() != args->photo3d.size())
-      throw std::invalid_argument("--labels: " + std::to_string(args->labels.size()) +
-                                  " names for " + std::to_string(args->photo3d.size()) +
-                                  " 3D photos (give one per 3D photo)");
-    for (const std::string& r : args->references) {
-      const size_t a = r.find(':'), b = r.find(':', a == std::string::npos ? a : a + 1);
-      eval::ReferenceResult ref;
-      try {
-        if (a == std::string::npos || b == std::string::npos) throw std::invalid_argument(r);
-        ref.label = r.substr(0, a);
-        size_t used = 0;
-        ref.psnr_db = std::stod(r.substr(a + 1, b - a - 1), &used);
-        if (used != b - a - 1) throw std::invalid_argument(r);
-        ref.ssim = std::stod(r.substr(b + 1), &used);
-        if (used != r.size() - b - 1) throw std::invalid_argument(r);
-      } catch (const std::exception&) {
-        throw std::invalid_argument("--reference " + r + ": expected NAME:PSNR_DB:SSIM");
-      }
-      args->report.references.push_back(ref);
+}
+
+// The checks of the arguments and what follows from them (the references,
+// the ablation flags), and the image folders made, before the (long)
+// evaluation.
+void PrepareEvaluateArgs(EvaluateArgs* args) {
+  args->options.viewer_views = !args->no_viewer_views;
+  args->options.backdrop = !args->no_backdrop;
+  if (const Status st = args->options.Check(); !st.ok())
+    throw std::invalid_argument("evaluate: " + st.message());
+  if (!args->labels.empty() && args->labels.size() != args->photo3d.size())
+    throw std::invalid_argument("--labels: " + std::to_string(args->labels.size()) +
+                                " names for " + std::to_string(args->photo3d.size()) +
+                                " 3D photos (give one per 3D photo)");
+  for (const std::string& r : args->references) {
+    const size_t a = r.find(':'), b = r.find(':', a == std::string::npos ? a : a + 1);
+    eval::ReferenceResult ref;
+    try {
+      if (a == std::string::npos || b == std::string::npos) throw std::invalid_argument(r);
+      ref.label = r.substr(0, a);
+      size_t used = 0;
+      ref.psnr_db = std::stod(r.substr(a + 1, b - a - 1), &used);
+      if (used != b - a - 1) throw std::invalid_argument(r);
+      ref.ssim = std::stod(r.substr(b + 1), &used);
+      if (used != r.size() - b - 1) throw std::invalid_argument(r);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--reference " + r + ": expected NAME:PSNR_DB:SSIM");
     }
-    if (const Status st = args->report.Check(); !st.ok())
-      throw std::invalid_argument("evaluate: --" + st.message());
-    if (!args->write_cameras.empty() && args->photo3d.size() != 1)
-      throw std::invalid_argument("--write-cameras: give exactly one 3D photo (got " +
-                                  std::to_string(args->photo3d.size()) + ")");
-    const std::filesystem::path html(args->html);
-    if (!html.parent_path().empty() && !std::filesystem::is_directory(html.parent_path()))
-      throw std::runtime_error(args->html + ": the folder " + html.parent_path().string() +
-                               " does not exist (create it or choose another -o)");
-    // Image folders are made before the (long) evaluation, so that a wrong
-    // path fails at once.
-    for (const auto& [flag, dir] : {std::pair{"--viewer-images", &args->viewer_images},
-                                    std::pair{"--rephoto-images", &args->rephoto_images}}) {
-      try {
-        if (!dir->empty()) io::CreateDirectories(*dir);
-      } catch (const std::exception& e) {
-        throw std::runtime_error(std::string(flag) + " " + e.what() + " (choose another folder)");
-      }
+    args->report.references.push_back(ref);
+  }
+  if (const Status st = args->report.Check(); !st.ok())
+    throw std::invalid_argument("evaluate: --" + st.message());
+  if (!args->write_cameras.empty() && args->photo3d.size() != 1)
+    throw std::invalid_argument("--write-cameras: give exactly one 3D photo (got " +
+                                std::to_string(args->photo3d.size()) + ")");
+  const std::filesystem::path html(args->html);
+  if (!html.parent_path().empty() && !std::filesystem::is_directory(html.parent_path()))
+    throw std::runtime_error(args->html + ": the folder " + html.parent_path().string() +
+                             " does not exist (create it or choose another -o)");
+  // Image folders are made before the (long) evaluation, so that a wrong
+  // path fails at once.
+  for (const auto& [flag, dir] : {std::pair{"--viewer-images", &args->viewer_images},
+                                  std::pair{"--rephoto-images", &args->rephoto_images}}) {
+    try {
+      if (!dir->empty()) io::CreateDirectories(*dir);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string(flag) + " " + e.what() + " (choose another folder)");
     }
-    std::vector<eval::PhotoModelEvaluation> evals;
-    for (size_t k = 0; k < args->photo3d.size(); ++k) {
-      const std::string& p = args->photo3d[k];
-      evals.push_back(eval::EvaluatePhoto3d(args->capture, p, args->options));
-      eval::PhotoModelEvaluation& e = evals.back();
-      if (!args->labels.empty()) e.label = args->labels[k];
-      std::printf(
-          "%s: %zu photos, error %.4f, completeness %.3f, PSNR %.2f dB, SSIM %.3f (whole frame "
-          "%.2f dB, %.3f)",
-          e.label.c_str(), e.photos.size(), e.mean_error, e.mean_completeness, e.mean_psnr_db,
-          e.mean_ssim, e.mean_psnr_filled_db, e.mean_ssim_filled);
-      if (e.has_depth)
-        std::printf(", depth median rel. error %.4f, within 3%% %.3f", e.mean_depth_median_rel,
-                    e.mean_depth_within);
-      std::printf("\n");
-      if (e.viewer) {
-        std::printf("  %s\n", eval::ViewerViewsSummary(*e.viewer).c_str());
-        if (!args->viewer_images.empty()) {
-          eval::WriteViewerHeatmaps(*e.viewer, args->viewer_images, std::to_string(k) + "_");
-          std::printf("  viewer heatmaps: %s/%zu_viewer_*.png\n", args->viewer_images.c_str(), k);
-        }
-      }
-      if (!args->rephoto_images.empty()) {
-        for (const eval::PhotoEvaluation& q : e.photos) {
-          const std::string stem = (std::filesystem::path(args->rephoto_images) /
-                                    (std::to_string(k) + "_" +
-                                     std::filesystem::path(q.name).stem().string()))
-                                       .string();
-          io::WritePng(stem + "_photo.png", q.photo);
-          io::WritePng(stem + "_render.png", q.render);
-        }
-        std::printf("  rephotographs: %s/%zu_*_render.png\n", args->rephoto_images.c_str(), k);
-      }
-      for (const eval::PhotoEvaluation& q : e.photos)
-        std::printf(
-            "  %-24s %dx%d error %.4f completeness %.3f PSNR %6.2f SSIM %.3f whole frame %6.2f "
-            "%.3f%s\n",
-            q.name.c_str(), q.metrics.width, q.metrics.height, q.metrics.error,
-            q.metrics.completeness, q.metrics.psnr_db, q.metrics.ssim, q.metrics.psnr_filled_db,
-            q.metrics.ssim_filled, q.held_out ? " (held out)" : "");
+  }
+}
+
+// Prints the figures of 3D photo number k and writes its images where asked.
+void ReportEvaluation(size_t k, const eval::PhotoModelEvaluation& e, const EvaluateArgs& args) {
+  std::printf(
+      "%s: %zu photos, error %.4f, completeness %.3f, PSNR %.2f dB, SSIM %.3f (whole frame "
+      "%.2f dB, %.3f)",
+      e.label.c_str(), e.photos.size(), e.mean_error, e.mean_completeness, e.mean_psnr_db,
+      e.mean_ssim, e.mean_psnr_filled_db, e.mean_ssim_filled);
+  if (e.has_depth)
+    std::printf(", depth median rel. error %.4f, within 3%% %.3f", e.mean_depth_median_rel,
+                e.mean_depth_within);
+  std::printf("\n");
+  if (e.viewer) {
+    std::printf("  %s\n", eval::ViewerViewsSummary(*e.viewer).c_str());
+    if (!args.viewer_images.empty()) {
+      eval::WriteViewerHeatmaps(*e.viewer, args.viewer_images, std::to_string(k) + "_");
+      std::printf("  viewer heatmaps: %s/%zu_viewer_*.png\n", args.viewer_images.c_str(), k);
     }
-    if (!args->write_cameras.empty()) {
-      std::vector<eval::NamedView> views;
-      for (const eval::PhotoEvaluation& q : evals.front().photos) {
-        if (q.has_distortion)
-          throw std::runtime_error("--write-cameras: photo " + q.name +
-                                   " has lens distortion, which the cameras file cannot carry "
-                                   "(evaluate the 3D photo's undistorted workspace)");
-        views.push_back({q.name, q.view});
-      }
-      io::WriteFileAtomic(args->write_cameras,
-                          eval::RephotoCamerasJson(views, evals.front().near_m,
-                                                   evals.front().far_m));
-      std::printf("cameras: %s\n", args->write_cameras.c_str());
+  }
+  if (!args.rephoto_images.empty()) {
+    for (const eval::PhotoEvaluation& q : e.photos) {
+      const std::string stem = (std::filesystem::path(args.rephoto_images) /
+                                (std::to_string(k) + "_" +
+                                 std::filesystem::path(q.name).stem().string()))
+                                   .string();
+      io::WritePng(stem + "_photo.png", q.photo);
+      io::WritePng(stem + "_render.png", q.render);
     }
-    io::WriteFileAtomic(args->html, eval::RenderHtmlReport(args->capture, evals, args->report));
-    std::printf("report: %s\n", args->html.c_str());
-    if (!args->json.empty()) {
-      io::WriteFileAtomic(args->json, eval::RenderJsonReport(args->capture, evals, args->options));
-      std::printf("json: %s\n", args->json.c_str());
-    }
-  });
+    std::printf("  rephotographs: %s/%zu_*_render.png\n", args.rephoto_images.c_str(), k);
+  }
+  for (const eval::PhotoEvaluation& q : e.photos)
+    std::printf(
+        "  %-24s %dx%d error %.4f completeness %.3f PSNR %6.2f SSIM %.3f whole frame %6.2f "
+        "%.3f%s\n",
+        q.name.c_str(), q.metrics.width, q.metrics.height, q.metrics.error,
+        q.metrics.completeness, q.metrics.psnr_db, q.metrics.ssim, q.metrics.psnr_filled_db,
+        q.metrics.ssim_filled, q.held_out ? " (held out)" : "");
+}
+
+// --write-cameras: the evaluated photos' cameras of the one 3D photo.
+void WriteCameras(const std::vector<eval::PhotoModelEvaluation>& evals, const EvaluateArgs& args) {
+  if (args.write_cameras.empty()) return;
+  std::vector<eval::NamedView> views;
+  for (const eval::PhotoEvaluation& q : evals.front().photos) {
+    if (q.has_distortion)
+      throw std::runtime_error("--write-cameras: photo " + q.name +
+                               " has lens distortion, which the cameras file cannot carry "
+                               "(evaluate the 3D photo's undistorted workspace)");
+    views.push_back({q.name, q.view});
+  }
+  io::WriteFileAtomic(args.write_cameras,
+                      eval::RephotoCamerasJson(views, evals.front().near_m, evals.front().far_m));
+  std::printf("cameras: %s\n", args.write_cameras.c_str());
+}
+
+void RunEvaluate(EvaluateArgs* args) {
+  PrepareEvaluateArgs(args);
+  std::vector<eval::PhotoModelEvaluation> evals;
+  for (size_t k = 0; k < args->photo3d.size(); ++k) {
+    evals.push_back(eval::EvaluatePhoto3d(args->capture, args->photo3d[k], args->options));
+    if (!args->labels.empty()) evals.back().label = args->labels[k];
+    ReportEvaluation(k, evals.back(), *args);
+  }
+  WriteCameras(evals, *args);
+  io::WriteFileAtomic(args->html, eval::RenderHtmlReport(args->capture, evals, args->report));
+  std::printf("report: %s\n", args->html.c_str());
+  if (!args->json.empty()) {
+    io::WriteFileAtomic(args->json, eval::RenderJsonReport(args->capture, evals, args->options));
+    std::printf("json: %s\n", args->json.c_str());
+  }
+}
+
+}  // namespace
+
+void AddEvaluateCommand(CLI::App& app) {
+  auto args = std::make_shared<EvaluateArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "evaluate",
+      "Virtual rephotography: render 3D photos from the photos' poses and compare them with the "
+      "photos (error, completeness, PSNR, SSIM; depth error on synthetic captures)");
+  AddEvaluateFlags(cmd, args);
+  cmd->callback([args] { RunEvaluate(args.get()); });
 }
 
 }  // namespace casual3d::cli

@@ -262,6 +262,151 @@ DepthComparison CompareDepth(const ImageF& truth, const render::RenderResult& r,
 
 }  // namespace
 
+namespace {
+
+// spec/mesh.md's mesh of the 3D photo, its atlas and, for the viewer views
+// with options.backdrop, the backdrop the viewer draws behind it.
+struct EvaluationMesh {
+  Mesh mesh;
+  Mesh backdrop;
+  Image8 atlas;
+};
+
+EvaluationMesh BuildEvaluationMesh(const LoadedPhoto3d& photo3d, const std::string& photo3d_path,
+                                   size_t num_selected, const EvaluateOptions& options,
+                                   PhotoModelEvaluation* eval) {
+  const auto mesh_start = std::chrono::steady_clock::now();
+  EvaluationMesh m;
+  auto built = BuildMesh(photo3d.pano);
+  if (!built.ok()) throw std::runtime_error(photo3d.source + ": " + built.status().message());
+  m.mesh = std::move(*built);
+  m.atlas = encoder::BuildColorAtlas(photo3d.pano);
+  eval->mesh_triangles = m.mesh.indices.size() / 3;
+  if (options.backdrop && options.viewer_views) {
+    auto built_backdrop = BuildBackdrop(photo3d.pano);
+    if (!built_backdrop.ok())
+      throw std::runtime_error(photo3d.source + ": backdrop: " + built_backdrop.status().message());
+    m.backdrop = std::move(*built_backdrop);
+    eval->backdrop_triangles = m.backdrop.num_triangles();
+  }
+  util::LogInfo("evaluate: " + photo3d_path + ": mesh of " +
+                std::to_string(eval->mesh_triangles) + " triangles (and " +
+                std::to_string(eval->backdrop_triangles) + " of the backdrop) in " +
+                std::to_string(SecondsSince(mesh_start)) + " s; " +
+                std::to_string(num_selected) + " photos");
+  return m;
+}
+
+// What a viewer sees (viewer_views.h), with the backdrop appended to the
+// mesh for it; the mesh alone again afterwards, for the rephotographs.
+void EvaluateViewerSide(const LoadedPhoto3d& photo3d, const std::string& photo3d_path,
+                        const EvaluateOptions& options, EvaluationMesh* m, PhotoModelEvaluation* eval) {
+  const auto viewer_start = std::chrono::steady_clock::now();
+  ViewerViewsOptions viewer = options.viewer;
+  viewer.num_threads = options.num_threads;
+  viewer.keep_images = viewer.keep_images && options.keep_images;
+  Mesh& mesh = m->mesh;
+  // Array sizes of the mesh alone (colours may be absent).
+  const size_t sizes[5] = {mesh.positions.size(), mesh.normals.size(), mesh.uvs.size(),
+                           mesh.colors.size(), mesh.indices.size()};
+  if (options.backdrop) {
+    viewer.vertex_colors_from_triangle = eval->mesh_triangles;
+    AppendMesh(m->backdrop, &mesh);
+  }
+  eval->viewer = EvaluateViewerViews(photo3d.pano, mesh, std::as_const(m->atlas).view(),
+                                     photo3d.pano.view_hints(), viewer);
+  mesh.positions.resize(sizes[0]);
+  mesh.normals.resize(sizes[1]);
+  mesh.uvs.resize(sizes[2]);
+  mesh.colors.resize(sizes[3]);
+  mesh.indices.resize(sizes[4]);
+  m->backdrop = Mesh();
+  util::LogInfo("evaluate: " + photo3d_path + ": 17 viewer views in " +
+                std::to_string(SecondsSince(viewer_start)) + " s");
+}
+
+// The model the photos' poses come from, its photo names sorted, and each
+// name's image.
+struct PosedPhotos {
+  fs::path model_dir;
+  geometry::SparseModel model;
+  std::vector<std::string> names;
+  std::map<std::string, const geometry::ModelImage*> by_name;
+};
+
+void ReadPosedPhotos(const fs::path& model_dir, PosedPhotos* posed) {
+  posed->model_dir = model_dir;
+  try {
+    posed->model = geometry::ReadModel(model_dir.string());
+  } catch (const std::exception& e) {
+    throw std::runtime_error(model_dir.string() + ": " + e.what());
+  }
+  for (const auto& [id, image] : posed->model.images) {
+    posed->names.push_back(image.name);
+    posed->by_name[image.name] = &image;
+  }
+  std::sort(posed->names.begin(), posed->names.end());
+  if (posed->names.empty())
+    throw std::runtime_error(model_dir.string() + ": the model has no registered photos");
+}
+
+// The photo `index` of `posed` at the evaluated width, as the capture holds
+// it, and its camera scaled alike.
+Image8 ReferencePhoto(const PosedPhotos& posed, const fs::path& capture, const std::string& name,
+                      const EvaluateOptions& options, geometry::Camera* camera) {
+  const geometry::ModelImage& image = *posed.by_name.at(name);
+  const auto cam_it = posed.model.cameras.find(image.camera_id);
+  if (cam_it == posed.model.cameras.end())
+    throw std::runtime_error(posed.model_dir.string() + ": photo " + name +
+                             " refers to a missing camera");
+  const geometry::Camera& full = cam_it->second;
+  const fs::path photo_path = FindReferencePhoto(posed.model_dir, capture, name);
+  const Image8 photo_full = io::ReadImage(photo_path.string());
+  if (photo_full.width() != full.width || photo_full.height() != full.height)
+    throw std::runtime_error(photo_path.string() + ": " + std::to_string(photo_full.width()) +
+                             "x" + std::to_string(photo_full.height()) +
+                             " pixels but its camera is " + std::to_string(full.width) + "x" +
+                             std::to_string(full.height) +
+                             " (compare with the photos the 3D photo was reconstructed from)");
+  const double scale = options.width > 0 ? double(options.width) / full.width : 1.0;
+  *camera = scale == 1.0 ? full : full.Scaled(scale);
+  Image8 photo(camera->width, camera->height, 3);
+  if (scale == 1.0) {
+    photo = photo_full;
+  } else {
+    cv::Mat dst = io::ToMat(photo);
+    cv::resize(io::ToMat(photo_full), dst, dst.size(), 0, 0,
+               scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+  }
+  return photo;
+}
+
+// The means over the evaluated photos (depth over those with ground truth).
+void AddMeans(PhotoModelEvaluation* eval) {
+  const double n = static_cast<double>(eval->photos.size());
+  int depth_n = 0;
+  for (const PhotoEvaluation& pe : eval->photos) {
+    eval->mean_error += pe.metrics.error / n;
+    eval->mean_completeness += pe.metrics.completeness / n;
+    eval->mean_psnr_db += pe.metrics.psnr_db / n;
+    eval->mean_ssim += pe.metrics.ssim / n;
+    eval->mean_psnr_filled_db += pe.metrics.psnr_filled_db / n;
+    eval->mean_ssim_filled += pe.metrics.ssim_filled / n;
+    if (pe.depth.available && pe.depth.pixels > 0) {
+      ++depth_n;
+      eval->mean_depth_median_rel += pe.depth.median_relative_error;
+      eval->mean_depth_within += pe.depth.within_tolerance;
+    }
+  }
+  if (depth_n > 0) {
+    eval->has_depth = true;
+    eval->mean_depth_median_rel /= depth_n;
+    eval->mean_depth_within /= depth_n;
+  }
+}
+
+}  // namespace
+
 PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
                                      const std::string& photo3d_path,
                                      const EvaluateOptions& options) {
@@ -288,83 +433,22 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
   eval.pano_height = photo3d.pano.height();
   ReadReports(photo3d.root, &eval);
 
-  const fs::path model_dir = FindSparseWorkspace(photo3d.root, capture);
-  eval.poses_from = model_dir.string();
-  geometry::SparseModel model;
-  try {
-    model = geometry::ReadModel(model_dir.string());
-  } catch (const std::exception& e) {
-    throw std::runtime_error(model_dir.string() + ": " + e.what());
-  }
-  std::vector<std::string> names;
-  std::map<std::string, const geometry::ModelImage*> by_name;
-  for (const auto& [id, image] : model.images) {
-    names.push_back(image.name);
-    by_name[image.name] = &image;
-  }
-  std::sort(names.begin(), names.end());
-  if (names.empty())
-    throw std::runtime_error(model_dir.string() + ": the model has no registered photos");
+  PosedPhotos posed;
+  ReadPosedPhotos(FindSparseWorkspace(photo3d.root, capture), &posed);
+  eval.poses_from = posed.model_dir.string();
   const std::vector<int> selected =
-      SelectPhotos(names, options.photos, options.holdout_every, eval.holdout);
+      SelectPhotos(posed.names, options.photos, options.holdout_every, eval.holdout);
   double depth_scale = 1.0;
   if (fs::is_directory(capture / "depth", ec)) {
-    depth_scale = ModelToCaptureScale(model, model_dir, capture);
+    depth_scale = ModelToCaptureScale(posed.model, posed.model_dir, capture);
     eval.depth_scale = depth_scale;
   }
 
   // The mesh and its atlas, unless every rendering comes from elsewhere.
   const bool render_here = options.rendered_dir.empty();
-  // spec/mesh.md's mesh; the viewer views append the backdrop to it and
-  // take it off again before the rephotographs.
-  Mesh mesh;
-  Mesh backdrop;
-  Image8 atlas;
-  if (render_here) {
-    const auto mesh_start = std::chrono::steady_clock::now();
-    auto built = BuildMesh(photo3d.pano);
-    if (!built.ok()) throw std::runtime_error(photo3d.source + ": " + built.status().message());
-    mesh = std::move(*built);
-    atlas = encoder::BuildColorAtlas(photo3d.pano);
-    eval.mesh_triangles = mesh.indices.size() / 3;
-    if (options.backdrop && options.viewer_views) {
-      auto built_backdrop = BuildBackdrop(photo3d.pano);
-      if (!built_backdrop.ok())
-        throw std::runtime_error(photo3d.source + ": backdrop: " + built_backdrop.status().message());
-      backdrop = std::move(*built_backdrop);
-      eval.backdrop_triangles = backdrop.num_triangles();
-    }
-    util::LogInfo("evaluate: " + photo3d_path + ": mesh of " +
-                  std::to_string(eval.mesh_triangles) + " triangles (and " +
-                  std::to_string(eval.backdrop_triangles) + " of the backdrop) in " +
-                  std::to_string(SecondsSince(mesh_start)) + " s; " +
-                  std::to_string(selected.size()) + " photos");
-  }
-
-  if (options.viewer_views && render_here) {
-    const auto viewer_start = std::chrono::steady_clock::now();
-    ViewerViewsOptions viewer = options.viewer;
-    viewer.num_threads = options.num_threads;
-    viewer.keep_images = viewer.keep_images && options.keep_images;
-    // Array sizes of the mesh alone (colours may be absent).
-    const size_t sizes[5] = {mesh.positions.size(), mesh.normals.size(), mesh.uvs.size(),
-                             mesh.colors.size(), mesh.indices.size()};
-    if (options.backdrop) {
-      viewer.vertex_colors_from_triangle = eval.mesh_triangles;
-      AppendMesh(backdrop, &mesh);
-    }
-    eval.viewer = EvaluateViewerViews(photo3d.pano, mesh, std::as_const(atlas).view(),
-                                      photo3d.pano.view_hints(), viewer);
-    // The mesh alone again for the rephotographs.
-    mesh.positions.resize(sizes[0]);
-    mesh.normals.resize(sizes[1]);
-    mesh.uvs.resize(sizes[2]);
-    mesh.colors.resize(sizes[3]);
-    mesh.indices.resize(sizes[4]);
-    backdrop = Mesh();
-    util::LogInfo("evaluate: " + photo3d_path + ": 17 viewer views in " +
-                  std::to_string(SecondsSince(viewer_start)) + " s");
-  }
+  EvaluationMesh m;
+  if (render_here) m = BuildEvaluationMesh(photo3d, photo3d_path, selected.size(), options, &eval);
+  if (options.viewer_views && render_here) EvaluateViewerSide(photo3d, photo3d_path, options, &m, &eval);
 
   render::RenderOptions render_options;
   render_options.num_threads = options.num_threads;
@@ -378,43 +462,21 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
   util::Progress progress("rephotography", static_cast<int64_t>(selected.size()));
   eval.error_histogram.assign(options.metrics.histogram_bins, 0);
   for (const int index : selected) {
-    const std::string& name = names[index];
-    const geometry::ModelImage& image = *by_name.at(name);
-    const auto cam_it = model.cameras.find(image.camera_id);
-    if (cam_it == model.cameras.end())
-      throw std::runtime_error(model_dir.string() + ": photo " + name +
-                               " refers to a missing camera");
-    const geometry::Camera& full = cam_it->second;
-    const fs::path photo_path = FindReferencePhoto(model_dir, capture, name);
-    const Image8 photo_full = io::ReadImage(photo_path.string());
-    if (photo_full.width() != full.width || photo_full.height() != full.height)
-      throw std::runtime_error(photo_path.string() + ": " + std::to_string(photo_full.width()) +
-                               "x" + std::to_string(photo_full.height()) +
-                               " pixels but its camera is " + std::to_string(full.width) + "x" +
-                               std::to_string(full.height) +
-                               " (compare with the photos the 3D photo was reconstructed from)");
-    const double scale = options.width > 0 ? double(options.width) / full.width : 1.0;
-    const geometry::Camera camera = scale == 1.0 ? full : full.Scaled(scale);
-
+    const std::string& name = posed.names[index];
+    const geometry::ModelImage& image = *posed.by_name.at(name);
+    geometry::Camera camera;
+    Image8 photo = ReferencePhoto(posed, capture, name, options, &camera);
     PhotoEvaluation pe;
     pe.name = name;
     pe.index = index;
     pe.held_out = std::find(eval.holdout.begin(), eval.holdout.end(), name) != eval.holdout.end();
-    Image8 photo(camera.width, camera.height, 3);
-    if (scale == 1.0) {
-      photo = photo_full;
-    } else {
-      cv::Mat dst = io::ToMat(photo);
-      cv::resize(io::ToMat(photo_full), dst, dst.size(), 0, 0,
-                 scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
-    }
     pe.view = render::ViewFromPhoto(camera, image.pose, photo3d.pano.frame());
     pe.has_distortion = camera.HasDistortion();
     const auto t = std::chrono::steady_clock::now();
     render::RenderResult r;
     if (render_here) {
-      r = render::RenderPhotoView(mesh, std::as_const(atlas).view(), photo3d.pano.frame(), camera, image.pose,
-                                  render_options);
+      r = render::RenderPhotoView(m.mesh, std::as_const(m.atlas).view(), photo3d.pano.frame(), camera,
+                                  image.pose, render_options);
     } else {
       if (pe.has_distortion)
         throw std::runtime_error("photo " + name + ": its camera has lens distortion, which " +
@@ -446,27 +508,7 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
     progress.Advance();
   }
   progress.Finish();
-
-  const double n = static_cast<double>(eval.photos.size());
-  int depth_n = 0;
-  for (const PhotoEvaluation& pe : eval.photos) {
-    eval.mean_error += pe.metrics.error / n;
-    eval.mean_completeness += pe.metrics.completeness / n;
-    eval.mean_psnr_db += pe.metrics.psnr_db / n;
-    eval.mean_ssim += pe.metrics.ssim / n;
-    eval.mean_psnr_filled_db += pe.metrics.psnr_filled_db / n;
-    eval.mean_ssim_filled += pe.metrics.ssim_filled / n;
-    if (pe.depth.available && pe.depth.pixels > 0) {
-      ++depth_n;
-      eval.mean_depth_median_rel += pe.depth.median_relative_error;
-      eval.mean_depth_within += pe.depth.within_tolerance;
-    }
-  }
-  if (depth_n > 0) {
-    eval.has_depth = true;
-    eval.mean_depth_median_rel /= depth_n;
-    eval.mean_depth_within /= depth_n;
-  }
+  AddMeans(&eval);
   return eval;
 }
 
