@@ -161,6 +161,127 @@ Status CheckMeshForExport(const Mesh& mesh) {
 
 namespace {
 
+// The texture: the atlas fitted within max_texture_size and encoded as PNG
+// or JPEG; *texture points at the image encoded (the atlas or *resized).
+StatusOr<std::vector<uint8_t>> EncodeTexture(const Image8& atlas, const GltfExportOptions& options,
+                                             Image8* resized, const Image8** texture) {
+  int tex_width = 0, tex_height = 0;
+  FitTextureSize(atlas.width(), atlas.height(), options.max_texture_size, &tex_width, &tex_height);
+  *texture = &atlas;
+  if (tex_width != atlas.width() || tex_height != atlas.height()) {
+    *resized = ResizeArea(atlas, tex_width, tex_height);
+    *texture = resized;
+  }
+  if (options.texture_format == TextureFormat::kPng) return EncodePng(**texture);
+  return EncodeJpeg(**texture, options.jpeg_quality);
+}
+
+// Adds the mesh's data to `model` and `primitive`: the Draco bitstream with
+// accessors without buffer views, or plain attribute and index buffers.
+// Returns the bytes of vertex and index data (or of the bitstream).
+size_t AddMeshData(const ExportMesh& stored, const std::vector<uint8_t>& draco_bytes,
+                   const std::map<std::string, int>& draco_ids, bool draco, tinygltf::Model* model,
+                   tinygltf::Primitive* primitive) {
+  uint32_t max_index = 0;
+  for (uint32_t i : stored.indices) max_index = std::max(max_index, i);
+  size_t mesh_bytes = 0;
+  // Indices: unsigned short when they fit (the 65535 value is reserved as a
+  // primitive restart in some APIs, so it is avoided).
+  const bool short_indices = max_index < 65535;
+  tinygltf::Accessor index_accessor;
+  index_accessor.componentType =
+      short_indices ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  index_accessor.count = stored.indices.size();
+  index_accessor.type = TINYGLTF_TYPE_SCALAR;
+  if (draco) {
+    // Accessors without buffer views: the data is in the Draco bitstream.
+    const int view = AddBufferView(model, draco_bytes.data(), draco_bytes.size(), 0);
+    mesh_bytes = draco_bytes.size();
+    primitive->attributes["POSITION"] = AddFloatAccessor(model, -1, stored.positions, 3, true);
+    if (!stored.normals.empty()) {
+      primitive->attributes["NORMAL"] = AddFloatAccessor(model, -1, stored.normals, 3, false);
+    }
+    primitive->attributes["TEXCOORD_0"] = AddFloatAccessor(model, -1, stored.uvs, 2, false);
+    tinygltf::Value::Object attributes;
+    for (const auto& [name, id] : draco_ids) attributes[name] = tinygltf::Value(id);
+    tinygltf::Value::Object extension;
+    extension["bufferView"] = tinygltf::Value(view);
+    extension["attributes"] = tinygltf::Value(std::move(attributes));
+    primitive->extensions[kDracoExtension] = tinygltf::Value(std::move(extension));
+  } else {
+    auto add_attribute = [&](const std::vector<float>& data, int components, bool bounds) {
+      const int view =
+          AddBufferView(model, data.data(), data.size() * sizeof(float), kArrayBuffer);
+      mesh_bytes += data.size() * sizeof(float);
+      return AddFloatAccessor(model, view, data, components, bounds);
+    };
+    primitive->attributes["POSITION"] = add_attribute(stored.positions, 3, true);
+    if (!stored.normals.empty())
+      primitive->attributes["NORMAL"] = add_attribute(stored.normals, 3, false);
+    primitive->attributes["TEXCOORD_0"] = add_attribute(stored.uvs, 2, false);
+    if (short_indices) {
+      std::vector<uint16_t> narrow(stored.indices.begin(), stored.indices.end());
+      index_accessor.bufferView =
+          AddBufferView(model, narrow.data(), narrow.size() * 2, kElementArrayBuffer);
+      mesh_bytes += narrow.size() * 2;
+    } else {
+      index_accessor.bufferView = AddBufferView(model, stored.indices.data(),
+                                                stored.indices.size() * 4, kElementArrayBuffer);
+      mesh_bytes += stored.indices.size() * 4;
+    }
+  }
+  model->accessors.push_back(index_accessor);
+  primitive->indices = static_cast<int>(model->accessors.size() - 1);
+  return mesh_bytes;
+}
+
+// Adds the texture's image, its sampler and the one material.
+void AddMaterial(const std::vector<uint8_t>& image_bytes, const GltfExportOptions& options,
+                 tinygltf::Model* model) {
+  tinygltf::Image image;
+  image.name = "colour atlas";
+  image.mimeType = options.texture_format == TextureFormat::kPng ? "image/png" : "image/jpeg";
+  image.bufferView = AddBufferView(model, image_bytes.data(), image_bytes.size(), 0);
+  model->images.push_back(image);
+  tinygltf::Sampler sampler;
+  sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+  sampler.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;  // Seam copies have u > 1.
+  sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+  model->samplers.push_back(sampler);
+  tinygltf::Texture gltf_texture;
+  gltf_texture.sampler = 0;
+  gltf_texture.source = 0;
+  model->textures.push_back(gltf_texture);
+  tinygltf::Material material;
+  material.name = "3D photo";
+  material.pbrMetallicRoughness.baseColorTexture.index = 0;
+  material.pbrMetallicRoughness.metallicFactor = 0.0;
+  material.pbrMetallicRoughness.roughnessFactor = 1.0;
+  material.doubleSided = options.double_sided;
+  if (options.unlit) {
+    material.extensions[kUnlitExtension] = tinygltf::Value(tinygltf::Value::Object());
+    model->extensionsUsed.push_back(kUnlitExtension);
+  }
+  model->materials.push_back(material);
+}
+
+// Adds the mesh of `primitive`, its node and the scene.
+void AddScene(const tinygltf::Primitive& primitive, tinygltf::Model* model) {
+  tinygltf::Mesh gltf_mesh;
+  gltf_mesh.name = "3D photo";
+  gltf_mesh.primitives.push_back(primitive);
+  model->meshes.push_back(gltf_mesh);
+  tinygltf::Node node;
+  node.name = "3D photo";
+  node.mesh = 0;
+  model->nodes.push_back(node);
+  tinygltf::Scene scene;
+  scene.nodes.push_back(0);
+  model->scenes.push_back(scene);
+  model->defaultScene = 0;
+}
+
 // EncodeGlb's work; the GLB as a string (what the glTF serializer gives).
 StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
                                       const GltfExportOptions& options, GltfExportStats* stats) {
@@ -171,19 +292,10 @@ StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
                            std::to_string(atlas.width()) + "x" + std::to_string(atlas.height()) +
                            " with " + std::to_string(atlas.channels()) + " channels");
   }
-
-  // Texture.
-  int tex_width = 0, tex_height = 0;
-  FitTextureSize(atlas.width(), atlas.height(), options.max_texture_size, &tex_width, &tex_height);
   Image8 resized;
-  const Image8* texture = &atlas;
-  if (tex_width != atlas.width() || tex_height != atlas.height()) {
-    resized = ResizeArea(atlas, tex_width, tex_height);
-    texture = &resized;
-  }
-  const bool png = options.texture_format == TextureFormat::kPng;
+  const Image8* texture = nullptr;
   CASUAL3D_ASSIGN_OR_RETURN(std::vector<uint8_t> image_bytes,
-                            png ? EncodePng(*texture) : EncodeJpeg(*texture, options.jpeg_quality));
+                            EncodeTexture(atlas, options, &resized, &texture));
 
   // Vertex data (no axis change: see the header).
   ExportMesh plain;
@@ -191,7 +303,6 @@ StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
   plain.uvs = mesh.uvs;
   plain.indices = mesh.indices;
   if (options.normals && !mesh.normals.empty()) plain.normals = UnitNormals(mesh);
-
   ExportMesh stored;
   std::vector<uint8_t> draco_bytes;
   std::map<std::string, int> draco_ids;
@@ -202,111 +313,21 @@ StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
   } else {
     stored = std::move(plain);
   }
-  const size_t num_vertices = stored.positions.size() / 3;
-  uint32_t max_index = 0;
-  for (uint32_t i : stored.indices) max_index = std::max(max_index, i);
 
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = std::string("casual3d ") + kVersion;
   model.buffers.resize(1);
-
   tinygltf::Primitive primitive;
   primitive.mode = TINYGLTF_MODE_TRIANGLES;
-  size_t mesh_bytes = 0;
-  // Indices: unsigned short when they fit (the 65535 value is reserved as a
-  // primitive restart in some APIs, so it is avoided).
-  const bool short_indices = max_index < 65535;
-  tinygltf::Accessor index_accessor;
-  index_accessor.componentType =
-      short_indices ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
-  index_accessor.count = stored.indices.size();
-  index_accessor.type = TINYGLTF_TYPE_SCALAR;
-  if (options.draco) {
-    // Accessors without buffer views: the data is in the Draco bitstream.
-    const int view = AddBufferView(&model, draco_bytes.data(), draco_bytes.size(), 0);
-    mesh_bytes = draco_bytes.size();
-    primitive.attributes["POSITION"] = AddFloatAccessor(&model, -1, stored.positions, 3, true);
-    if (!stored.normals.empty()) {
-      primitive.attributes["NORMAL"] = AddFloatAccessor(&model, -1, stored.normals, 3, false);
-    }
-    primitive.attributes["TEXCOORD_0"] = AddFloatAccessor(&model, -1, stored.uvs, 2, false);
-    tinygltf::Value::Object attributes;
-    for (const auto& [name, id] : draco_ids) attributes[name] = tinygltf::Value(id);
-    tinygltf::Value::Object extension;
-    extension["bufferView"] = tinygltf::Value(view);
-    extension["attributes"] = tinygltf::Value(std::move(attributes));
-    primitive.extensions[kDracoExtension] = tinygltf::Value(std::move(extension));
-  } else {
-    auto add_attribute = [&](const std::vector<float>& data, int components, bool bounds) {
-      const int view =
-          AddBufferView(&model, data.data(), data.size() * sizeof(float), kArrayBuffer);
-      mesh_bytes += data.size() * sizeof(float);
-      return AddFloatAccessor(&model, view, data, components, bounds);
-    };
-    primitive.attributes["POSITION"] = add_attribute(stored.positions, 3, true);
-    if (!stored.normals.empty())
-      primitive.attributes["NORMAL"] = add_attribute(stored.normals, 3, false);
-    primitive.attributes["TEXCOORD_0"] = add_attribute(stored.uvs, 2, false);
-    if (short_indices) {
-      std::vector<uint16_t> narrow(stored.indices.begin(), stored.indices.end());
-      index_accessor.bufferView =
-          AddBufferView(&model, narrow.data(), narrow.size() * 2, kElementArrayBuffer);
-      mesh_bytes += narrow.size() * 2;
-    } else {
-      index_accessor.bufferView = AddBufferView(&model, stored.indices.data(),
-                                                stored.indices.size() * 4, kElementArrayBuffer);
-      mesh_bytes += stored.indices.size() * 4;
-    }
-  }
-  model.accessors.push_back(index_accessor);
-  primitive.indices = static_cast<int>(model.accessors.size() - 1);
-
-  // Image, sampler, texture, material.
-  tinygltf::Image image;
-  image.name = "colour atlas";
-  image.mimeType = png ? "image/png" : "image/jpeg";
-  image.bufferView = AddBufferView(&model, image_bytes.data(), image_bytes.size(), 0);
-  model.images.push_back(image);
-  tinygltf::Sampler sampler;
-  sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-  sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-  sampler.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;  // Seam copies have u > 1.
-  sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-  model.samplers.push_back(sampler);
-  tinygltf::Texture gltf_texture;
-  gltf_texture.sampler = 0;
-  gltf_texture.source = 0;
-  model.textures.push_back(gltf_texture);
-  tinygltf::Material material;
-  material.name = "3D photo";
-  material.pbrMetallicRoughness.baseColorTexture.index = 0;
-  material.pbrMetallicRoughness.metallicFactor = 0.0;
-  material.pbrMetallicRoughness.roughnessFactor = 1.0;
-  material.doubleSided = options.double_sided;
-  if (options.unlit) {
-    material.extensions[kUnlitExtension] = tinygltf::Value(tinygltf::Value::Object());
-    model.extensionsUsed.push_back(kUnlitExtension);
-  }
-  model.materials.push_back(material);
+  const size_t mesh_bytes = AddMeshData(stored, draco_bytes, draco_ids, options.draco, &model, &primitive);
+  AddMaterial(image_bytes, options, &model);
   primitive.material = 0;
   if (options.draco) {
     model.extensionsUsed.push_back(kDracoExtension);
     model.extensionsRequired.push_back(kDracoExtension);
   }
-
-  tinygltf::Mesh gltf_mesh;
-  gltf_mesh.name = "3D photo";
-  gltf_mesh.primitives.push_back(primitive);
-  model.meshes.push_back(gltf_mesh);
-  tinygltf::Node node;
-  node.name = "3D photo";
-  node.mesh = 0;
-  model.nodes.push_back(node);
-  tinygltf::Scene scene;
-  scene.nodes.push_back(0);
-  model.scenes.push_back(scene);
-  model.defaultScene = 0;
+  AddScene(primitive, &model);
   // The BIN chunk length must be a multiple of 4; the serializer pads it.
   model.buffers[0].data.resize((model.buffers[0].data.size() + 3) & ~size_t{3}, 0);
 
@@ -318,7 +339,7 @@ StatusOr<std::string> EncodeGlbString(const Mesh& mesh, const Image8& atlas,
   }
   std::string glb = stream.str();
   if (stats) {
-    stats->num_vertices = num_vertices;
+    stats->num_vertices = stored.positions.size() / 3;
     stats->num_triangles = stored.indices.size() / 3;
     stats->texture_width = texture->width();
     stats->texture_height = texture->height();
