@@ -259,139 +259,164 @@ inline uint32_t PopCount(uint64_t v) {
 #endif
 }
 
-}  // namespace
+// A vertex key: node * 2 + (1 if its uv is in the other layer's half).
+inline uint32_t KeyOf(NodeRef r) { return ((r & kNodeMask) << 1) | ((r & kOtherHalfBit) ? 1u : 0u); }
 
-Mesh MeshAssembler::Finish(int num_threads) {
-  const int threads = ResolveThreads(num_threads);
-  ChooseAtlasHalves(threads);
-  const int w = pano_.width(), h = pano_.height();
-  // Vertex keys: node * 2 + (1 if its uv is in the other layer's half).
+// A seam copy's slot: (row, layer, other half).
+inline size_t SeamSlot(NodeRef r, int w) {
+  const uint32_t node = r & kNodeMask;
+  return 4 * static_cast<size_t>((node >> 1) / w) + 2 * (node & 1) + ((r & kOtherHalfBit) ? 1 : 0);
+}
+
+// The vertices the references use. Used keys are a bitmap with a running
+// count per 64-bit word: the vertex index of a key is its rank among used
+// keys (6 MB for 4096 x 2048 instead of a 128 MB index table). Seam copies
+// are numbered after them.
+struct VertexKeys {
+  size_t words = 0;
+  std::vector<uint64_t> used;
+  std::vector<uint32_t> used_before;     // Used keys in the words before.
+  std::vector<uint32_t> seam_vertex_of;  // By SeamSlot: index + 1; 0: unused.
+  uint32_t regular = 0;                  // Vertices that are not seam copies.
+  uint32_t count = 0;                    // All vertices.
+
+  uint32_t VertexOf(uint32_t key) const {
+    const uint64_t below = used[key >> 6] & ((uint64_t{1} << (key & 63)) - 1);
+    return used_before[key >> 6] + PopCount(below);
+  }
+};
+
+VertexKeys MarkVertexKeys(const std::vector<NodeRef>& refs, int w, int h, int threads) {
+  VertexKeys k;
   const size_t keys = static_cast<size_t>(w) * h * 2 * 2;
-  // Used keys as a bitmap with a running count per 64-bit word: the vertex
-  // index of a key is its rank among used keys (6 MB for 4096 x 2048 instead
-  // of a 128 MB index table).
-  const size_t words = (keys + 63) / 64;
-  std::vector<uint64_t> used(words, 0);
-  // Seam copies by (row, layer, other half): index + 1; 0: unused.
-  std::vector<uint32_t> seam_vertex_of(4 * static_cast<size_t>(h), 0);
-  auto key_of = [](NodeRef r) -> uint32_t {
-    return ((r & kNodeMask) << 1) | ((r & kOtherHalfBit) ? 1u : 0u);
-  };
-  auto seam_slot = [w](NodeRef r) -> size_t {
-    const uint32_t node = r & kNodeMask;
-    return 4 * static_cast<size_t>((node >> 1) / w) + 2 * (node & 1) +
-           ((r & kOtherHalfBit) ? 1 : 0);
-  };
+  k.words = (keys + 63) / 64;
+  k.used.assign(k.words, 0);
+  k.seam_vertex_of.assign(4 * static_cast<size_t>(h), 0);
   // Each chunk of references marks its own bitmap (the first chunk `used`
   // itself); the bitmaps are then OR-ed word range by word range.
-  const int64_t num_refs = static_cast<int64_t>(refs_.size());
+  const int64_t num_refs = static_cast<int64_t>(refs.size());
   const int mark_chunks = num_refs >= (int64_t{1} << 20) ? threads : 1;
   std::vector<std::vector<uint64_t>> more_used(static_cast<size_t>(mark_chunks - 1));
   std::vector<std::vector<uint32_t>> more_seams(static_cast<size_t>(mark_chunks - 1));
   ParallelFor(0, mark_chunks, threads, [&](int64_t c) {
-    uint64_t* bits = used.data();
-    uint32_t* seams = seam_vertex_of.data();
+    uint64_t* bits = k.used.data();
+    uint32_t* seams = k.seam_vertex_of.data();
     if (c > 0) {
-      more_used[c - 1].assign(words, 0);
-      more_seams[c - 1].assign(seam_vertex_of.size(), 0);
+      more_used[c - 1].assign(k.words, 0);
+      more_seams[c - 1].assign(k.seam_vertex_of.size(), 0);
       bits = more_used[c - 1].data();
       seams = more_seams[c - 1].data();
     }
     int64_t first, last;
     ChunkRange(num_refs, mark_chunks, c, &first, &last);
     for (int64_t i = first; i < last; ++i) {
-      const NodeRef r = refs_[i];
+      const NodeRef r = refs[i];
       if (r & kSeamBit) {
-        seams[seam_slot(r)] = 1;
+        seams[SeamSlot(r, w)] = 1;
       } else {
-        const uint32_t key = key_of(r);
+        const uint32_t key = KeyOf(r);
         bits[key >> 6] |= uint64_t{1} << (key & 63);
       }
     }
   });
   if (mark_chunks > 1) {
-    ParallelFor(0, static_cast<int64_t>(words), threads, [&](int64_t i) {
-      for (const auto& more : more_used) used[i] |= more[i];
+    ParallelFor(0, static_cast<int64_t>(k.words), threads, [&](int64_t i) {
+      for (const auto& more : more_used) k.used[i] |= more[i];
     }, 1 << 14);
     for (const auto& more : more_seams) {
-      for (size_t i = 0; i < seam_vertex_of.size(); ++i) seam_vertex_of[i] |= more[i];
+      for (size_t i = 0; i < k.seam_vertex_of.size(); ++i) k.seam_vertex_of[i] |= more[i];
     }
     std::vector<std::vector<uint64_t>>().swap(more_used);
   }
-  std::vector<uint32_t> used_before(words);
+  k.used_before.resize(k.words);
   uint32_t count = 0;
-  for (size_t i = 0; i < words; ++i) {
-    used_before[i] = count;
-    count += PopCount(used[i]);
+  for (size_t i = 0; i < k.words; ++i) {
+    k.used_before[i] = count;
+    count += PopCount(k.used[i]);
   }
-  const uint32_t regular = count;
-  for (uint32_t& v : seam_vertex_of) {
+  k.regular = count;
+  for (uint32_t& v : k.seam_vertex_of) {
     if (v) v = ++count;
   }
-  auto vertex_of = [&](uint32_t key) {
-    const uint64_t below = used[key >> 6] & ((uint64_t{1} << (key & 63)) - 1);
-    return used_before[key >> 6] + PopCount(below);
-  };
+  k.count = count;
+  return k;
+}
 
-  // Direction tables (Sec. 3 of spec/mesh.md): longitude per column and
-  // latitude per row at pixel centres, with the deterministic sine/cosine.
-  std::vector<double> sin_lon(w), cos_lon(w), sin_lat(h), cos_lat(h);
-  for (int x = 0; x < w; ++x) {
-    DeterministicSinCos(((x + 0.5) / w - 0.5) * 2.0 * kPi, &sin_lon[x], &cos_lon[x]);
-  }
-  for (int y = 0; y < h; ++y) {
-    DeterministicSinCos((0.5 - (y + 0.5) / h) * kPi, &sin_lat[y], &cos_lat[y]);
-  }
-
-  // Texture coordinates per column and per (row, layer), spec/mesh.md Sec. 3.
-  std::vector<float> u_of(w + 1), v_of(2 * static_cast<size_t>(h));
-  for (int x = 0; x <= w; ++x) u_of[x] = static_cast<float>((x + 0.5) / w);
-  for (int y = 0; y < h; ++y) {
-    for (int l = 0; l < kNumLayers; ++l) {
-      v_of[2 * y + l] = static_cast<float>((y + 0.5 + l * static_cast<double>(h)) / (2.0 * h));
+// Writes vertices of `pano` into a mesh sized for them: position from the
+// node's depth and its pixel's direction, normal, colour and uv.
+class VertexWriter {
+ public:
+  VertexWriter(const TwoLayerPanorama& pano, Mesh* mesh) : pano_(pano), mesh_(*mesh) {
+    const int w = pano.width(), h = pano.height();
+    // Direction tables (Sec. 3 of spec/mesh.md): longitude per column and
+    // latitude per row at pixel centres, with the deterministic sine/cosine.
+    sin_lon_.resize(w);
+    cos_lon_.resize(w);
+    sin_lat_.resize(h);
+    cos_lat_.resize(h);
+    for (int x = 0; x < w; ++x) {
+      DeterministicSinCos(((x + 0.5) / w - 0.5) * 2.0 * kPi, &sin_lon_[x], &cos_lon_[x]);
+    }
+    for (int y = 0; y < h; ++y) {
+      DeterministicSinCos((0.5 - (y + 0.5) / h) * kPi, &sin_lat_[y], &cos_lat_[y]);
+    }
+    // Texture coordinates per column and per (row, layer), spec/mesh.md Sec. 3.
+    u_of_.resize(w + 1);
+    v_of_.resize(2 * static_cast<size_t>(h));
+    for (int x = 0; x <= w; ++x) u_of_[x] = static_cast<float>((x + 0.5) / w);
+    for (int y = 0; y < h; ++y) {
+      for (int l = 0; l < kNumLayers; ++l) {
+        v_of_[2 * y + l] = static_cast<float>((y + 0.5 + l * static_cast<double>(h)) / (2.0 * h));
+      }
     }
   }
 
-  Mesh mesh;
-  mesh.positions.resize(3 * static_cast<size_t>(count));
-  mesh.normals.resize(3 * static_cast<size_t>(count));
-  mesh.uvs.resize(2 * static_cast<size_t>(count));
-  mesh.colors.resize(3 * static_cast<size_t>(count));
-  // Writes vertex `index`.
-  auto emit = [&](uint32_t index, int x, int y, int layer, int half, bool seam) {
+  // Writes vertex `index`: node (x, y, layer), its uv in atlas half `half`
+  // (column w's for a seam copy).
+  void Emit(uint32_t index, int x, int y, int layer, int half, bool seam) const {
     const LayerData& d = pano_.layer(layer);
     const size_t i = pano_.index(x, y);
     const double depth = d.depth_m[i];
-    const double horizontal = cos_lat[y] * depth;
-    float* position = &mesh.positions[3 * static_cast<size_t>(index)];
-    float* normal = &mesh.normals[3 * static_cast<size_t>(index)];
-    uint8_t* color = &mesh.colors[3 * static_cast<size_t>(index)];
-    float* uv = &mesh.uvs[2 * static_cast<size_t>(index)];
-    position[0] = static_cast<float>(horizontal * sin_lon[x]);
-    position[1] = static_cast<float>(sin_lat[y] * depth);
-    position[2] = static_cast<float>(-(horizontal * cos_lon[x]));
+    const double horizontal = cos_lat_[y] * depth;
+    float* position = &mesh_.positions[3 * static_cast<size_t>(index)];
+    float* normal = &mesh_.normals[3 * static_cast<size_t>(index)];
+    uint8_t* color = &mesh_.colors[3 * static_cast<size_t>(index)];
+    float* uv = &mesh_.uvs[2 * static_cast<size_t>(index)];
+    position[0] = static_cast<float>(horizontal * sin_lon_[x]);
+    position[1] = static_cast<float>(sin_lat_[y] * depth);
+    position[2] = static_cast<float>(-(horizontal * cos_lon_[x]));
     for (int c = 0; c < 3; ++c) {
       normal[c] = d.normal[3 * i + c];
       color[c] = d.rgb[3 * i + c];
     }
-    uv[0] = u_of[seam ? w : x];
-    uv[1] = v_of[2 * y + half];
-  };
-  // Used keys in increasing order, i.e. (row, column, layer, half) order, in
-  // ranges of words whose first vertex index is known from used_before. A
-  // word holds the keys of 16 pixels; its first pixel's row and column are
-  // carried from word to word instead of divided out per key.
-  const int64_t word_chunks = regular >= (1u << 16) ? 8 * static_cast<int64_t>(threads) : 1;
+    uv[0] = u_of_[seam ? pano_.width() : x];
+    uv[1] = v_of_[2 * y + half];
+  }
+
+ private:
+  const TwoLayerPanorama& pano_;
+  Mesh& mesh_;
+  std::vector<double> sin_lon_, cos_lon_, sin_lat_, cos_lat_;
+  std::vector<float> u_of_, v_of_;
+};
+
+// Writes the vertices of the used keys in increasing order, i.e. (row,
+// column, layer, half) order, in ranges of words whose first vertex index is
+// known from used_before. A word holds the keys of 16 pixels; its first
+// pixel's row and column are carried from word to word instead of divided
+// out per key.
+void EmitRegularVertices(const VertexKeys& k, int w, int threads, const VertexWriter& writer) {
+  const int64_t word_chunks = k.regular >= (1u << 16) ? 8 * static_cast<int64_t>(threads) : 1;
   ParallelFor(0, word_chunks, threads, [&](int64_t c) {
     int64_t first, last;
-    ChunkRange(static_cast<int64_t>(words), word_chunks, c, &first, &last);
+    ChunkRange(static_cast<int64_t>(k.words), word_chunks, c, &first, &last);
     if (first >= last) return;
     const uint64_t first_pixel = static_cast<uint64_t>(first) * 16;
     int word_x = static_cast<int>(first_pixel % static_cast<uint64_t>(w));
     int word_y = static_cast<int>(first_pixel / static_cast<uint64_t>(w));
-    uint32_t index = used_before[first];
+    uint32_t index = k.used_before[first];
     for (int64_t word = first; word < last; ++word) {
-      for (uint64_t bits = used[word]; bits != 0; bits &= bits - 1) {
+      for (uint64_t bits = k.used[word]; bits != 0; bits &= bits - 1) {
         const int bit = __builtin_ctzll(bits);
         int x = word_x + (bit >> 2), y = word_y;
         if (x >= w) {  // 16 pixels may run into the next rows when w < 16.
@@ -400,7 +425,7 @@ Mesh MeshAssembler::Finish(int num_threads) {
         }
         const int l = (bit >> 1) & 1;
         const int other = bit & 1;
-        emit(index++, x, y, l, l ^ other, false);
+        writer.Emit(index++, x, y, l, l ^ other, false);
       }
       word_x += 16;
       if (word_x >= w) {
@@ -409,18 +434,36 @@ Mesh MeshAssembler::Finish(int num_threads) {
       }
     }
   });
-  uint32_t index = regular;
+}
+
+}  // namespace
+
+Mesh MeshAssembler::Finish(int num_threads) {
+  const int threads = ResolveThreads(num_threads);
+  ChooseAtlasHalves(threads);
+  const int w = pano_.width(), h = pano_.height();
+  const VertexKeys keys = MarkVertexKeys(refs_, w, h, threads);
+
+  Mesh mesh;
+  mesh.positions.resize(3 * static_cast<size_t>(keys.count));
+  mesh.normals.resize(3 * static_cast<size_t>(keys.count));
+  mesh.uvs.resize(2 * static_cast<size_t>(keys.count));
+  mesh.colors.resize(3 * static_cast<size_t>(keys.count));
+  const VertexWriter writer(pano_, &mesh);
+  EmitRegularVertices(keys, w, threads, writer);
+  uint32_t index = keys.regular;
   for (int y = 0; y < h; ++y) {
     for (int l = 0; l < kNumLayers; ++l) {
       for (int other = 0; other < 2; ++other) {
-        if (seam_vertex_of[4 * y + 2 * l + other]) emit(index++, 0, y, l, l ^ other, true);
+        if (keys.seam_vertex_of[4 * y + 2 * l + other]) writer.Emit(index++, 0, y, l, l ^ other, true);
       }
     }
   }
   // References become indices in place (both are 32-bit).
+  const int64_t num_refs = static_cast<int64_t>(refs_.size());
   ParallelFor(0, num_refs, threads, [&](int64_t i) {
     NodeRef& r = refs_[i];
-    r = (r & kSeamBit) ? seam_vertex_of[seam_slot(r)] - 1 : vertex_of(key_of(r));
+    r = (r & kSeamBit) ? keys.seam_vertex_of[SeamSlot(r, w)] - 1 : keys.VertexOf(KeyOf(r));
   }, 1 << 16);
   mesh.indices = std::move(refs_);
   refs_ = std::vector<NodeRef>();

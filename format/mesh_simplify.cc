@@ -589,16 +589,11 @@ std::vector<Leaf> SelectLeaves(const std::vector<LayerPyramid>& pyramids, double
   return leaves;
 }
 
-// Builds the simplified mesh for a set of leaves (spec/mesh.md Sec. 5.4) and
-// sets *triangles to its triangle count. If `count_limit` >= 0 and the count
-// exceeds it, returns an empty mesh (the caller only needs the count). Rows
-// of quads and runs of leaves go to threads in bands whose triangles are
-// joined in order, so the mesh does not depend on the number of threads.
-Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>& leaves,
-              int threads, int64_t count_limit, int64_t* triangles) {
+// Per layer, whether a leaf of that layer covers the quad (1 or 0); the back
+// layer's only with use_back.
+void CoverLeafQuads(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>& leaves, int threads,
+                    std::vector<uint8_t> covered[kNumLayers]) {
   const int w = p.width(), qh = p.height() - 1;
-  // Per layer, whether a leaf of that layer covers the quad (1 or 0).
-  std::vector<uint8_t> covered[kNumLayers];
   for (int l = 0; l < (use_back ? kNumLayers : 1); ++l) {
     covered[l].assign(static_cast<size_t>(w) * qh, 0);
   }
@@ -615,6 +610,162 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
     }
     for (int y = 0; y < s; ++y, row += w) std::memset(row, 1, static_cast<size_t>(s));
   }, 1024);
+}
+
+// Step 1: the pixel-quad triangles the leaves leave, rows y_begin..y_end.
+// A quad covered by leaves of every layer that has a node at its corners
+// has no triangle left (each triangle starts at a corner node of an
+// uncovered layer).
+void AddUncoveredQuads(const TwoLayerPanorama& p, bool use_back, const std::vector<uint8_t> covered[kNumLayers],
+                       int64_t y_begin, int64_t y_end, MeshAssembler* out) {
+  const int w = p.width();
+  out->Reserve(static_cast<size_t>(w) * (y_end - y_begin) / 2 + 1024);
+  // See BackInColumns; zero without the back layer.
+  std::vector<uint8_t> back_in_column(w + 8, 0);
+  const uint8_t* bic = back_in_column.data();
+  for (int y = static_cast<int>(y_begin); y < y_end; ++y) {
+    const uint8_t* front_covered = &covered[kFront][static_cast<size_t>(y) * w];
+    const uint8_t* back_covered = use_back ? &covered[kBack][static_cast<size_t>(y) * w] : nullptr;
+    if (use_back) BackInColumns(p, y, back_in_column.data());
+    for (int x = 0; x < w; ++x) {
+      // Eight quads covered in front without back nodes have no triangle.
+      if ((x & 7) == 0 && x + 8 <= w &&
+          (Load64(front_covered + x) & ~(Load64(bic + x) | Load64(bic + x + 1))) == kOnes) {
+        x += 7;
+        continue;
+      }
+      if (!front_covered[x]) {
+        const unsigned skip = use_back ? static_cast<unsigned>(back_covered[x]) << 1 : 0u;
+        AddQuadTriangles(p, x, y, use_back, skip, out);
+        continue;
+      }
+      // Covered in front: triangles remain only from back nodes not covered.
+      if (!(bic[x] | bic[x + 1]) || back_covered[x]) continue;
+      AddQuadTriangles(p, x, y, use_back, 1u, out);
+    }
+  }
+}
+
+// The nodes kept by the simplified mesh (step 2), by node number
+// pixel * 2 + layer; a column of w is column 0's.
+class KeptNodes {
+ public:
+  explicit KeptNodes(const TwoLayerPanorama& p)
+      : p_(p), w_(p.width()), kept_(static_cast<size_t>(p.width()) * p.height() * 2, 0) {}
+
+  size_t node(int x, int y, int layer) const { return p_.index(x == w_ ? 0 : x, y) * 2 + layer; }
+  bool is_kept(size_t node) const { return kept_[node] != 0; }
+  bool is_kept(int x, int y, int layer) const { return is_kept(node(x, y, layer)); }
+  void Keep(size_t node) { kept_[node] = 1; }
+  void Release() { std::vector<uint8_t>().swap(kept_); }
+
+ private:
+  const TwoLayerPanorama& p_;
+  int w_;
+  std::vector<uint8_t> kept_;
+};
+
+// Step 2, kept nodes: every vertex of the remaining pixel-quad triangles
+// and every leaf corner. A band's triangles use the nodes of its rows and
+// of the row below, so bands of one parity never share a node: even bands,
+// then odd ones. Leaf corners are few.
+void KeepNodes(const std::vector<MeshAssembler>& quad_parts, const std::vector<Leaf>& leaves, int threads,
+               KeptNodes* kept) {
+  const int64_t row_bands = static_cast<int64_t>(quad_parts.size());
+  for (int parity = 0; parity < 2; ++parity) {
+    ParallelFor(0, (row_bands + 1 - parity) / 2, threads, [&](int64_t half) {
+      for (NodeRef r : quad_parts[2 * half + parity].refs()) kept->Keep(r & ~kSeamBit);
+    });
+  }
+  for (const Leaf& leaf : leaves) {
+    const int s = 1 << leaf.level;
+    kept->Keep(kept->node(leaf.x0, leaf.y0, leaf.layer));
+    kept->Keep(kept->node(leaf.x0 + s, leaf.y0, leaf.layer));
+    kept->Keep(kept->node(leaf.x0, leaf.y0 + s, leaf.layer));
+    kept->Keep(kept->node(leaf.x0 + s, leaf.y0 + s, leaf.layer));
+  }
+}
+
+// The triangles of a leaf's patch, from the kept nodes on the sides of its
+// ring (AddPatch builds the same patch): two for a bare quad, n - 2 for a
+// fan from a corner, n for a fan from the centre.
+int64_t CountPatchTriangles(const Leaf& leaf, const KeptNodes& kept) {
+  const int s = 1 << leaf.level, x0 = leaf.x0, y0 = leaf.y0, l = leaf.layer;
+  size_t extra[4] = {0, 0, 0, 0};  // Sides A-C, C-D, D-B, B-A.
+  for (int i = 1; i < s; ++i) {
+    extra[0] += kept.is_kept(x0, y0 + i, l);
+    extra[1] += kept.is_kept(x0 + i, y0 + s, l);
+    extra[2] += kept.is_kept(x0 + s, y0 + i, l);
+    extra[3] += kept.is_kept(x0 + i, y0, l);
+  }
+  const int64_t n = static_cast<int64_t>(4 + extra[0] + extra[1] + extra[2] + extra[3]);
+  return n == 4 ? 2 : (PatchApex(extra) >= 0 ? n - 2 : n);
+}
+
+// Step 3: the patch of one leaf, its border's kept nodes (`ring`: scratch)
+// fanned from a corner or the centre.
+void AddPatch(const TwoLayerPanorama& p, const Leaf& leaf, const KeptNodes& kept, std::vector<NodeRef>* ring,
+              MeshAssembler* out) {
+  const int w = p.width();
+  const int s = 1 << leaf.level, x0 = leaf.x0, y0 = leaf.y0, l = leaf.layer;
+  auto ref = [&](int x, int y) {
+    return x == w ? MakeNodeRef(p, 0, y, l, true) : MakeNodeRef(p, x, y, l, false);
+  };
+  // Border counter-clockwise seen from the centre: down the left side,
+  // right along the bottom, up the right side, left along the top.
+  // corner[] holds the ring positions of A, C, D, B; side i runs from
+  // corner i to i + 1.
+  ring->clear();
+  size_t corner[4];
+  corner[0] = ring->size();
+  for (int y = y0; y < y0 + s; ++y) {
+    if (y == y0 || kept.is_kept(x0, y, l)) ring->push_back(ref(x0, y));
+  }
+  corner[1] = ring->size();
+  for (int x = x0; x < x0 + s; ++x) {
+    if (x == x0 || kept.is_kept(x, y0 + s, l)) ring->push_back(ref(x, y0 + s));
+  }
+  corner[2] = ring->size();
+  for (int y = y0 + s; y > y0; --y) {
+    if (y == y0 + s || kept.is_kept(x0 + s, y, l)) ring->push_back(ref(x0 + s, y));
+  }
+  corner[3] = ring->size();
+  for (int x = x0 + s; x > x0; --x) {
+    if (x == x0 + s || kept.is_kept(x, y0, l)) ring->push_back(ref(x, y0));
+  }
+  const std::vector<NodeRef>& r = *ring;
+  const size_t n = r.size();
+  if (n == 4) {
+    // Corners A, C, D, B: the two triangles of a pixel quad (A-D diagonal).
+    out->AddTriangle(r[3], r[0], r[2]);
+    out->AddTriangle(r[1], r[2], r[0]);
+    return;
+  }
+  // A fan from a corner whose two sides have no extra vertex has no
+  // degenerate triangle and needs n - 2 triangles; otherwise fan from the
+  // block's centre node (n triangles).
+  size_t extra[4];
+  for (int i = 0; i < 4; ++i) extra[i] = (i == 3 ? n : corner[i + 1]) - corner[i] - 1;
+  const int apex = PatchApex(extra);
+  if (apex >= 0) {
+    const size_t v = corner[apex];
+    for (size_t i = 1; i + 1 < n; ++i) out->AddTriangle(r[v], r[(v + i) % n], r[(v + i + 1) % n]);
+  } else {
+    const NodeRef centre = ref(x0 + s / 2, y0 + s / 2);
+    for (size_t i = 0; i < n; ++i) out->AddTriangle(centre, r[i], r[(i + 1) % n]);
+  }
+}
+
+// Builds the simplified mesh for a set of leaves (spec/mesh.md Sec. 5.4) and
+// sets *triangles to its triangle count. If `count_limit` >= 0 and the count
+// exceeds it, returns an empty mesh (the caller only needs the count). Rows
+// of quads and runs of leaves go to threads in bands whose triangles are
+// joined in order, so the mesh does not depend on the number of threads.
+Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>& leaves,
+              int threads, int64_t count_limit, int64_t* triangles) {
+  const int qh = p.height() - 1;
+  std::vector<uint8_t> covered[kNumLayers];
+  CoverLeafQuads(p, use_back, leaves, threads, covered);
 
   // Step 1, remaining pixel-quad triangles, in bands of rows.
   const int64_t row_bands = std::min<int64_t>(qh, 8 * static_cast<int64_t>(threads));
@@ -623,86 +774,25 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
   ParallelFor(0, row_bands, threads, [&](int64_t band) {
     int64_t y_begin, y_end;
     ChunkRange(qh, row_bands, band, &y_begin, &y_end);
-    MeshAssembler& out = quad_parts[band];
-    out.Reserve(static_cast<size_t>(w) * (y_end - y_begin) / 2 + 1024);
-    // A quad covered by leaves of every layer that has a node at its corners
-    // has no triangle left (each triangle starts at a corner node of an
-    // uncovered layer).
-    // See BackInColumns; zero without the back layer.
-    std::vector<uint8_t> back_in_column(w + 8, 0);
-    const uint8_t* bic = back_in_column.data();
-    for (int y = static_cast<int>(y_begin); y < y_end; ++y) {
-      const uint8_t* front_covered = &covered[kFront][static_cast<size_t>(y) * w];
-      const uint8_t* back_covered =
-          use_back ? &covered[kBack][static_cast<size_t>(y) * w] : nullptr;
-      if (use_back) BackInColumns(p, y, back_in_column.data());
-      for (int x = 0; x < w; ++x) {
-        // Eight quads covered in front without back nodes have no triangle.
-        if ((x & 7) == 0 && x + 8 <= w &&
-            (Load64(front_covered + x) & ~(Load64(bic + x) | Load64(bic + x + 1))) == kOnes) {
-          x += 7;
-          continue;
-        }
-        if (!front_covered[x]) {
-          const unsigned skip = use_back ? static_cast<unsigned>(back_covered[x]) << 1 : 0u;
-          AddQuadTriangles(p, x, y, use_back, skip, &out);
-          continue;
-        }
-        // Covered in front: triangles remain only from back nodes not covered.
-        if (!(bic[x] | bic[x + 1]) || back_covered[x]) continue;
-        AddQuadTriangles(p, x, y, use_back, 1u, &out);
-      }
-    }
+    AddUncoveredQuads(p, use_back, covered, y_begin, y_end, &quad_parts[band]);
   });
-  // Step 2, kept nodes: every vertex of the remaining pixel-quad triangles
-  // and every leaf corner. A band's triangles use the nodes of its rows and
-  // of the row below, so bands of one parity never share a node: even bands,
-  // then odd ones. Leaf corners are few.
-  const size_t num_nodes = static_cast<size_t>(w) * p.height() * 2;
-  std::vector<uint8_t> kept(num_nodes, 0);
-  for (int parity = 0; parity < 2; ++parity) {
-    ParallelFor(0, (row_bands + 1 - parity) / 2, threads, [&](int64_t half) {
-      for (NodeRef r : quad_parts[2 * half + parity].refs()) kept[r & ~kSeamBit] = 1;
-    });
-  }
-  auto node = [&](int x, int y, int layer) { return p.index(x == w ? 0 : x, y) * 2 + layer; };
-  for (const Leaf& leaf : leaves) {
-    const int s = 1 << leaf.level;
-    kept[node(leaf.x0, leaf.y0, leaf.layer)] = 1;
-    kept[node(leaf.x0 + s, leaf.y0, leaf.layer)] = 1;
-    kept[node(leaf.x0, leaf.y0 + s, leaf.layer)] = 1;
-    kept[node(leaf.x0 + s, leaf.y0 + s, leaf.layer)] = 1;
-  }
-  auto is_kept = [&](size_t node) { return kept[node] != 0; };
+  KeptNodes kept(p);
+  KeepNodes(quad_parts, leaves, threads, &kept);
+  const int64_t num_leaves = static_cast<int64_t>(leaves.size());
   const int64_t leaf_runs = std::min<int64_t>(num_leaves, 8 * static_cast<int64_t>(threads));
   // Triangles of each run of leaves, when counted first (then exact
   // reservations for step 3).
   std::vector<int64_t> run_triangles;
   if (count_limit >= 0) {
     run_triangles.assign(static_cast<size_t>(leaf_runs), 0);
-    // Only the count may be needed: each patch's, from the kept nodes on the
-    // sides of its ring (step 3 below builds the same patches).
+    // Only the count may be needed: each patch's.
     int64_t quad_triangles = 0;
     for (const MeshAssembler& part : quad_parts) quad_triangles += part.num_triangles();
     ParallelFor(0, leaf_runs, threads, [&](int64_t run) {
       int64_t first, last;
       ChunkRange(num_leaves, leaf_runs, run, &first, &last);
       int64_t count = 0;
-      for (int64_t li = first; li < last; ++li) {
-        const Leaf& leaf = leaves[li];
-        const int s = 1 << leaf.level, x0 = leaf.x0, y0 = leaf.y0, l = leaf.layer;
-        size_t extra[4] = {0, 0, 0, 0};  // Sides A-C, C-D, D-B, B-A.
-        for (int i = 1; i < s; ++i) {
-          extra[0] += is_kept(node(x0, y0 + i, l));
-          extra[1] += is_kept(node(x0 + i, y0 + s, l));
-          extra[2] += is_kept(node(x0 + s, y0 + i, l));
-          extra[3] += is_kept(node(x0 + i, y0, l));
-        }
-        // Two triangles for a bare quad, n - 2 for a fan from a corner, n
-        // for a fan from the centre.
-        const int64_t n = static_cast<int64_t>(4 + extra[0] + extra[1] + extra[2] + extra[3]);
-        count += n == 4 ? 2 : (PatchApex(extra) >= 0 ? n - 2 : n);
-      }
+      for (int64_t li = first; li < last; ++li) count += CountPatchTriangles(leaves[li], kept);
       run_triangles[run] = count;
     });
     int64_t total = quad_triangles;
@@ -726,59 +816,9 @@ Mesh Assemble(const TwoLayerPanorama& p, bool use_back, const std::vector<Leaf>&
       out.Reserve(most);
     }
     std::vector<NodeRef> ring;
-    for (int64_t li = first; li < last; ++li) {
-      const Leaf& leaf = leaves[li];
-      const int s = 1 << leaf.level, x0 = leaf.x0, y0 = leaf.y0, l = leaf.layer;
-      auto ref = [&](int x, int y) {
-        return x == w ? MakeNodeRef(p, 0, y, l, true) : MakeNodeRef(p, x, y, l, false);
-      };
-      // Border counter-clockwise seen from the centre: down the left side,
-      // right along the bottom, up the right side, left along the top.
-      // corner[] holds the ring positions of A, C, D, B; side i runs from
-      // corner i to i + 1.
-      ring.clear();
-      size_t corner[4];
-      corner[0] = ring.size();
-      for (int y = y0; y < y0 + s; ++y) {
-        if (y == y0 || is_kept(node(x0, y, l))) ring.push_back(ref(x0, y));
-      }
-      corner[1] = ring.size();
-      for (int x = x0; x < x0 + s; ++x) {
-        if (x == x0 || is_kept(node(x, y0 + s, l))) ring.push_back(ref(x, y0 + s));
-      }
-      corner[2] = ring.size();
-      for (int y = y0 + s; y > y0; --y) {
-        if (y == y0 + s || is_kept(node(x0 + s, y, l))) ring.push_back(ref(x0 + s, y));
-      }
-      corner[3] = ring.size();
-      for (int x = x0 + s; x > x0; --x) {
-        if (x == x0 + s || is_kept(node(x, y0, l))) ring.push_back(ref(x, y0));
-      }
-      const size_t n = ring.size();
-      if (n == 4) {
-        // Corners A, C, D, B: the two triangles of a pixel quad (A-D diagonal).
-        out.AddTriangle(ring[3], ring[0], ring[2]);
-        out.AddTriangle(ring[1], ring[2], ring[0]);
-        continue;
-      }
-      // A fan from a corner whose two sides have no extra vertex has no
-      // degenerate triangle and needs n - 2 triangles; otherwise fan from the
-      // block's centre node (n triangles).
-      size_t extra[4];
-      for (int i = 0; i < 4; ++i) extra[i] = (i == 3 ? n : corner[i + 1]) - corner[i] - 1;
-      const int apex = PatchApex(extra);
-      if (apex >= 0) {
-        const size_t v = corner[apex];
-        for (size_t i = 1; i + 1 < n; ++i) {
-          out.AddTriangle(ring[v], ring[(v + i) % n], ring[(v + i + 1) % n]);
-        }
-      } else {
-        const NodeRef centre = ref(x0 + s / 2, y0 + s / 2);
-        for (size_t i = 0; i < n; ++i) out.AddTriangle(centre, ring[i], ring[(i + 1) % n]);
-      }
-    }
+    for (int64_t li = first; li < last; ++li) AddPatch(p, leaves[li], kept, &ring, &out);
   });
-  std::vector<uint8_t>().swap(kept);
+  kept.Release();
   MeshAssembler out(p);
   size_t total = 0;
   for (const MeshAssembler& part : quad_parts) total += part.num_triangles();
