@@ -55,18 +55,15 @@ const std::vector<float>& LossyNormalQualities() {
 StatusOr<std::vector<uint8_t>> EncodeLossyNormalTile(const TwoLayerPanorama& pano, int x0, int y0,
                                                      int w, int h, const Image8& image,
                                                      const NormalQuantization& q,
-                                                     const TileImageCodec& codec, int method,
+                                                     const TileImageCodec& codec, int lossy_method,
+                                                     const TileEncodeSettings& lossless,
                                                      NormalTileError* error) {
   struct Coded {
     std::vector<uint8_t> bytes;
     NormalTileError error;
     bool ok = false;
   };
-  auto code = [&](bool lossless, float quality) -> StatusOr<Coded> {
-    TileEncodeSettings settings;
-    settings.lossless = lossless;
-    settings.quality = quality;
-    settings.method = method;
+  auto code = [&](const TileEncodeSettings& settings) -> StatusOr<Coded> {
     Coded coded;
     CASUAL3D_ASSIGN_OR_RETURN(coded.bytes, codec.Encode(image.view(), settings));
     CASUAL3D_ASSIGN_OR_RETURN(Image8 decoded, codec.Decode(coded.bytes.data(), coded.bytes.size()));
@@ -83,7 +80,10 @@ StatusOr<std::vector<uint8_t>> EncodeLossyNormalTile(const TwoLayerPanorama& pan
   Coded best;
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    CASUAL3D_ASSIGN_OR_RETURN(Coded coded, code(false, qualities[mid]));
+    TileEncodeSettings lossy;
+    lossy.quality = qualities[mid];
+    lossy.method = lossy_method;
+    CASUAL3D_ASSIGN_OR_RETURN(Coded coded, code(lossy));
     if (coded.ok) {
       best = std::move(coded);
       hi = mid;
@@ -92,7 +92,7 @@ StatusOr<std::vector<uint8_t>> EncodeLossyNormalTile(const TwoLayerPanorama& pan
     }
   }
   if (!best.ok) {
-    CASUAL3D_ASSIGN_OR_RETURN(best, code(true, 75.0f));
+    CASUAL3D_ASSIGN_OR_RETURN(best, code(lossless));
     if (!best.ok)
       return InternalError("lossless normal codes exceed the bounds (mean " +
                            std::to_string(best.error.mean_deg) + ", p99 " +

@@ -39,13 +39,14 @@ const std::vector<float>& LossyNormalQualities();
 // Encodes `image` (EncodeTileImage's lossy normal image of that tile, absent
 // nodes filled or not) with `codec` at the lowest quality of
 // LossyNormalQualities() (by bisection) whose decoded normals are within
-// q.mean_error_deg and q.p99_error_deg, or lossless when none is; `method`
-// is the codec's speed/size trade-off. `error`, if not null, receives the
-// chosen coding's error.
+// q.mean_error_deg and q.p99_error_deg, with the speed/size trade-off
+// `lossy_method`; or, when none is, with the lossless `lossless` settings.
+// `error`, if not null, receives the chosen coding's error.
 StatusOr<std::vector<uint8_t>> EncodeLossyNormalTile(const TwoLayerPanorama& pano, int x0, int y0,
                                                      int w, int h, const Image8& image,
                                                      const NormalQuantization& q,
-                                                     const TileImageCodec& codec, int method,
+                                                     const TileImageCodec& codec, int lossy_method,
+                                                     const TileEncodeSettings& lossless,
                                                      NormalTileError* error = nullptr);
 
 }  // namespace casual3d::encoder

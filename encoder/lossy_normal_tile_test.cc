@@ -32,6 +32,14 @@ TwoLayerPanorama NoisyNormals(double noise) {
   return pano;
 }
 
+TileEncodeSettings Lossless() {
+  TileEncodeSettings s;
+  s.lossless = true;
+  s.quality = 25.0f;
+  s.method = 1;
+  return s;
+}
+
 struct Coded {
   std::vector<uint8_t> bytes;
   NormalTileError error;
@@ -46,7 +54,8 @@ Coded Code(const TwoLayerPanorama& pano, const NormalQuantization& q) {
   const TileImageCodec* codec = *TileImageCodecFor(WebpTileImageFormat());
   Coded c;
   StatusOr<std::vector<uint8_t>> bytes =
-      EncodeLossyNormalTile(pano, 0, 0, pano.width(), pano.height(), image, q, *codec, 3, &c.error);
+      EncodeLossyNormalTile(pano, 0, 0, pano.width(), pano.height(), image, q, *codec, 3,
+                            Lossless(), &c.error);
   EXPECT_TRUE(bytes.ok()) << bytes.status().ToString();
   c.bytes = *bytes;
   c.decoded = *codec->Decode(c.bytes.data(), c.bytes.size());

@@ -200,15 +200,20 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
     if (options.fill_absent &&
         (job.kind == TileImageKind::kDepth || job.kind == TileImageKind::kNormal))
       FillAbsentCodes(*level_pano[job.level], x, y, w, h, &image);
-    TileEncodeSettings settings;
-    settings.lossless = TileImageIsLossless(job.kind, manifest.normal.type);
-    settings.quality = settings.lossless ? options.lossless_effort : options.color_quality;
-    settings.method = settings.lossless ? options.lossless_method : options.color_method;
+    TileEncodeSettings lossless;
+    lossless.lossless = true;
+    lossless.quality = options.lossless_effort;
+    lossless.method = options.lossless_method;
+    TileEncodeSettings color;
+    color.quality = options.color_quality;
+    color.method = options.color_method;
+    // Lossy normals choose their own quality per tile, the colour's method.
     StatusOr<std::vector<uint8_t>> bytes =
         job.kind == TileImageKind::kNormal && manifest.normal.lossy()
             ? EncodeLossyNormalTile(*level_pano[job.level], x, y, w, h, image, manifest.normal,
-                                    *codec, options.color_method)
-            : codec->Encode(static_cast<const Image8&>(image).view(), settings);
+                                    *codec, options.color_method, lossless)
+            : codec->Encode(static_cast<const Image8&>(image).view(),
+                            TileImageIsLossless(job.kind, manifest.normal.type) ? lossless : color);
     if (!bytes.ok()) {
       job_status[j] = Status(bytes.status().code(), job.path + ": " + bytes.status().message());
       failed.store(true);

@@ -66,16 +66,15 @@ StatusOr<std::vector<uint8_t>> EncodeWebp(ImageView<const uint8_t> rgb,
 }
 
 StatusOr<Image8> DecodeWebp(const uint8_t* data, size_t size, int64_t max_pixels) {
-  int width = 0, height = 0;
-  if (data == nullptr || size == 0 || !WebPGetInfo(data, size, &width, &height))
+  // One parse of the headers: the size and whether there is alpha.
+  WebPBitstreamFeatures features;
+  if (data == nullptr || size == 0 || WebPGetFeatures(data, size, &features) != VP8_STATUS_OK)
     return InvalidData("not a WebP image");
+  const int width = features.width, height = features.height;
   if (width < 1 || height < 1 || width > kMaxWebpDimension || height > kMaxWebpDimension ||
       static_cast<int64_t>(width) * height > max_pixels)
     return LimitExceeded("WebP image of " + std::to_string(width) + "x" + std::to_string(height) +
                          " exceeds the limit");
-  WebPBitstreamFeatures features;
-  if (WebPGetFeatures(data, size, &features) != VP8_STATUS_OK)
-    return InvalidData("not a WebP image");
   const int channels = features.has_alpha ? 4 : 3;
   Image8 image(width, height, channels);
   const uint8_t* decoded =
