@@ -5,8 +5,24 @@
 // an OffscreenCanvas 2D readback: the package's images are opaque RGB (alpha is
 // ignored by the format), so the readback returns the decoded values unchanged.
 
-let canvas = null;
-let context = null;
+// One canvas per image size: a package's images come in two to three sizes
+// (w x h graph, w x 2h colour, depth and normal, 2w x 2h lossy normal), and
+// resizing a single canvas between them reallocates its backing store.
+const contexts = new Map();
+
+function contextFor(width, height) {
+  const key = `${width}x${height}`;
+  let context = contexts.get(key);
+  if (context) {
+    context.clearRect(0, 0, width, height);
+    return context;
+  }
+  if (contexts.size >= 4) contexts.clear();
+  context = new OffscreenCanvas(width, height).getContext('2d', { willReadFrequently: true, alpha: true });
+  if (!context) throw new Error('this browser offers no 2D OffscreenCanvas to read decoded tiles');
+  contexts.set(key, context);
+  return context;
+}
 
 /**
  * @param {Uint8Array} bytes the encoded image
@@ -25,17 +41,7 @@ export async function decodeImage(bytes, name, type) {
   }
   try {
     const { width, height } = bitmap;
-    if (!canvas) {
-      canvas = new OffscreenCanvas(width, height);
-      context = canvas.getContext('2d', { willReadFrequently: true, alpha: true });
-      if (!context) throw new Error('this browser offers no 2D OffscreenCanvas to read decoded tiles');
-    }
-    if (canvas.width !== width || canvas.height !== height) {
-      canvas.width = width;
-      canvas.height = height;
-    } else {
-      context.clearRect(0, 0, width, height);
-    }
+    const context = contextFor(width, height);
     context.drawImage(bitmap, 0, 0);
     return { width, height, data: context.getImageData(0, 0, width, height).data };
   } finally {
