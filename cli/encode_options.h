@@ -37,8 +37,8 @@ struct EncodeCommandOptions {
     v.Field("package.levels", o.package.levels, R::ZeroOr(R::Closed(1, kMaxLevels)),
             "Levels of detail; 0 = automatic");
     v.Field("package.depth_bits", o.package.depth_bits, R::Closed(8, 16),
-            "Bits of the log-depth code (10: relative error at most 0.34% for far/near 1000; "
-            "12 for 0.084%)");
+            "Bits of the log-depth code (9: relative error at most 0.68% for far/near 1000; "
+            "10 for 0.34%, 12 for 0.084%)");
     v.Field("package.normal_bits", o.package.normal_bits, R::Closed(4, 8),
             "Bits per octahedral normal coordinate (5: angular error at most 8.1 degrees; 8 for "
             "1 degree)");

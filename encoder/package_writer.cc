@@ -95,7 +95,7 @@ Status PackageOptions::Check() const {
 PackageOptions DeliveryPackageOptions() {
   PackageOptions options;
   options.normal_bits = 5;
-  options.depth_bits = 10;
+  options.depth_bits = 9;
   options.lossless_method = 4;
   options.lossless_effort = 75.0f;
   options.fill_absent = true;

@@ -220,9 +220,9 @@ TEST_F(PackageWriterTest, DeliveryOptionsKeepTheirBoundsAndShrinkThePackage) {
                                     const TwoLayerPanorama& decoded) {
     EXPECT_FALSE(manifest.normal.lossy());
     EXPECT_EQ(manifest.normal.bits, 5);
-    EXPECT_EQ(manifest.depth.bits, 10);
-    // Depth within exp(ln(50) / 2046) - 1 = 0.19% (the bound of 10-bit codes).
-    EXPECT_NEAR(manifest.depth.MaxRelativeError(), std::exp(std::log(50.0) / 2046) - 1, 1e-5);
+    EXPECT_EQ(manifest.depth.bits, 9);
+    // Depth within exp(ln(50) / 1020) - 1 = 0.38% (the bound of 9-bit codes).
+    EXPECT_NEAR(manifest.depth.MaxRelativeError(), std::exp(std::log(50.0) / 1020) - 1, 1e-5);
     const double min_psnr[3] = {37.5, 35.5, 33.5};
     ExpectDecodedMatches(expected, decoded, manifest.depth, min_psnr[level], 8.1);
   });

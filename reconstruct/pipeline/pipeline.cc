@@ -33,9 +33,9 @@ using Clock = std::chrono::steady_clock;
 // text used to carry. panorama-8: stitched colour and depth blended across
 // the photos that agree, depth smoothed along surfaces
 // (spec/stage-panorama.md, version 7). encode-3: coarser levels take the mean
-// normal of their block, the manifest is compact.
+// normal of their block, the manifest is compact. encode-4: 9-bit depth.
 constexpr const char* kStageVersions[kNumStages] = {"sparse-4", "dense-5", "panorama-8",
-                                                    "encode-3"};
+                                                    "encode-4"};
 
 std::string HashHex(const std::string& text) {
   return Sha256Hex(reinterpret_cast<const uint8_t*>(text.data()), text.size());

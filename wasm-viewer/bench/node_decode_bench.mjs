@@ -22,6 +22,7 @@ import path from 'node:path';
 
 import { loadFormatModule, runTool } from '../test/node-support.mjs';
 import { readPackageLevel } from '../test/node-package.mjs';
+import { simplifyMaxError } from '../js/mesh-error.js';
 
 const repeats = Number(process.argv[3] ?? 3);
 const level = Number(process.argv[4] ?? 0);
@@ -61,12 +62,14 @@ try {
     b.cpu = Math.min(b.cpu, cpu);
     first[step] ??= { wall, cpu };
   };
+  // As the viewer's worker: the simplifier's error beyond the depth code's step.
+  const simplifyError = simplifyMaxError(JSON.parse(fs.readFileSync(path.join(pkg, 'manifest.json'), 'utf8')).depth_encoding);
   let full = 0, simplified = 0, bound = 0;
   for (let r = 0; r < repeats; ++r) {
     const { pano, timing, cpu } = await readPackageLevel(format, pkg, level);
     for (const k of Object.keys(timing)) keep(k, timing[k], cpu[k]);
     let mesh, wall, c;
-    [mesh, wall, c] = measure(() => format.buildMesh(pano, { maxTriangles: MAX_TRIANGLES }));
+    [mesh, wall, c] = measure(() => format.buildMesh(pano, { maxTriangles: MAX_TRIANGLES, maxRelativeError: simplifyError }));
     keep('meshSimplifiedMs', wall, c);
     simplified = mesh.indices.length / 3;
     bound = mesh.maxRelativeError;

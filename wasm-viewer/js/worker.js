@@ -28,6 +28,7 @@
 import { FormatModule } from './format-module.js';
 import { Casual3dPackage } from './format.js';
 import { openUrl } from './package-source.js';
+import { simplifyMaxError } from './mesh-error.js';
 import { decodeImage } from './tile-decoder.js';
 import { buildEnvironment } from './environment.js';
 import { deriveViewHints, narrowContent, parseViewHints, presenceFromMesh } from './view-hints.js';
@@ -104,6 +105,8 @@ async function load({ id, url, maxLevelWidth, maxTriangles, backdrop: withBackdr
   // that the camera's far plane never clips the scene: a model in COLMAP
   // units can lie thousands of units away.
   const depthFarM = reader.depthFarM;
+  // The reader accepted depth_encoding, so it is in range.
+  const simplifyError = simplifyMaxError(pkg.manifest.depth_encoding);
   try {
     const numLevels = reader.numLevels;
     // Coarsest first; finer levels while they fit maxLevelWidth.
@@ -159,7 +162,9 @@ async function load({ id, url, maxLevelWidth, maxTriangles, backdrop: withBackdr
         try {
           // The full mesh has about 2 triangles per node; simplify above the budget.
           const fullEstimate = 2 * info.width * info.height;
-          mesh = format.buildMesh(pano, { maxTriangles: fullEstimate > maxTriangles ? maxTriangles : 0 });
+          mesh = format.buildMesh(pano, fullEstimate > maxTriangles
+            ? { maxTriangles, maxRelativeError: simplifyError }
+            : { maxTriangles: 0 });
           if (withBackdrop) backdrop = format.buildBackdrop(pano, { cellPx: backdropCell(info.width, info.height, maxTriangles) });
           atlas = pano.atlas();
         } finally {
