@@ -6,6 +6,7 @@
 // The input is a package folder (holding manifest.json), a single-file package
 // (.c3d) or a master file (OpenEXR), recognised by content, not by name.
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -52,8 +53,11 @@ std::string Number(double value) {
   return buf;
 }
 
-// Reads the panorama from whatever `input` is.
-TwoLayerPanorama LoadPanorama(const ExportOptions& opts) {
+// Reads the panorama from whatever `input` is. *depth_code_step receives the
+// relative depth step between neighbouring codes of a package (spec Sec. 4.2),
+// 0 for a master file, whose depth is exact.
+TwoLayerPanorama LoadPanorama(const ExportOptions& opts, double* depth_code_step) {
+  *depth_code_step = 0.0;
   const std::string& input = opts.input;
   std::error_code ec;
   const fs::file_status st = fs::status(input, ec);
@@ -68,6 +72,8 @@ TwoLayerPanorama LoadPanorama(const ExportOptions& opts) {
     Manifest manifest;
     auto pano = ReadPackage(source, encoder::TileImageDecoders(), read, &manifest);
     if (!pano.ok()) Fail(input + ": " + pano.status().ToString());
+    const double half_step = manifest.depth.MaxRelativeError();
+    *depth_code_step = (1.0 + half_step) * (1.0 + half_step) - 1.0;
     return std::move(pano).value();
   };
 
@@ -135,7 +141,8 @@ void RunExport(ExportOptions& opts) {
   };
   // Three stages: read, build the mesh, encode and write.
   util::Progress progress("export", 3);
-  const TwoLayerPanorama pano = LoadPanorama(opts);
+  double depth_code_step = 0.0;
+  const TwoLayerPanorama pano = LoadPanorama(opts, &depth_code_step);
   progress.Advance();
   util::LogInfo("read " + opts.input + ": " + std::to_string(pano.width()) + "x" +
                 std::to_string(pano.height()) + " panorama" + since(start));
@@ -146,6 +153,10 @@ void RunExport(ExportOptions& opts) {
     opts.simplify_options.max_pixels = std::max<int64_t>(
         opts.simplify_options.max_pixels, static_cast<int64_t>(pano.width()) * pano.height());
     opts.simplify_options.validate_input = false;  // The readers validated it.
+    // A package's depth is a staircase of code steps: --max-error is counted
+    // beyond one step, as the viewer does (spec Sec. 4.2).
+    opts.simplify_options.max_relative_error =
+        std::min(0.5, opts.simplify_options.max_relative_error + depth_code_step);
     auto simplified = BuildSimplifiedMesh(pano, opts.simplify_options);
     if (!simplified.ok()) Fail(opts.input + ": " + simplified.status().ToString());
     if (!simplified->budget_met) {

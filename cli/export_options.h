@@ -40,7 +40,8 @@ struct ExportOptions {
     // Library: (0, 0.5]; from 1e-6 on here, a bound that keeps the mesh finite.
     v.Field("simplify_options.max_relative_error", o.simplify_options.max_relative_error,
             R::Closed(1e-6, 0.5),
-            "Largest relative depth error of the simplification (0.01 = 1%)");
+            "Largest relative depth error of the simplification (0.01 = 1%); from a "
+            "package, beyond one step of its depth code");
     v.Field("texture", o.texture, R::OneOf({"jpeg", "png"}), "Texture format");
     v.Field("gltf.jpeg_quality", o.gltf.jpeg_quality, R::Closed(1, 100), "JPEG quality");
     v.Field("gltf.max_texture_size", o.gltf.max_texture_size, R::Closed(16, 16384),
