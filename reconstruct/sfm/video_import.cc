@@ -75,6 +75,12 @@ double Motion(const cv::Mat& a, const cv::Mat& b) {
 
 }  // namespace
 
+std::string VideoFrameName(int index) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "frame_%06d.jpg", index);
+  return name;
+}
+
 bool IsVideoFileName(const std::string& name) {
   const std::string l = Lower(name);
   if (name.empty() || name[0] == '.') return false;
@@ -207,9 +213,7 @@ VideoFrames ExtractVideoFrames(const std::string& video, const std::string& outp
     Image8 rgb(frame.cols, frame.rows, 3);
     cv::Mat dst = io::ToMat(rgb);
     cv::cvtColor(frame, dst, cv::COLOR_BGR2RGB);
-    char name[32];
-    std::snprintf(name, sizeof(name), "/%04zu.jpg", next);
-    io::WriteJpeg(output_dir + name, rgb, jpeg);
+    io::WriteJpeg(output_dir + "/" + VideoFrameName(i), rgb, jpeg);
     ++next;
   }
   if (next < result.picked.size()) {

@@ -60,6 +60,12 @@ struct VideoFrames {
   double seconds = 0.0;       // Decoding and frame selection.
 };
 
+// The name of the picked frame `index` (zero-based, in decoding order) of a
+// clip: "frame_000123.jpg". Frames are named by their place in the clip, so
+// that a picked frame can be found again (and matched with ground truth
+// rendered along the clip, synth/clip.h).
+std::string VideoFrameName(int index);
+
 // True for the file names of videos (.mp4, .mov, .m4v, .mkv, .avi, .webm; any case).
 bool IsVideoFileName(const std::string& name);
 
@@ -70,7 +76,7 @@ bool IsVideoFileName(const std::string& name);
 std::string VideoOf(const std::string& input);
 
 // Decodes `video`, picks frames and writes them to `output_dir` (must exist)
-// as NNNN.jpg in clip order. Throws std::runtime_error with one clear line if
+// named by their index in the clip (VideoFrameName). Throws std::runtime_error with one clear line if
 // the file cannot be decoded or yields fewer than 3 frames.
 VideoFrames ExtractVideoFrames(const std::string& video, const std::string& output_dir,
                                const VideoFrameOptions& options);
