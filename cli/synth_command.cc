@@ -38,6 +38,7 @@ void AddSynthCommand(CLI::App& app) {
           },
           "", "even"));
   AddDescribedOption(cmd, "--jpeg-quality", *options, options->jpeg_quality);
+  AddDescribedOption(cmd, "--video-frames", *options, options->video_frames);
   AddDescribedOption(cmd, "--threads", *options, options->num_threads);
   cmd->callback([options, rig_name, out_dir] {
     if (!synth::RigKindFromName(*rig_name, &options->rig)) {
@@ -52,6 +53,13 @@ void AddSynthCommand(CLI::App& app) {
         s.mean_track_length, s.depth_min_m, s.depth_max_m, s.panorama_width, s.panorama_height,
         s.wrote_master ? " + master.exr" : "", s.seconds_photos, s.seconds_panorama,
         s.seconds_total);
+    if (s.video_frames > 0) {
+      std::printf(
+          "synth: wrote %s/video: %d frames and their ground truth (video/sparse), the nearest "
+          "frame %.1f-%.1f cm from each photo; %.1f s\n",
+          out_dir->c_str(), s.video_frames, 100.0 * s.video_min_distance_m,
+          100.0 * s.video_max_distance_m, s.seconds_video);
+    }
   });
 }
 

@@ -14,6 +14,7 @@
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/io/image_io.h"
 #include "reconstruct/io/jpeg_exif.h"
+#include "reconstruct/synth/clip.h"
 #include "reconstruct/synth/default_scene.h"
 #include "reconstruct/synth/ground_truth_panorama.h"
 #include "reconstruct/synth/ground_truth_two_layer.h"
@@ -61,6 +62,12 @@ RigOptions SynthOptions::ResolvedRig() const {
 
 Status SynthOptions::Check() const {
   CASUAL3D_RETURN_IF_ERROR(util::CheckFields(*this));
+  // The clip's path interpolates orientations about their mean (clip.h):
+  // the sphere rig's turn all around has no such mean.
+  if (video_frames > 0 && rig == RigKind::kSphere)
+    return InvalidArgument(
+        "video_frames " + std::to_string(video_frames) +
+        ": a video clip follows the partial or walk-around rig, not the sphere rig");
   return ResolvedRig().Check();
 }
 
@@ -165,7 +172,7 @@ void WriteGroundTruthPanorama(const SynthOptions& options, const Scene& scene, c
 nlohmann::ordered_json CaptureJson(const SynthOptions& options, const RigOptions& rig_options, const Rig& rig,
                                    const PanoramaFrame& frame, const RenderedPhotos& photos,
                                    const TwoLayerOptions& two_layer_options, double pano_lo, double pano_hi,
-                                   const CaptureSummary& summary) {
+                                   const CaptureSummary& summary, const ClipSummary* clip) {
   const int n = rig_options.num_photos;
   const int pano_w = options.panorama_width, pano_h = options.panorama_width / 2;
   nlohmann::ordered_json j;
@@ -221,6 +228,18 @@ nlohmann::ordered_json CaptureJson(const SynthOptions& options, const RigOptions
   }
   j["photos"] = list;
   j["sparse_points"] = summary.num_points;
+  if (clip != nullptr) {
+    nlohmann::ordered_json nearest = nlohmann::ordered_json::array();
+    for (const NearestFrame& f : clip->nearest)
+      nearest.push_back({{"photo", f.photo},
+                         {"frame", f.frame},
+                         {"distance_m", f.distance_m},
+                         {"angle_deg", f.angle_deg}});
+    j["video"] = {{"frames", clip->num_frames},
+                  {"frame_names", "video/frame_NNNNNN.jpg"},
+                  {"sparse", "video/sparse"},
+                  {"nearest_frame", nearest}};
+  }
   return j;
 }
 
@@ -249,6 +268,28 @@ CaptureSummary GenerateCapture(const SynthOptions& options, const std::string& d
   summary.seconds_photos = Seconds(photos_start);
   WriteGroundTruthSparse(options, rig, photos, dir, &summary);
 
+  ClipSummary clip;
+  if (options.video_frames > 0) {
+    ClipOptions clip_options;
+    clip_options.num_frames = options.video_frames;
+    clip_options.seed = options.seed;
+    clip_options.noise_sigma = options.noise_sigma;
+    clip_options.exposure_jitter_stops = options.exposure_jitter_stops;
+    clip_options.moving_object = options.moving_object;
+    clip_options.moving_step_m = options.moving_step_m;
+    clip_options.jpeg_quality = options.jpeg_quality;
+    clip_options.edge_samples = options.edge_samples;
+    clip_options.num_threads = options.num_threads;
+    clip = WriteClip(clip_options, rig_options, centre, scene, rig, photos.names, dir);
+    summary.video_frames = clip.num_frames;
+    summary.seconds_video = clip.seconds;
+    summary.video_min_distance_m = std::numeric_limits<double>::infinity();
+    for (const NearestFrame& f : clip.nearest) {
+      summary.video_max_distance_m = std::max(summary.video_max_distance_m, f.distance_m);
+      summary.video_min_distance_m = std::min(summary.video_min_distance_m, f.distance_m);
+    }
+  }
+
   // Ground-truth panorama from the rig centre (panorama frame = world axes).
   const Clock::time_point pano_start = Clock::now();
   PanoramaFrame frame;
@@ -264,7 +305,8 @@ CaptureSummary GenerateCapture(const SynthOptions& options, const std::string& d
   summary.depth_max_m = std::max(photos.depth_hi, pano_hi);
 
   const nlohmann::ordered_json j = CaptureJson(options, rig_options, rig, frame, photos, two_layer_options,
-                                               pano_lo, pano_hi, summary);
+                                               pano_lo, pano_hi, summary,
+                                               options.video_frames > 0 ? &clip : nullptr);
   io::WriteFileAtomic(dir + "/capture.json", j.dump(2) + "\n");
   summary.seconds_total = Seconds(start);
   return summary;

@@ -9,6 +9,8 @@
 //   DIR/ground_truth/panorama.exr  first/second surfaces from the rig centre (ground_truth_panorama.h)
 //   DIR/ground_truth/master.exr    the same as a two-layer master file (ground_truth_two_layer.h)
 //   DIR/capture.json           rig, seed, options, panorama frame, scene facts
+//   DIR/video/                 with video_frames > 0: the capture as a video
+//                              clip's frames and their ground truth (clip.h)
 // The same options give the same bytes in every file, whatever the thread count.
 
 #include <cstdint>
@@ -35,6 +37,9 @@ struct SynthOptions {
   int edge_samples = 3;           // Anti-aliasing rays per axis at edge pixels, 1..8.
   int sparse_step_px = 24;        // Grid spacing of sampled 3D points in each photo, pixels.
   bool write_master = true;       // Also write ground_truth/master.exr.
+  // Also render the capture as a hand-held video clip of this many frames
+  // (DIR/video, clip.h; 300 = 10 s at 30 fps); 0: none, else 2..100000.
+  int video_frames = 0;
   int num_threads = 0;            // 0: all cores.
 
   template <typename Self, typename Visitor>
@@ -63,6 +68,10 @@ struct SynthOptions {
     v.Field("sparse_step_px", o.sparse_step_px, R::Closed(2, 4096),
             "Grid spacing of sampled 3D points in each photo, pixels");
     v.Field("write_master", o.write_master, R::Any(), "Also write ground_truth/master.exr");
+    v.Field("video_frames", o.video_frames, R::ZeroOr(R::Closed(2, 100000)),
+            "Also render the capture as a hand-held video clip of this many frames "
+            "(DIR/video/frame_NNNNNN.jpg and ground truth DIR/video/sparse; 300 = 10 s at 30 fps); "
+            "0 = none");
     v.Field("num_threads", o.num_threads, R::AtLeast(0), "Worker threads (0: all cores)",
             util::Keyed::kNo);
   }
@@ -86,6 +95,11 @@ struct CaptureSummary {
   double seconds_panorama = 0;
   double seconds_total = 0;
   bool wrote_master = false;
+  int video_frames = 0;        // Frames of the clip written to DIR/video.
+  double seconds_video = 0;
+  // The clip's nearest frame to each photo (clip.h), when video_frames > 0.
+  double video_max_distance_m = 0;   // Largest over the photos of the nearest frame's distance.
+  double video_min_distance_m = 0;   // Smallest of them.
 };
 
 // Writes the capture folder `dir` (created if missing; existing files of the
