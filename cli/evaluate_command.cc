@@ -2,7 +2,7 @@
 // [--json out.json] [--width 900] [--photos names...] [--holdout-every N]
 // [--labels names...] [--reference NAME:PSNR:SSIM] [--no-viewer-views] [--no-backdrop]
 // [--viewer-width 640] [--viewer-height 400] [--viewer-images DIR] [--rephoto-images DIR]
-// [--write-cameras cameras.json] [--rendered DIR]`:
+// [--write-cameras cameras.json] [--rendered DIR] [--reference-poses SPARSE_DIR]`:
 // virtual rephotography (paper Sec. 6.3) of one or more 3D photos of the same
 // capture and what a viewer sees of each (tears, stretched fill), with a
 // self-contained HTML report and a JSON summary. --write-cameras and
@@ -95,6 +95,7 @@ void AddEvaluateFlags(CLI::App* cmd, const std::shared_ptr<EvaluateArgs>& args) 
                   "matrices in the panorama frame, which is glTF's) for rendering them elsewhere; "
                   "one 3D photo only");
   AddDescribedOption(cmd, "--rendered", args->options, args->options.rendered_dir);
+  AddDescribedOption(cmd, "--reference-poses", args->options, args->options.reference_poses);
 }
 
 // The checks of the arguments and what follows from them (the references,

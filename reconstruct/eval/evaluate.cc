@@ -1,10 +1,12 @@
 #include "reconstruct/eval/evaluate.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -334,6 +336,19 @@ struct PosedPhotos {
   std::map<std::string, const geometry::ModelImage*> by_name;
 };
 
+// Fills the names and the by-name index of posed->model.
+void IndexPosedPhotos(PosedPhotos* posed) {
+  posed->names.clear();
+  posed->by_name.clear();
+  for (const auto& [id, image] : posed->model.images) {
+    posed->names.push_back(image.name);
+    posed->by_name[image.name] = &image;
+  }
+  std::sort(posed->names.begin(), posed->names.end());
+  if (posed->names.empty())
+    throw std::runtime_error(posed->model_dir.string() + ": the model has no registered photos");
+}
+
 void ReadPosedPhotos(const fs::path& model_dir, PosedPhotos* posed) {
   posed->model_dir = model_dir;
   try {
@@ -341,13 +356,36 @@ void ReadPosedPhotos(const fs::path& model_dir, PosedPhotos* posed) {
   } catch (const std::exception& e) {
     throw std::runtime_error(model_dir.string() + ": " + e.what());
   }
-  for (const auto& [id, image] : posed->model.images) {
-    posed->names.push_back(image.name);
-    posed->by_name[image.name] = &image;
-  }
-  std::sort(posed->names.begin(), posed->names.end());
-  if (posed->names.empty())
-    throw std::runtime_error(model_dir.string() + ": the model has no registered photos");
+  IndexPosedPhotos(posed);
+}
+
+// With options.reference_poses: the reference's photos, posed in the 3D
+// photo's world by aligning `own` (the 3D photo's model) to the reference over
+// the photos both hold other than the evaluated ones; `selected` receives
+// the evaluated photos' indices among the reference's names.
+PosedPhotos PosedFromReference(const PosedPhotos& own, const EvaluateOptions& options,
+                               PhotoModelEvaluation* eval, std::vector<int>* selected) {
+  PosedPhotos ref;
+  ReadPosedPhotos(FindReferenceModel(options.reference_poses), &ref);
+  *selected = SelectPhotos(ref.names, options.photos, options.holdout_every, eval->holdout);
+  std::set<std::string> evaluated;
+  for (const int i : *selected) evaluated.insert(ref.names[i]);
+  ReferenceAlignment alignment;
+  ref.model = PosesFromReference(own.model, ref.model, evaluated, own.model_dir.string(),
+                                 ref.model_dir.string(), &alignment);
+  IndexPosedPhotos(&ref);
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "evaluate: poses from %s, aligned to %s by %d common photos: scale %.4g, "
+                "residuals %.3f deg and %.4g (reference units) on average",
+                ref.model_dir.c_str(), own.model_dir.c_str(), alignment.num_common,
+                alignment.model_to_reference.scale, alignment.mean_rotation_error_deg,
+                alignment.mean_centre_error);
+  util::LogInfo(line);
+  eval->reference_alignment = alignment;
+  eval->poses_from = ref.model_dir.string() + " (aligned to " + own.model_dir.string() + " by " +
+                     std::to_string(alignment.num_common) + " photos)";
+  return ref;
 }
 
 // The photo `index` of `posed` at the evaluated width, as the capture holds
@@ -436,11 +474,19 @@ PhotoModelEvaluation EvaluatePhoto3d(const std::string& capture_dir,
   PosedPhotos posed;
   ReadPosedPhotos(FindSparseWorkspace(photo3d.root, capture), &posed);
   eval.poses_from = posed.model_dir.string();
-  const std::vector<int> selected =
-      SelectPhotos(posed.names, options.photos, options.holdout_every, eval.holdout);
+  std::vector<int> selected;
+  if (options.reference_poses.empty()) {
+    selected = SelectPhotos(posed.names, options.photos, options.holdout_every, eval.holdout);
+  } else {
+    posed = PosedFromReference(posed, options, &eval, &selected);
+    IndexPosedPhotos(&posed);  // Pointers into this copy's model.
+  }
   double depth_scale = 1.0;
   if (fs::is_directory(capture / "depth", ec)) {
-    depth_scale = ModelToCaptureScale(posed.model, posed.model_dir, capture);
+    // The reference is in the capture's units: the alignment's scale takes
+    // the 3D photo's units there.
+    depth_scale = eval.reference_alignment ? eval.reference_alignment->model_to_reference.scale
+                                           : ModelToCaptureScale(posed.model, posed.model_dir, capture);
     eval.depth_scale = depth_scale;
   }
 

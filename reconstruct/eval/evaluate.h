@@ -20,6 +20,12 @@
 // gave its pose (SPARSE/images/<name>), else CAPTURE/images/<name>, else
 // CAPTURE/<name>; it must have the camera's size.
 //
+// With EvaluateOptions::reference_poses, the evaluated photos' poses and
+// cameras come from that reference model instead, mapped into the 3D
+// photo's world by aligning the 3D photo's model to it over the photos both
+// hold (reference_alignment.h): for photos the 3D photo's model lacks, such
+// as the photos held out of a 3D photo made from a video's frames.
+//
 // Held-out views: ROOT/report.json may list "holdout" (names of photos that
 // were registered but not used to build the 3D photo); by default exactly
 // those are evaluated. Without such a list every registered photo is.
@@ -35,6 +41,7 @@
 
 #include "format/status.h"
 #include "format/image.h"
+#include "reconstruct/eval/reference_alignment.h"
 #include "reconstruct/eval/rephoto_metrics.h"
 #include "reconstruct/eval/viewer_views.h"
 #include "reconstruct/util/options_fields.h"
@@ -76,6 +83,14 @@ struct EvaluateOptions {
   // are skipped (they are this program's renders).
   // Needs cameras without lens distortion (the undistorted workspace).
   std::string rendered_dir;
+  // A COLMAP model folder (or a folder with sparse/ or sparse/0) holding the
+  // evaluated photos and at least 3 of the 3D photo's own photos (or video
+  // frames), by file name: when not empty, the evaluated photos' poses and
+  // cameras come from it, mapped into the 3D photo's world
+  // (reference_alignment.h), and `photos` and `holdout_every` name or index
+  // its photos. Ground-truth depth is compared after the alignment's scale,
+  // so the reference must be in the capture's units (its ground truth).
+  std::string reference_poses;
 
   // `photos`, a list, is not described (options_fields.h describes single
   // values); any list is valid.
@@ -102,6 +117,10 @@ struct EvaluateOptions {
             "Score renderings made elsewhere instead of rendering here: one PNG per photo "
             "(<photo stem>.png, RGBA, alpha 0 = nothing drawn) from the cameras of "
             "--write-cameras");
+    v.Field("reference_poses", o.reference_poses, R::Any(),
+            "Take the evaluated photos' poses from this COLMAP model (e.g. a synthetic "
+            "capture's ground truth), aligned to the 3D photo's model by the photos or video "
+            "frames both hold (at least 3, by file name): for photos the 3D photo's model lacks");
   }
   Status Check() const { return util::CheckFields(*this); }  // Names the field and its range.
 };
@@ -143,6 +162,9 @@ struct PhotoModelEvaluation {
   std::string label;       // The 3D photo's path as given (or a caller's name for it).
   std::string source;      // What was read: "master.exr" path or package path.
   std::string poses_from;  // The sparse model folder used.
+  // With EvaluateOptions::reference_poses: how the 3D photo's model was
+  // aligned to the reference giving the poses.
+  std::optional<ReferenceAlignment> reference_alignment;
   int pano_width = 0, pano_height = 0;
   size_t mesh_triangles = 0;      // spec/mesh.md's mesh.
   size_t backdrop_triangles = 0;  // The backdrop drawn with it in the viewer views.

@@ -160,6 +160,57 @@ TEST_F(EvaluateSyntheticTest, DepthOfAModelAtAnotherScaleIsComparedAfterScaling)
   fs::remove_all(root);
 }
 
+// A 3D photo whose own model lacks the evaluated photos (as one made from a
+// video's frames lacks the photos held out of it): their poses come from the
+// capture's ground truth, aligned to the 3D photo's model (here the whole
+// world at 2.5 times the scale and shifted) by the photos both hold.
+TEST_F(EvaluateSyntheticTest, PhotosMissingFromTheModelArePosedFromTheReference) {
+  constexpr double kScale = 2.5;
+  const Eigen::Vector3d shift(0.4, -1.0, 3.0);
+  const fs::path root = dir_ / "without_0_and_5";
+  fs::create_directories(root / "work" / "sparse" / "sparse");
+  geometry::SparseModel model = geometry::ReadModel((dir_ / "sparse").string());
+  for (int id : {1, 6}) model.images.erase(id);  // 0000.jpg and 0005.jpg.
+  for (auto& [id, image] : model.images)
+    image.pose = geometry::Pose::FromCenter(image.pose.R(), kScale * image.pose.Center() + shift);
+  model.points.clear();
+  for (auto& [id, image] : model.images) image.points2d.clear();
+  geometry::WriteModelBinary(model, (root / "work" / "sparse" / "sparse").string());
+  auto pano = encoder::ReadMasterFile((dir_ / "photo3d" / "master.exr").string());
+  ASSERT_TRUE(pano.ok()) << pano.status().ToString();
+  for (int l = 0; l < kNumLayers; ++l)
+    for (float& d : pano->layer(l).depth_m) d *= static_cast<float>(kScale);
+  for (int k = 0; k < 3; ++k) pano->frame().centre[k] = kScale * pano->frame().centre[k] + shift[k];
+  ASSERT_TRUE(encoder::WriteMasterFile(*pano, (root / "master.exr").string()).ok());
+
+  EvaluateOptions options;
+  options.width = 160;
+  options.viewer_views = false;
+  options.photos = {"0000.jpg", "0005.jpg"};
+  // Without the reference, the photos are not in the 3D photo's model.
+  EXPECT_THROW(EvaluatePhoto3d(dir_.string(), root.string(), options), std::runtime_error);
+  options.reference_poses = (dir_ / "sparse").string();
+  const PhotoModelEvaluation e = EvaluatePhoto3d(dir_.string(), root.string(), options);
+  ASSERT_TRUE(e.reference_alignment.has_value());
+  EXPECT_EQ(e.reference_alignment->num_common, 6);
+  EXPECT_NEAR(e.reference_alignment->model_to_reference.scale, 1.0 / kScale, 1e-6);
+  EXPECT_NEAR(e.depth_scale, 1.0 / kScale, 1e-6);
+  ASSERT_EQ(e.photos.size(), 2u);
+  ASSERT_TRUE(e.has_depth);
+  // As well rephotographed as from the capture's own poses.
+  options.reference_poses.clear();
+  const PhotoModelEvaluation direct =
+      EvaluatePhoto3d(dir_.string(), (dir_ / "photo3d").string(), options);
+  for (size_t i = 0; i < e.photos.size(); ++i) {
+    const PhotoEvaluation& p = e.photos[i];
+    EXPECT_GT(p.metrics.completeness, 0.95) << p.name;
+    EXPECT_NEAR(p.metrics.psnr_db, direct.photos[i].metrics.psnr_db, 0.05) << p.name;
+    EXPECT_LT(p.depth.median_relative_error, 0.01) << p.name;
+    EXPECT_NEAR(p.depth.median_ratio, 1.0, 0.01) << p.name;
+  }
+  fs::remove_all(root);
+}
+
 TEST_F(EvaluateSyntheticTest, ReadsSingleFilePackages) {
   auto pano = encoder::ReadMasterFile((dir_ / "photo3d" / "master.exr").string());
   ASSERT_TRUE(pano.ok()) << pano.status().ToString();

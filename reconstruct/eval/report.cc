@@ -293,6 +293,15 @@ std::string RenderJsonReport(const std::string& capture,
     m["label"] = e.label;
     m["source"] = e.source;
     m["poses_from"] = e.poses_from;
+    if (e.reference_alignment) {
+      const ReferenceAlignment& a = *e.reference_alignment;
+      m["reference_alignment"] = {{"common_photos", a.num_common},
+                                  {"scale", a.model_to_reference.scale},
+                                  {"mean_rotation_error_deg", a.mean_rotation_error_deg},
+                                  {"max_rotation_error_deg", a.max_rotation_error_deg},
+                                  {"mean_centre_error", a.mean_centre_error},
+                                  {"max_centre_error", a.max_centre_error}};
+    }
     m["pano_width"] = e.pano_width;
     m["pano_height"] = e.pano_height;
     m["mesh_triangles"] = e.mesh_triangles;
