@@ -100,6 +100,7 @@ void AddSparseCommand(CLI::App& app) {
   AddDescribedOption(cmd, "--threads", s, s.num_threads);
   AddDescribedOption(cmd, "--init-tri-angle", s, s.init_min_tri_angle_deg);
   AddDescribedOption(cmd, "--min-registered", s, s.min_registered_fraction);
+  AddDescribedOption(cmd, "--min-photo-points", s, s.min_photo_points);
   cmd->add_flag("--robust-centre", s.frame.robust_centre,
                 "Centre the 3D photo at the geometric median of the cameras, not their mean");
   AddDescribedOption(cmd, "--colmap", s, s.colmap_path);

@@ -23,6 +23,7 @@
 #include "reconstruct/sfm/colmap_database.h"
 #include "reconstruct/sfm/colmap_runner.h"
 #include "reconstruct/sfm/descriptor_matcher.h"
+#include "reconstruct/sfm/untied_photos.h"
 #include "reconstruct/util/log.h"
 
 namespace casual3d::sfm {
@@ -285,6 +286,7 @@ Json OptionsJson(const SparseStageOptions& o) {
           {"num_threads", o.num_threads},
           {"init_min_tri_angle_deg", o.init_min_tri_angle_deg},
           {"min_registered_fraction", o.min_registered_fraction},
+          {"min_photo_points", o.min_photo_points},
           {"depth_ranges",
            {{"near_percentile", o.depth_ranges.near_percentile},
             {"far_percentile", o.depth_ranges.far_percentile},
@@ -492,6 +494,26 @@ RawModel RegisterPhotos(const std::string& input, const std::string& video,
   return raw;
 }
 
+// Leaves out of `raw`'s model the photos that see fewer than
+// options.min_photo_points 3D points (untied_photos.h), writing the model
+// that remains to WORK/sparse_tied for the undistortion.
+void LeaveOutUntiedPhotos(const SparseStageOptions& options, const fs::path& work,
+                          const std::string& log_path, RawModel* raw) {
+  const std::vector<UntiedPhoto> dropped = DropUntiedPhotos(options.min_photo_points, &raw->model);
+  for (const UntiedPhoto& u : dropped) {
+    const std::string line = "left out " + u.name + ": registered, but sees only " +
+                             std::to_string(u.points) + " 3D points (fewer than " +
+                             std::to_string(options.min_photo_points) +
+                             "): nothing ties its pose to the other photos";
+    AppendLog(log_path, line);
+    util::LogWarning(line);
+  }
+  if (dropped.empty()) return;
+  raw->model_dir = work / "sparse_tied";
+  fs::create_directories(raw->model_dir);
+  geometry::WriteModelBinary(raw->model, raw->model_dir.string());
+}
+
 // Registration check: which photos the model holds; throws if fewer than
 // min_registered_fraction of them (and at least 3).
 void CheckRegistration(const RawModel& raw, const SparseStageOptions& options, SparseStageResult* result) {
@@ -624,8 +646,9 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
 
   SparseStageResult result;
   result.input_type = workspace ? "workspace" : video.empty() ? "photos" : "video";
-  const RawModel raw = workspace ? WorkspaceModel(input_path, workspace_models, log_path)
+  RawModel raw = workspace ? WorkspaceModel(input_path, workspace_models, log_path)
                                  : RegisterPhotos(input, video, options, colmap, threads, work, log_path, &result);
+  if (!workspace && options.min_photo_points > 0) LeaveOutUntiedPhotos(options, work, log_path, &raw);
   CheckRegistration(raw, options, &result);
   Undistort(raw, colmap, log_path, tmp, work, &result);
   SetUpScene(tmp, options, &result);

@@ -81,6 +81,12 @@ struct SparseStageOptions {
   // Fewer registered photos than this fraction of the input is an error; any
   // unregistered photo is a warning.
   double min_registered_fraction = 0.5;  // Range [0, 1].
+  // A photo the mapper registered but that sees fewer 3D points than this
+  // is left out as unregistered: nothing ties its pose to the others (the
+  // points that registered it were filtered out afterwards), and a pose
+  // adrift would move the 3D photo's frame and depth ranges. COLMAP
+  // registers a photo from 15 matches at least (Mapper.min_num_matches).
+  int min_photo_points = 15;  // Range [0, 1e6]; 0 keeps every registered photo.
   bool overwrite = false;   // Replace an existing OUT (only once the new one is complete).
   bool keep_work = false;   // Keep COLMAP's database and raw models in OUT/work.
   std::string colmap_path;  // Empty: `colmap` on PATH.
@@ -110,6 +116,8 @@ struct SparseStageOptions {
             "Smallest triangulation angle of the mapper's initial pair, degrees");
     v.Field("min_registered_fraction", o.min_registered_fraction, R::Closed(0, 1),
             "Fewer registered photos than this fraction is an error");
+    v.Field("min_photo_points", o.min_photo_points, R::Closed(0, 1000000),
+            "Registered photos seeing fewer 3D points are left out (unregistered); 0 keeps all");
     v.Field("overwrite", o.overwrite, R::Any(), "Replace an existing output folder", util::Keyed::kNo);
     v.Field("keep_work", o.keep_work, R::Any(), "Keep COLMAP's database and raw models in OUT/work");
     v.Field("colmap_path", o.colmap_path, R::Any(), "COLMAP program; empty: colmap on PATH");
