@@ -274,7 +274,6 @@ Json OptionsJson(const SparseStageOptions& o) {
             {"min_step_fraction", o.video.min_step_fraction},
             {"blur_ratio", o.video.blur_ratio},
             {"blur_window", o.video.blur_window},
-            {"near_sharpest", o.video.near_sharpest},
             {"analysis_long_side", o.video.analysis_long_side}}},
           {"camera_model", o.camera_model},
           {"shared_camera", o.shared_camera},

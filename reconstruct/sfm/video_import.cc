@@ -144,28 +144,15 @@ std::vector<int> PickFrames(const std::vector<double>& sharpness, const std::vec
   for (int k = 0; k < count; ++k) {
     // Step k holds the frames whose accumulated motion is within half a step of k steps.
     const double lo = (k - 0.5) * step, hi = (k + 0.5) * step;
-    int sharpest = -1, begin = -1, end = -1;
+    int best = -1;
     for (int i = first; i < n && along[i] < hi; ++i) {
       if (along[i] < lo) continue;
-      const bool better = sharpest < 0 || (sharp[i] && !sharp[sharpest]) ||
-                          (sharp[i] == sharp[sharpest] && sharpness[i] > sharpness[sharpest]);
-      if (better) sharpest = i;
-      if (begin < 0) begin = i;
-      end = i + 1;
+      const bool better = best < 0 || (sharp[i] && !sharp[best]) ||
+                          (sharp[i] == sharp[best] && sharpness[i] > sharpness[best]);
+      if (better) best = i;
       first = i + 1;
     }
-    if (sharpest < 0) continue;
-    // Of the frames about as sharp as the sharpest, the one nearest the
-    // step's centre: steps then stay about even, where the sharpest alone
-    // can sit at the end of one step next to the start of the next one.
-    int best = sharpest;
-    for (int i = begin; i < end; ++i) {
-      if (sharp[i] != sharp[sharpest] ||
-          sharpness[i] < options.near_sharpest * sharpness[sharpest])
-        continue;
-      if (std::abs(along[i] - k * step) < std::abs(along[best] - k * step)) best = i;
-    }
-    picked.push_back(best);
+    if (best >= 0) picked.push_back(best);
   }
   return picked;
 }

@@ -10,10 +10,9 @@
 //   2. motion between consecutive frames: median displacement of corners
 //      tracked by pyramidal Lucas-Kanade, summed along the clip;
 //   3. the accumulated motion is cut into equal steps (at least min_step of the
-//      frame diagonal, at most max_frames frames), and each step keeps, of its
-//      frames that are not blurred and about as sharp as its sharpest, the one
-//      nearest its centre: spread evenly over the motion, not hundreds of near
-//      duplicates of a pause.
+//      frame diagonal, at most max_frames frames), and each step keeps its
+//      sharpest frame that is not blurred: spread over the motion, not hundreds
+//      of near duplicates of a pause.
 // Frames carry no focal length: COLMAP starts from its default prior.
 
 #include <string>
@@ -31,10 +30,6 @@ struct VideoFrameOptions {
   double min_step_fraction = 0.02;  // Range [0, 1].
   double blur_ratio = 0.7;          // Range [0, 1]; 0 keeps every frame.
   int blur_window = 7;              // Range [1, 100]; neighbours on each side.
-  // Within a step, frames at least this sharp relative to the step's
-  // sharpest count as sharp as it, and the one nearest the step's centre is
-  // kept; 1: always the sharpest.
-  double near_sharpest = 0.8;       // Range [0, 1].
   int analysis_long_side = 480;     // Range [64, 4096]; pixels of the analysis copy.
   int jpeg_quality = 95;            // Range [50, 100]; quality of the written frames.
 
@@ -46,9 +41,6 @@ struct VideoFrameOptions {
             "Smallest motion between picked frames, fraction of the frame diagonal");
     v.Field("blur_ratio", o.blur_ratio, R::Closed(0, 1), "Frames less sharp than this times their neighbours' median are skipped; 0 keeps all");
     v.Field("blur_window", o.blur_window, R::Closed(1, 100), "Neighbours on each side for the sharpness test");
-    v.Field("near_sharpest", o.near_sharpest, R::Closed(0, 1),
-            "Frames this sharp relative to a step's sharpest count as sharp, and the one nearest "
-            "the step's centre is kept; 1 = the sharpest");
     v.Field("analysis_long_side", o.analysis_long_side, R::Closed(64, 4096), "Long side of the analysis copy, pixels");
     v.Field("jpeg_quality", o.jpeg_quality, R::Closed(50, 100), "Quality of the written frames");
   }

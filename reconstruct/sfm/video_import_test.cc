@@ -5,7 +5,6 @@
 
 #include <unistd.h>
 
-#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -44,28 +43,6 @@ TEST(PickFramesTest, SpreadOverTheMotionSharpAndBounded) {
   EXPECT_NE(std::set<int>(picked.begin(), picked.end()).count(160), 0u);
   // A floor on the step: 99 units at >= 30 per step give 4 frames.
   EXPECT_EQ(PickFrames(sharpness, motion, 30.0, options, nullptr).size(), 4u);
-}
-
-// Regression: with every frame sharp, the sharpest of each step could sit at
-// its end next to the start of the next step (a synthetic clip's frames 274
-// and 275 were both picked). Frames about as sharp as the sharpest are
-// equal, and the one nearest the step's centre is kept.
-TEST(PickFramesTest, EvenStepsWhenEveryFrameIsSharp) {
-  const int n = 91;
-  std::vector<double> sharpness(n), motion(n, 1.0);
-  for (int i = 0; i < n; ++i) sharpness[i] = 90.0 + (i * 37 % 11);  // 90..100, uneven.
-  VideoFrameOptions options;
-  options.max_frames = 11;  // Steps of 9 frames.
-  const std::vector<int> picked = PickFrames(sharpness, motion, 0.0, options, nullptr);
-  ASSERT_EQ(picked.size(), 11u);
-  for (int k = 0; k < 11; ++k) EXPECT_EQ(picked[k], 9 * k);
-  // Always the sharpest: uneven.
-  options.near_sharpest = 1.0;
-  const std::vector<int> sharpest = PickFrames(sharpness, motion, 0.0, options, nullptr);
-  int smallest_gap = n;
-  for (size_t k = 1; k < sharpest.size(); ++k)
-    smallest_gap = std::min(smallest_gap, sharpest[k] - sharpest[k - 1]);
-  EXPECT_LT(smallest_gap, 6);
 }
 
 class VideoImportTest : public ::testing::Test {
