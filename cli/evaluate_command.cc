@@ -59,8 +59,9 @@ void AddEvaluateFlags(CLI::App* cmd, const std::shared_ptr<EvaluateArgs>& args) 
   cmd->add_option("--json", args->json, "Also write the figures as JSON to this file");
   AddDescribedOption(cmd, "--width", args->options, args->options.width);
   cmd->add_option("--photos", args->options.photos,
-                  "Photos to evaluate, by file name or index in the sorted model (default: the "
-                  "3D photo's held-out photos, else all)");
+                  "Photos to evaluate, by file name or index in the sorted model (the "
+                  "reference's with --reference-poses; default: the 3D photo's held-out photos, "
+                  "else all)");
   AddDescribedOption(cmd, "--holdout-every", args->options, args->options.holdout_every);
   AddDescribedOption(cmd, "--shift", args->options, args->options.metrics.shift_radius_px);
   AddDescribedOption(cmd, "--threads", args->options, args->options.num_threads);
