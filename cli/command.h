@@ -29,7 +29,8 @@ void AddSparseCommand(CLI::App& app);
 // --max-features, --sift-first-octave and --colmap-matching, shared by
 // `sparse` and `reconstruct` (cli/sparse_command.cc).
 void AddSiftOptions(CLI::App* cmd, sfm::SparseStageOptions* options);
-// --strict-photos, --mixed-cameras and --max-frames (photo and video input).
+// --strict-photos, --mixed-cameras, --max-frames and --video-focal-guess
+// (photo and video input).
 void AddPhotoInputOptions(CLI::App* cmd, sfm::SparseStageOptions* options);
 
 // `casual3d dense <workspace> -o <out>` (cli/dense_command.cc).

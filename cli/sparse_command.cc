@@ -70,6 +70,7 @@ void AddPhotoInputOptions(CLI::App* cmd, sfm::SparseStageOptions* options) {
   cmd->add_flag("--mixed-cameras", options->import.allow_mixed_devices,
                 "Accept photos from different cameras (one calibration per camera)");
   AddDescribedOption(cmd, "--max-frames", *options, options->video.max_frames);
+  AddDescribedOption(cmd, "--video-focal-guess", *options, options->video.focal_guess);
 }
 
 void AddSparseCommand(CLI::App& app) {

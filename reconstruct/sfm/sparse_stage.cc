@@ -105,14 +105,20 @@ std::string LastLines(const std::string& text) {
 
 // `focal_unknown`: some photos had no focal length (no EXIF, no --focal-px),
 // which COLMAP's default guess (1.2 times the long side, a 45-degree view)
-// often fails to start from; a video never carries one.
+// often fails to start from; a video never carries one. `focal_guess`: the
+// video's frames started from this guess (VideoFrameOptions::focal_guess,
+// times the long side), 0 if none.
 std::string NothingRegisteredMessage(int num_photos, const std::string& input_type = "photos",
-                                     bool focal_unknown = false) {
+                                     bool focal_unknown = false, double focal_guess = 0.0) {
   const bool video = input_type == "video";
   const std::string what = std::to_string(num_photos) + (video ? " frames" : " photos");
-  if (focal_unknown) {
+  if (focal_unknown || (video && focal_guess > 0)) {
     return "COLMAP registered none of the " + what + " (no initial pair found); " +
-           (video ? "a video carries no focal length" : "the photos carry no focal length (EXIF)") +
+           (video ? "a video carries no focal length" +
+                        (focal_guess > 0 ? " (tried " + FormatNumber(focal_guess) +
+                                               " times the long side)"
+                                         : std::string())
+                  : "the photos carry no focal length (EXIF)") +
            ": give the camera's with --focal-px (pixels at the " + (video ? "video's" : "photos'") +
            " size; about 0.8 times the long side for a phone's main camera)" +
            (video ? "" : ", or take more photos with more overlap of a textured scene");
@@ -274,7 +280,8 @@ Json OptionsJson(const SparseStageOptions& o) {
             {"min_step_fraction", o.video.min_step_fraction},
             {"blur_ratio", o.video.blur_ratio},
             {"blur_window", o.video.blur_window},
-            {"analysis_long_side", o.video.analysis_long_side}}},
+            {"analysis_long_side", o.video.analysis_long_side},
+            {"focal_guess", o.video.focal_guess}}},
           {"camera_model", o.camera_model},
           {"shared_camera", o.shared_camera},
           {"matcher", matcher},
@@ -371,11 +378,22 @@ PhotoImport ImportInput(const std::string& input, const std::string& video,
     result->timings_s.emplace_back("frame_selection", v.seconds);
     photo_dir = frames.string();
   }
+  PhotoImportOptions import = options.import;
+  if (!video.empty() && !(import.focal_px > 0) && options.video.focal_guess > 0) {
+    const VideoFrames& v = result->video;
+    import.focal_px = options.video.focal_guess * std::max(v.width, v.height);
+    const std::string line = "focal prior of the video's frames: " + FormatNumber(import.focal_px) +
+                             " px, guessed (" + FormatNumber(options.video.focal_guess) +
+                             " times the long side, a phone's main camera); give --focal-px "
+                             "if the camera's differs";
+    AppendLog(log_path, line);
+    util::LogInfo(line);
+  }
   const auto t0 = std::chrono::steady_clock::now();
   PhotoImport photos;
   {
     util::Progress progress("import photos", 1000);
-    photos = ImportPhotos(photo_dir, (work / "images").string(), options.import,
+    photos = ImportPhotos(photo_dir, (work / "images").string(), import,
                           [&](int done, int total) {
                             if (InterruptRequested()) throw std::runtime_error("interrupted");
                             progress.Set(static_cast<int64_t>(done) * 1000 / std::max(total, 1));
@@ -466,7 +484,9 @@ RawModel RegisterPhotos(const std::string& input, const std::string& video,
   ColmapSteps steps(colmap, log_path, n, result);
   const bool focal_unknown = std::any_of(photos.groups.begin(), photos.groups.end(),
                                          [](const CameraGroup& g) { return !(g.focal_px > 0); });
-  steps.nothing_registered = NothingRegisteredMessage(n, result->input_type, focal_unknown);
+  const double focal_guess = !video.empty() && !(options.import.focal_px > 0) ? options.video.focal_guess : 0.0;
+  steps.nothing_registered =
+      NothingRegisteredMessage(n, result->input_type, focal_unknown, focal_guess);
   const std::string db = (work / "database.db").string();
   ExtractFeatures(photos, options, db, raw.image_dir, work, threads, log_path, &steps);
   MatchFeatures(n, options, db, threads, log_path, &steps, result);

@@ -121,7 +121,11 @@ TEST_F(SparseStageTest, NothingRegisteredFromAVideoAsksForTheFocalLength) {
   }
   writer.release();
   ExpectFailure({"COLMAP registered none of the ", " frames (no initial pair found); a video carries no "
-                 "focal length: give the camera's with --focal-px"});
+                 "focal length (tried 0.8 times the long side): give the camera's with --focal-px"});
+  // Without the guess, COLMAP's own: the same advice.
+  options_.video.focal_guess = 0;
+  ExpectFailure({" frames (no initial pair found); a video carries no focal length: give the "
+                 "camera's with --focal-px"});
 }
 
 TEST_F(SparseStageTest, ExtractorThatLeftNoDatabaseIsReported) {

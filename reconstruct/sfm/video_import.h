@@ -32,6 +32,12 @@ struct VideoFrameOptions {
   int blur_window = 7;              // Range [1, 100]; neighbours on each side.
   int analysis_long_side = 480;     // Range [64, 4096]; pixels of the analysis copy.
   int jpeg_quality = 95;            // Range [50, 100]; quality of the written frames.
+  // A video carries no focal length. Without --focal-px, the frames' focal
+  // prior is this times their long side (bundle adjustment refines it): 0.8
+  // is a phone's main camera filming (about 65 degrees across the long side,
+  // a little narrower than its photos). COLMAP's own guess, 1.2 (45 degrees),
+  // often finds no initial pair. Range 0 (none: COLMAP's guess) or [0.2, 5].
+  double focal_guess = 0.8;
 
   template <typename Self, typename Visitor>
   static void DescribeFields(Self& o, Visitor& v) {
@@ -43,6 +49,9 @@ struct VideoFrameOptions {
     v.Field("blur_window", o.blur_window, R::Closed(1, 100), "Neighbours on each side for the sharpness test");
     v.Field("analysis_long_side", o.analysis_long_side, R::Closed(64, 4096), "Long side of the analysis copy, pixels");
     v.Field("jpeg_quality", o.jpeg_quality, R::Closed(50, 100), "Quality of the written frames");
+    v.Field("focal_guess", o.focal_guess, R::ZeroOr(R::Closed(0.2, 5)),
+            "Focal prior of a video's frames without --focal-px, times their long side "
+            "(0.8: a phone's main camera); 0 = COLMAP's guess");
   }
   Status Check() const { return util::CheckFields(*this); }
 };
