@@ -62,8 +62,12 @@ TEST(ReconstructEndToEndTest, PhotosToWebPackageAndBack) {
   ASSERT_TRUE(master.ok()) << master.status().ToString();
   FolderFileSource source((out / "web").string());
   encoder::WebpImageDecoder decoder;
-  const auto pano = ReadPackage(source, decoder);
+  Manifest manifest;
+  const auto pano = ReadPackage(source, decoder, ReadOptions(), &manifest);
   ASSERT_TRUE(pano.ok()) << pano.status().ToString();
+  // Depth within the bound the package declares (spec Sec. 4.2), with float slack.
+  const double depth_bound = manifest.depth.MaxRelativeError() + 1e-5;
+  ASSERT_LT(depth_bound, 0.01);
   ASSERT_TRUE(pano->Validate().ok());
   ASSERT_EQ(pano->width(), 1024);
   long front = 0, depth_ok = 0;
@@ -73,7 +77,7 @@ TEST(ReconstructEndToEndTest, PhotosToWebPackageAndBack) {
     if (!pano->layer(kFront).present[i]) continue;
     ++front;
     const float a = pano->layer(kFront).depth_m[i], b = master->layer(kFront).depth_m[i];
-    depth_ok += std::abs(a - b) <= 0.005f * b;
+    depth_ok += std::abs(a - b) <= depth_bound * b;
   }
   ASSERT_GT(front, 0);
   EXPECT_EQ(depth_ok, front);
