@@ -169,11 +169,9 @@ void ReadReports(const fs::path& root, PhotoModelEvaluation* eval) {
 
 // The workspace (folder with sparse/ and images/) giving the poses.
 fs::path FindSparseWorkspace(const fs::path& root, const fs::path& capture) {
-  std::error_code ec;
   for (const fs::path& ws : {root / "work" / "sparse", capture}) {
     for (const fs::path& model : {ws / "sparse", ws / "sparse" / "0"}) {
-      if (fs::exists(model / "cameras.bin", ec) || fs::exists(model / "cameras.txt", ec))
-        return model;
+      if (HoldsColmapModel(model.string())) return model;
     }
   }
   throw std::runtime_error(
@@ -205,7 +203,7 @@ double ModelToCaptureScale(const geometry::SparseModel& model, const fs::path& m
   std::error_code ec;
   fs::path truth_dir;
   for (const fs::path& d : {capture / "sparse", capture / "sparse" / "0"})
-    if (fs::exists(d / "cameras.bin", ec) || fs::exists(d / "cameras.txt", ec)) truth_dir = d;
+    if (HoldsColmapModel(d.string())) truth_dir = d;
   if (truth_dir.empty() || fs::equivalent(truth_dir, model_dir, ec)) return 1.0;
   const geometry::SparseModel truth = geometry::ReadModel(truth_dir.string());
   std::map<std::string, Eigen::Vector3d> truth_centres;

@@ -10,6 +10,12 @@ namespace casual3d::eval {
 
 namespace fs = std::filesystem;
 
+bool HoldsColmapModel(const std::string& dir) {
+  std::error_code ec;
+  const fs::path d(dir);
+  return fs::exists(d / "cameras.bin", ec) || fs::exists(d / "cameras.txt", ec);
+}
+
 std::string FindReferenceModel(const std::string& path) {
   std::error_code ec;
   const fs::path p(path);
@@ -18,7 +24,7 @@ std::string FindReferenceModel(const std::string& path) {
                              ": not a folder (give a COLMAP model folder for the "
                              "reference poses, e.g. a synthetic capture's sparse/)");
   for (const fs::path& d : {p, p / "sparse", p / "sparse" / "0"})
-    if (fs::exists(d / "cameras.bin", ec) || fs::exists(d / "cameras.txt", ec)) return d.string();
+    if (HoldsColmapModel(d.string())) return d.string();
   throw std::runtime_error(path + ": no COLMAP model (cameras.bin or cameras.txt) in it, in " +
                            (p / "sparse").string() + " or in " + (p / "sparse" / "0").string());
 }

@@ -28,6 +28,9 @@ struct ReferenceAlignment {
   double mean_centre_error = 0, max_centre_error = 0;
 };
 
+// Whether `dir` holds a COLMAP model (cameras.bin or cameras.txt).
+bool HoldsColmapModel(const std::string& dir);
+
 // The folder holding a COLMAP model (cameras.bin or cameras.txt) for `path`:
 // the folder itself, else its sparse/ or sparse/0. Throws std::runtime_error
 // naming `path` when none holds one.

@@ -356,6 +356,13 @@ RawModel WorkspaceModel(const fs::path& input_path, const std::vector<fs::path>&
   return raw;
 }
 
+// The factor of the long side that a video's frames take as their focal
+// prior: VideoFrameOptions::focal_guess unless --focal-px gives one, 0 for
+// photos and when no guess is asked for.
+double VideoFocalGuess(const std::string& video, const SparseStageOptions& options) {
+  return !video.empty() && !(options.import.focal_px > 0) ? options.video.focal_guess : 0.0;
+}
+
 // 1. The photos imported into WORK/images at the working resolution (a
 // video's picked frames first), skipped files logged.
 PhotoImport ImportInput(const std::string& input, const std::string& video,
@@ -379,11 +386,11 @@ PhotoImport ImportInput(const std::string& input, const std::string& video,
     photo_dir = frames.string();
   }
   PhotoImportOptions import = options.import;
-  if (!video.empty() && !(import.focal_px > 0) && options.video.focal_guess > 0) {
+  if (const double guess = VideoFocalGuess(video, options); guess > 0) {
     const VideoFrames& v = result->video;
-    import.focal_px = options.video.focal_guess * std::max(v.width, v.height);
+    import.focal_px = guess * std::max(v.width, v.height);
     const std::string line = "focal prior of the video's frames: " + FormatNumber(import.focal_px) +
-                             " px, guessed (" + FormatNumber(options.video.focal_guess) +
+                             " px, guessed (" + FormatNumber(guess) +
                              " times the long side, a phone's main camera); give --focal-px "
                              "if the camera's differs";
     AppendLog(log_path, line);
@@ -484,9 +491,8 @@ RawModel RegisterPhotos(const std::string& input, const std::string& video,
   ColmapSteps steps(colmap, log_path, n, result);
   const bool focal_unknown = std::any_of(photos.groups.begin(), photos.groups.end(),
                                          [](const CameraGroup& g) { return !(g.focal_px > 0); });
-  const double focal_guess = !video.empty() && !(options.import.focal_px > 0) ? options.video.focal_guess : 0.0;
-  steps.nothing_registered =
-      NothingRegisteredMessage(n, result->input_type, focal_unknown, focal_guess);
+  steps.nothing_registered = NothingRegisteredMessage(n, result->input_type, focal_unknown,
+                                                      VideoFocalGuess(video, options));
   const std::string db = (work / "database.db").string();
   ExtractFeatures(photos, options, db, raw.image_dir, work, threads, log_path, &steps);
   MatchFeatures(n, options, db, threads, log_path, &steps, result);
