@@ -274,6 +274,29 @@ std::vector<const DenseView*> DensePlan::SweptViews(int i) const {
   return out;
 }
 
+std::vector<int> PhotosRead(const DensePlan& plan, const std::vector<int>& photos) {
+  std::vector<int> read;
+  for (int i : photos) {
+    read.push_back(i);
+    read.insert(read.end(), plan.swept[i].begin(), plan.swept[i].end());
+  }
+  std::sort(read.begin(), read.end());
+  read.erase(std::unique(read.begin(), read.end()), read.end());
+  return read;
+}
+
+namespace {
+
+// Photo i and its swept neighbours must have their pixels (PhotosRead).
+void CheckPixelsLoaded(const DensePlan& plan, int i) {
+  for (int j : PhotosRead(plan, {i}))
+    if (!HasViewPixels(plan.ws, j))
+      throw std::logic_error("dense: photo " + plan.ws.views[j].name + " was not loaded before " +
+                             plan.ws.views[i].name + "'s pass");
+}
+
+}  // namespace
+
 double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -284,9 +307,9 @@ std::vector<int> AllPhotos(int n) {
   return all;
 }
 
-DensePlan PlanDense(const std::string& workspace_dir, const DenseOptions& options) {
+DensePlan PlanDense(const std::string& workspace_dir, const DenseOptions& options, bool load_pixels) {
   DensePlan plan;
-  plan.ws = LoadWorkspace(workspace_dir, options.working_scale, options.neighbors);
+  plan.ws = LoadWorkspace(workspace_dir, options.working_scale, options.neighbors, load_pixels);
   const int n = plan.size();
   // Far-plane extension (dense_stage.h): labels are added beyond the sparse
   // range at the sparse range's spacing, so near content keeps its precision.
@@ -332,6 +355,7 @@ void CreateDenseOutputFolders(const std::string& out_dir, const DenseOptions& op
 
 CostVolume SweepPhoto(const DensePlan& plan, int i, const DenseOptions& options, int threads,
                       const std::string& cost_path, BufferPool* pool, ImageF* wta) {
+  CheckPixelsLoaded(plan, i);
   SweepOptions sweep = options.sweep;
   sweep.num_threads = threads;
   sweep.num_depths = plan.num_labels[i];
@@ -364,6 +388,7 @@ ImageF ReadDepthMap(const std::string& dir, const std::string& stem) {
 ImageF DepthPhoto(const DensePlan& plan, int i, const DenseOptions& options, int threads,
                   const std::vector<const ImageF*>& wta, const CostVolume& shell, const std::string& cost_path,
                   const ImageF& ground_truth, const std::string& out_dir, BufferPool* pool, PhotoReport* pr) {
+  CheckPixelsLoaded(plan, i);
   const DenseView& v = plan.ws.views[i];
   const std::string stem = OutputStem(v.name);
   const LabelGrid grid{shell.inv_near, shell.inv_far, shell.num_labels};
@@ -500,6 +525,7 @@ DenseReport FinishDense(const DensePlan& plan, const DenseOptions& options, std:
                         std::chrono::steady_clock::time_point start, double seconds_load) {
   const int n = plan.size();
   const int threads = base::ResolveThreads(options.num_threads);
+  for (int i = 0; i < n; ++i) CheckPixelsLoaded(plan, i);
   if (options.visibility.enabled) CheckFreeSpaceAll(plan, options, threads, shells, &depth, &photos);
 
   // Outputs and evaluation of the final maps.

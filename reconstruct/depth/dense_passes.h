@@ -38,10 +38,15 @@ struct DensePlan {
   std::vector<const DenseView*> SweptViews(int i) const;
 };
 
-// Loads the workspace (workspace.h) and plans the sweep: the far-plane
-// extension (DenseOptions::min_far_over_near) and each photo's neighbours.
-// Throws as LoadWorkspace.
-DensePlan PlanDense(const std::string& workspace_dir, const DenseOptions& options);
+// Loads the workspace (workspace.h; the photos' pixels only with
+// `load_pixels`) and plans the sweep: the far-plane extension
+// (DenseOptions::min_far_over_near) and each photo's neighbours. Throws as
+// LoadWorkspace.
+DensePlan PlanDense(const std::string& workspace_dir, const DenseOptions& options, bool load_pixels = true);
+
+// The photos whose pixels passes 1 and 2 read for the photos `photos`: each
+// one and its swept neighbours, sorted. (Pass 3 reads every photo's.)
+std::vector<int> PhotosRead(const DensePlan& plan, const std::vector<int>& photos);
 
 // The parts of photo i's report known before any pass runs.
 PhotoReport PhotoHeader(const DensePlan& plan, int i);

@@ -233,8 +233,8 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
   if (!options.ground_truth_dir.empty() && !fs::is_directory(options.ground_truth_dir))
     throw std::runtime_error(options.ground_truth_dir + ": ground-truth folder does not exist");
   const auto start = Clock::now();
-  const DensePlan plan = PlanDense(workspace_dir, options);
-  const double seconds_load = SecondsSince(start);
+  // Pixels are loaded below, only those of the photos this unit reads.
+  DensePlan plan = PlanDense(workspace_dir, options, /*load_pixels=*/false);
   const int n = plan.size();
   for (int i : photos)
     if (i >= n)
@@ -262,6 +262,21 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
         if (!HasRecord(units, "sweep", plan, j)) throw std::runtime_error(MissingUnitMessage(plan, j, "sweep", units));
   if (pass == DensePass::kFinish) CheckDepthUnitsDone(plan, units);
 
+  const int threads = base::ResolveThreads(options.num_threads);
+  if (pass == DensePass::kPlan) {
+    // Every photo must decode at its camera's size; one at a time, so that
+    // the plan of a large capture needs the memory of one photo.
+    for (int i = 0; i < n; ++i) {
+      LoadViewPixels(&plan.ws, i);
+      DenseView& v = plan.ws.views[i];
+      v.gray_full = v.color = v.gray = ImageF();
+    }
+  } else {
+    ForEachPhoto(plan, pass == DensePass::kFinish ? AllPhotos(n) : PhotosRead(plan, todo), threads,
+                 [&](int i) { LoadViewPixels(&plan.ws, i); });
+  }
+  const double seconds_load = SecondsSince(start);
+
   CreateDenseOutputFolders(out_dir, options);
   for (const char* sub : {"cost", "wta", "sweep", "depth"}) io::CreateDirectories(units.Dir(sub));
   CheckOrWritePlan(units, plan, options);
@@ -273,7 +288,6 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
   }
   result.ran = static_cast<int>(todo.size());
   if (todo.empty()) return result;
-  const int threads = base::ResolveThreads(options.num_threads);
   const int outer = std::min<int>(threads, static_cast<int>(todo.size()));
   const int inner = std::max(1, threads / outer);
   if (pass == DensePass::kSweep) {

@@ -2,12 +2,14 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
 
+#include "reconstruct/depth/dense_passes.h"
 #include "reconstruct/depth/dense_report.h"
 #include "reconstruct/depth/testing/toy_dense_options.h"
 #include "reconstruct/depth/testing/toy_scene.h"
@@ -133,6 +135,37 @@ TEST_F(DenseUnitsTest, RefusesUnitsWithOtherOptionsOrPhotos) {
   EXPECT_THROW(Unit("fresh", DensePass::kDepth, {2}), std::runtime_error);
   EXPECT_THROW(Unit("fresh", DensePass::kFinish), std::runtime_error);
   EXPECT_FALSE(fs::exists(*root_ / "fresh"));
+}
+
+TEST_F(DenseUnitsTest, UnitsReadOnlyThePhotosTheyNeed) {
+  // A copy of the workspace with one photo that photo 0's sweep does not
+  // read made undecodable: the sweep runs, the plan (which checks every
+  // photo) and a unit that reads it name it.
+  const fs::path ws = *root_ / "ws-one-bad";
+  fs::copy(Workspace(), ws, fs::copy_options::recursive);
+  DenseOptions options = Options();
+  options.num_neighbors = 2;
+  const DensePlan plan = PlanDense(ws.string(), options, /*load_pixels=*/false);
+  EXPECT_FALSE(HasViewPixels(plan.ws, 0));
+  const std::vector<int> read = PhotosRead(plan, {0});
+  ASSERT_EQ(read.size(), 3u);
+  int unread = 0;
+  while (std::find(read.begin(), read.end(), unread) != read.end()) ++unread;
+  const std::string bad_name = plan.ws.views[unread].name;
+  io::WriteFileAtomic((ws / "images" / bad_name).string(), "not a photo");
+
+  const auto unit = [&](DensePass pass, const std::vector<int>& photos) {
+    return RunDenseUnit(ws.string(), (*root_ / "one-bad").string(), options, pass, photos);
+  };
+  EXPECT_EQ(unit(DensePass::kSweep, {0}).ran, 1);
+  for (DensePass pass : {DensePass::kPlan, DensePass::kSweep}) {
+    try {
+      unit(pass, {unread});
+      FAIL() << "a unit read the undecodable " << bad_name;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(bad_name), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(ParsePhotoListTest, IndicesAndRanges) {

@@ -50,8 +50,24 @@ std::string OutputStem(const std::string& image_name) {
   return stem;
 }
 
+void LoadViewPixels(LoadedWorkspace* ws, int i) {
+  DenseView& v = ws->views.at(i);
+  if (HasViewPixels(*ws, i)) return;
+  const std::string path = (fs::path(ws->images_dir) / v.name).string();
+  ImageF full = ReadPhotoFloat(path);
+  if (full.width() != v.full_width || full.height() != v.full_height)
+    throw std::runtime_error(path + ": size " + std::to_string(full.width()) + "x" +
+                             std::to_string(full.height()) + " does not match its camera (" +
+                             std::to_string(v.full_width) + "x" + std::to_string(v.full_height) + ")");
+  v.gray_full = GrayOf(full);
+  v.color = ResizeArea(full, v.camera.width, v.camera.height);
+  v.gray = GrayOf(v.color);
+}
+
+bool HasViewPixels(const LoadedWorkspace& ws, int i) { return !ws.views.at(i).gray_full.empty(); }
+
 LoadedWorkspace LoadWorkspace(const std::string& workspace_dir, double working_scale,
-                              const NeighborOptions& neighbor_options) {
+                              const NeighborOptions& neighbor_options, bool load_pixels) {
   if (!(working_scale > 0 && working_scale <= 1))
     throw std::invalid_argument("working_scale must lie in (0, 1]");
   const fs::path root(workspace_dir);
@@ -99,12 +115,6 @@ LoadedWorkspace LoadWorkspace(const std::string& workspace_dir, double working_s
     if (range_it == ranges.end())
       throw std::runtime_error(sparse.string() + ": no depth range for " + im->name);
 
-    const std::string path = (images / im->name).string();
-    ImageF full = ReadPhotoFloat(path);
-    if (full.width() != cam.width || full.height() != cam.height)
-      throw std::runtime_error(path + ": size " + std::to_string(full.width()) + "x" +
-                               std::to_string(full.height()) + " does not match its camera (" +
-                               std::to_string(cam.width) + "x" + std::to_string(cam.height) + ")");
     DenseView v;
     v.name = im->name;
     v.full_width = cam.width;
@@ -122,12 +132,10 @@ LoadedWorkspace LoadWorkspace(const std::string& workspace_dir, double working_s
     const int wh = std::max(8, static_cast<int>(std::lround(cam.height * working_scale)));
     v.camera = pc.Resized(ww, wh);
     v.camera_full = pc;
-    v.gray_full = GrayOf(full);
     v.range.near_m = range_it->second.near_m;
     v.range.far_m = range_it->second.far_m;
-    v.color = ResizeArea(full, ww, wh);
-    v.gray = GrayOf(v.color);
     ws.views.push_back(std::move(v));
+    if (load_pixels) LoadViewPixels(&ws, static_cast<int>(ws.views.size()) - 1);
 
     NeighborInput in;
     in.center = im->pose.Center();

@@ -21,11 +21,24 @@ struct LoadedWorkspace {
   std::string images_dir;
 };
 
-// Reads the model and the photos, downscales them by `working_scale` (0, 1]
-// and ranks neighbours. Throws std::runtime_error naming the file and the
-// problem (missing folder, undecodable photo, distorted camera model, ...).
+// Reads the model and, with `load_pixels`, the photos (LoadViewPixels for
+// every view), and ranks neighbours. Without `load_pixels` the views have
+// their names, cameras and depth ranges but no images, for a unit of work that
+// needs a few photos of a large capture (dense_units.h). Throws
+// std::runtime_error naming the file and the problem (missing folder,
+// undecodable photo, distorted camera model, ...).
 LoadedWorkspace LoadWorkspace(const std::string& workspace_dir, double working_scale,
-                              const NeighborOptions& neighbor_options);
+                              const NeighborOptions& neighbor_options, bool load_pixels = true);
+
+// Reads view `i`'s photo from ws->images_dir into its images: full-resolution
+// grey, and colour and grey downscaled to its working camera's size (area
+// averaging). Does nothing when they are already there. Throws
+// std::runtime_error naming the photo when it cannot be decoded or its size is
+// not its camera's.
+void LoadViewPixels(LoadedWorkspace* ws, int i);
+
+// Whether view `i` has its images (LoadViewPixels ran).
+bool HasViewPixels(const LoadedWorkspace& ws, int i);
 
 // Reads one photo at full resolution as RGB float in [0, 1].
 ImageF ReadPhotoFloat(const std::string& path);
