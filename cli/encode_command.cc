@@ -1,7 +1,7 @@
 // `casual3d encode <master.exr> -o <package> [--quality Q] [--tile-size N]
 // [--levels N] [--depth-bits B] [--normal-bits B] [--lossy-normals]
 // [--normal-mean-error DEG] [--normal-p99-error DEG] [--single-file out.c3d]
-// [--capture SPARSE_DIR] [--title T]`: turns a master file into a web package
+// [--max-kb N [--min-quality Q]] [--capture SPARSE_DIR] [--title T]`: turns a master file into a web package
 // (spec/package.md), optionally also as one .c3d file.
 
 #include <chrono>
@@ -13,6 +13,7 @@
 #include "cli/encode_options.h"
 #include "cli/viewer_assets.h"
 #include "encoder/master_file.h"
+#include "encoder/package_fit.h"
 #include "encoder/package_writer.h"
 #include "reconstruct/pipeline/capture_shape.h"
 #include "reconstruct/util/log.h"
@@ -40,10 +41,26 @@ void RunEncode(const EncodeCommandOptions& o) {
   StatusOr<TwoLayerPanorama> pano = encoder::ReadMasterFile(o.master);
   if (!pano.ok()) throw std::runtime_error(pano.status().message());
   const auto read = std::chrono::steady_clock::now();
-  encoder::PackageStats stats;
-  StatusOr<encoder::PackageFiles> files = encoder::EncodePackage(*pano, o.package, &stats);
-  if (!files.ok()) throw std::runtime_error(o.master + ": " + files.status().message());
+  encoder::PackageFitOptions fit;
+  fit.max_bytes = static_cast<uint64_t>(o.max_kb) * 1024;
+  fit.min_color_quality = o.min_quality;
+  StatusOr<encoder::PackageFit> fitted = encoder::EncodePackageWithin(*pano, o.package, fit);
+  if (!fitted.ok())
+    throw std::runtime_error(o.master + ": " + fitted.status().message() +
+                             (o.max_kb > 0 ? " (--max-kb, --min-quality)" : ""));
+  const encoder::PackageFiles* files = &fitted->files;
+  const encoder::PackageStats& stats = fitted->stats;
   const auto encoded = std::chrono::steady_clock::now();
+  if (o.max_kb > 0) {
+    const encoder::PackageOptions& used = fitted->options;
+    const bool changed = used.lossy_normals != o.package.lossy_normals ||
+                         used.color_quality != o.package.color_quality;
+    util::LogInfo(std::string("--max-kb ") + std::to_string(o.max_kb) + ": " +
+                  (changed ? "fitted with " : "fits with the given settings, ") +
+                  (used.lossy_normals ? "lossy normals" : "lossless normals") + ", colour quality " +
+                  std::to_string(static_cast<int>(used.color_quality)) + " (" +
+                  std::to_string(fitted->encodings) + " encodings)");
+  }
   if (!o.output.empty()) {
     Status s = encoder::WritePackageFolder(*files, o.output);
     if (!s.ok()) throw std::runtime_error(s.message());
@@ -90,6 +107,8 @@ void AddEncodeCommand(CLI::App& app) {
                 "of --normal-bits");
   AddDescribedOption(cmd, "--normal-mean-error", *options, options->package.normal_mean_error_deg);
   AddDescribedOption(cmd, "--normal-p99-error", *options, options->package.normal_p99_error_deg);
+  AddDescribedOption(cmd, "--max-kb", *options, options->max_kb);
+  AddDescribedOption(cmd, "--min-quality", *options, options->min_quality);
   AddDescribedOption(cmd, "--threads", *options, options->package.num_threads);
   cmd->add_flag("!--no-viewer", options->viewer, "Do not add index.html and the viewer");
   cmd->add_option("--title", options->title,

@@ -26,6 +26,9 @@ struct EncodeCommandOptions {
   // Web delivery settings; --depth-bits 12 --normal-bits 8 keep each node's
   // value as closely as PackageOptions' defaults.
   encoder::PackageOptions package = encoder::DeliveryPackageOptions();
+  // A byte budget for the whole package (encoder/package_fit.h): 0 = none.
+  int max_kb = 0;
+  float min_quality = 75.0f;  // The lowest colour quality the budget may use.
 
   template <typename Self, typename Visitor>
   static void DescribeFields(Self& o, Visitor& v) {
@@ -49,6 +52,12 @@ struct EncodeCommandOptions {
             "Lossy normals: each tile's mean angular error at most this, degrees");
     v.Field("package.normal_p99_error_deg", o.package.normal_p99_error_deg, R::Closed(1, 90),
             "Lossy normals: each tile's 99th-percentile angular error at most this, degrees");
+    v.Field("max_kb", o.max_kb, R::AtLeast(0),
+            "Fit the whole package in this many KB (1024 bytes): lossy normals first, then "
+            "colour quality down to --min-quality; fails naming the smallest size reached. "
+            "0 = no budget");
+    v.Field("min_quality", o.min_quality, R::Closed(0, 100),
+            "Lowest colour quality --max-kb may use");
     v.Field("package.num_threads", o.package.num_threads, R::Closed(0, 256),
             "Encoding threads; 0 = all cores", util::Keyed::kNo);
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <system_error>
 #include <utility>
 
@@ -103,8 +104,12 @@ PackageOptions DeliveryPackageOptions() {
   return options;
 }
 
-StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const PackageOptions& options,
-                                     PackageStats* stats) {
+namespace {
+
+// EncodePackage; with `earlier`, the tiles other than colour are copied from
+// it (ReencodeColor).
+StatusOr<PackageFiles> Encode(const TwoLayerPanorama& pano, const PackageOptions& options,
+                              const PackageFiles* earlier, PackageStats* stats) {
   CASUAL3D_RETURN_IF_ERROR(options.Check());
   if (pano.width() > kMaxPackageWidth || pano.height() > kMaxPackageHeight)
     return InvalidArgument("panorama " + std::to_string(pano.width()) + "x" +
@@ -185,6 +190,11 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
     manifest.levels.push_back(std::move(L));
   }
 
+  // The earlier encoding's tiles by path.
+  std::map<std::string, const std::vector<uint8_t>*> earlier_tiles;
+  if (earlier != nullptr)
+    for (const auto& [path, bytes] : *earlier) earlier_tiles[path] = &bytes;
+
   // Tiles are encoded in parallel; after a failure no further tile starts,
   // and the first failing tile in job order is reported.
   std::vector<Status> job_status(jobs.size());
@@ -193,6 +203,16 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
                     [&](int64_t j) {
     if (failed.load()) return;
     Job& job = jobs[j];
+    if (earlier != nullptr && job.kind != TileImageKind::kColor) {
+      const auto it = earlier_tiles.find(job.path);
+      if (it == earlier_tiles.end()) {
+        job_status[j] = InternalError(job.path + ": not among the earlier encoding's files");
+        failed.store(true);
+        return;
+      }
+      job.bytes = *it->second;
+      return;
+    }
     int x, y, w, h;
     manifest.TileRect(job.level, job.tile, &x, &y, &w, &h);
     Image8 image =
@@ -246,6 +266,18 @@ StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const Package
   s.num_files = static_cast<int>(files.size());
   if (stats != nullptr) *stats = std::move(s);
   return files;
+}
+
+}  // namespace
+
+StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const PackageOptions& options,
+                                     PackageStats* stats) {
+  return Encode(pano, options, nullptr, stats);
+}
+
+StatusOr<PackageFiles> ReencodeColor(const TwoLayerPanorama& pano, const PackageOptions& options,
+                                     const PackageFiles& earlier, PackageStats* stats) {
+  return Encode(pano, options, &earlier, stats);
 }
 
 Status WritePackageFolder(const PackageFiles& files, const std::string& dir) {

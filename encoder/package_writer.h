@@ -93,6 +93,14 @@ using PackageFiles = std::vector<std::pair<std::string, std::vector<uint8_t>>>;
 StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const PackageOptions& options,
                                      PackageStats* stats = nullptr);
 
+// EncodePackage at other colour settings: the depth, normal and graph tiles
+// are copied from `earlier`, the files EncodePackage gave for the same
+// panorama with options that differ from `options` in color_quality and
+// color_method only (the caller's promise), and only the colour tiles are
+// encoded again (package_fit.h).
+StatusOr<PackageFiles> ReencodeColor(const TwoLayerPanorama& pano, const PackageOptions& options,
+                                     const PackageFiles& earlier, PackageStats* stats = nullptr);
+
 // Writes package files into folder `dir` atomically: everything goes to a
 // temporary folder next to it that then replaces `dir`. An existing `dir` is
 // replaced only if it is empty or holds a package (a manifest.json); anything

@@ -141,6 +141,25 @@ TEST_F(PackageCliTest, EncodeInfoValidate) {
       << bad.output;
 }
 
+TEST_F(PackageCliTest, MaxKbFitsThePackageInItsBudget) {
+  const std::string full = (dir_ / "full").string(), fitted = (dir_ / "fitted").string();
+  ASSERT_EQ(Casual3d("encode " + master_ + " -o " + full + " --no-viewer").exit_code, 0);
+  const auto package_bytes = [](const std::string& dir) {
+    uintmax_t total = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+      if (e.is_regular_file()) total += e.file_size();
+    return total;
+  };
+  const uintmax_t budget = package_bytes(full) * 9 / 10;
+  CommandResult fit = Casual3d("-v encode " + master_ + " -o " + fitted + " --no-viewer --max-kb " +
+                               std::to_string(budget / 1024));
+  ASSERT_EQ(fit.exit_code, 0) << fit.output;
+  EXPECT_NE(fit.output.find("--max-kb " + std::to_string(budget / 1024) + ": fitted with"), std::string::npos)
+      << fit.output;
+  EXPECT_LE(package_bytes(fitted), budget / 1024 * 1024);
+  EXPECT_EQ(Casual3d("validate " + fitted).exit_code, 0);
+}
+
 TEST_F(PackageCliTest, BadInputsGiveOneClearLine) {
   struct Case {
     std::string args, message;
@@ -154,6 +173,12 @@ TEST_F(PackageCliTest, BadInputsGiveOneClearLine) {
       {"encode " + master_ + " -o " + (dir_ / "out").string() + " --quality 101",
        "--quality: 101 is outside [0, 100]"},
       {"encode " + master_ + " -o " + dir_.string(), "is not a casual3d package"},
+      {"encode " + master_ + " -o " + (dir_ / "out").string() + " --max-kb 1",
+       "the package does not fit in 1.0 KB: the smallest was"},
+      {"encode " + master_ + " -o " + (dir_ / "out").string() + " --max-kb -3",
+       "--max-kb: -3 is outside >= 0"},
+      {"encode " + master_ + " -o " + (dir_ / "out").string() + " --max-kb 100 --min-quality 120",
+       "--min-quality: 120 is outside [0, 100]"},
       {"info " + master_, "not a package folder (no manifest.json) nor a valid .c3d file"},
       {"validate " + (dir_ / "nothing").string(), "not a package folder"},
   };

@@ -10,6 +10,7 @@
 
 #include "base/atomic_file.h"
 #include "encoder/master_file.h"
+#include "encoder/package_fit.h"
 #include "encoder/package_writer.h"
 #include "format/sha256.h"
 #include "reconstruct/geometry/colmap_model.h"
@@ -121,6 +122,7 @@ Status PipelineOptions::Check() const {
   }
   if (!(color_quality >= 0 && color_quality <= 100)) return InvalidArgument("color_quality: must be in [0, 100]");
   if (num_threads < 0) return InvalidArgument("num_threads: must be >= 0");
+  if (max_package_kb < 0) return InvalidArgument("max_package_kb: must be >= 0 (0 = no budget)");
   if (holdout_every < 0 || holdout_every > 1000) return InvalidArgument("holdout_every: must be in [0, 1000]");
   for (const Status& s : {sparse.Check(), dense.Check(), panorama.Check()})
     if (!s.ok()) return s;
@@ -196,7 +198,8 @@ class PipelineRun {
                        util::FieldsKeyText(options_.panorama));
     keys_[3] =
         HashHex(std::string(kStageVersions[3]) + "\n" + keys_[2] + "\n" +
-                std::to_string(options_.color_quality) + " " + std::to_string(options_.tile_size));
+                std::to_string(options_.color_quality) + " " + std::to_string(options_.tile_size) +
+                (options_.max_package_kb > 0 ? " max " + std::to_string(options_.max_package_kb) : ""));
   }
 
   // The previous report.json, if any: cached stages keep the timings and
@@ -339,9 +342,14 @@ class PipelineRun {
     package.color_quality = options_.color_quality;
     package.tile_size = options_.tile_size;
     package.num_threads = options_.num_threads;
-    encoder::PackageStats stats;
-    auto files = encoder::EncodePackage(*pano, package, &stats);
-    if (!files.ok()) throw std::runtime_error(files.status().ToString());
+    encoder::PackageFitOptions fit;
+    fit.max_bytes = static_cast<uint64_t>(options_.max_package_kb) * 1024;
+    auto fitted = encoder::EncodePackageWithin(*pano, package, fit);
+    if (!fitted.ok())
+      throw std::runtime_error(fitted.status().message() +
+                               (fit.max_bytes > 0 ? " (--max-package-kb)" : ""));
+    const encoder::PackageFiles* files = &fitted->files;
+    const encoder::PackageStats& stats = fitted->stats;
     fs::remove(key_paths_[s], ec);
     Status st = encoder::WritePackageFolder(*files, dirs_[s].string());
     if (!st.ok()) throw std::runtime_error(st.ToString());
@@ -360,7 +368,10 @@ class PipelineRun {
     }
     report_.package_bytes = stats.total_bytes;
     io::WriteFileAtomic(key_paths_[s].string(), keys_[s]);
-    stage_json_["encode"] = {{"package_bytes", stats.total_bytes}, {"files", stats.num_files}};
+    stage_json_["encode"] = {{"package_bytes", stats.total_bytes},
+                             {"files", stats.num_files},
+                             {"color_quality", fitted->options.color_quality},
+                             {"lossy_normals", fitted->options.lossy_normals}};
   }
 
   // report.json: the stages (a cached one with the time and results of the

@@ -55,6 +55,9 @@ struct PipelineOptions {
   // Encoding of the web package (encoder/package_writer.h), by its main knobs.
   float color_quality = 90.0f;  // Lossy WebP quality of colour tiles, [0, 100].
   int tile_size = 512;          // Tile side, pixels, [16, 4096].
+  // The whole package at most this many KB (encoder/package_fit.h: lossy
+  // normals, then colour quality down to 75); 0 = no budget.
+  int max_package_kb = 0;
   // Run the stages from `from` to `to` (inclusive). Stages before `from` must
   // have their outputs in the cache.
   Stage from = Stage::kSparse;
