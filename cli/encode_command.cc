@@ -59,7 +59,7 @@ void RunEncode(const EncodeCommandOptions& o) {
                   (changed ? "fitted with " : "fits with the given settings, ") +
                   (used.lossy_normals ? "lossy normals" : "lossless normals") + ", colour quality " +
                   std::to_string(static_cast<int>(used.color_quality)) + " (" +
-                  std::to_string(fitted->encodings) + " encodings)");
+                  std::to_string(fitted->encodings) + (fitted->encodings == 1 ? " encoding)" : " encodings)"));
   }
   if (!o.output.empty()) {
     Status s = encoder::WritePackageFolder(*files, o.output);

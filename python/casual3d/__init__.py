@@ -366,7 +366,8 @@ def _set_options(options, kwargs, what):
     return options
 
 
-def write_package(pano: Panorama, path, **options) -> dict:
+def write_package(pano: Panorama, path, *, max_kb: Optional[int] = None, min_quality: float = 75,
+                  **options) -> dict:
     """Writes `pano` as a package: a folder, or one .c3d file if `path` ends in .c3d.
 
     Written atomically; an existing folder is replaced only if it is empty or
@@ -378,8 +379,14 @@ def write_package(pano: Panorama, path, **options) -> dict:
     cores], generator. Colour is lossy; depth (quantized to depth_bits),
     normals (normal_bits), labels and links are stored losslessly, but with
     lossy_normals the normals are lossy images whose tiles keep the two error
-    bounds (package version 1.2). Returns the sizes written.
+    bounds (package version 1.2). With `max_kb` the whole package fits in
+    that many KB (1024 bytes), as `casual3d encode --max-kb` does: lossy
+    normals first, then the highest colour quality down to `min_quality` that
+    fits; a ValueError names the smallest size reached when nothing fits.
+    Returns the sizes written and the colour quality and normals used.
     """
+    if max_kb is not None and (isinstance(max_kb, bool) or not isinstance(max_kb, int) or max_kb < 1):
+        raise ValueError(f"max_kb {max_kb!r}: expected a positive whole number of KB, or None")
     path = _os.fspath(path)
     native = _casual3d._PackageOptions()
     native.generator = f"casual3d {__version__}"
@@ -388,7 +395,8 @@ def write_package(pano: Panorama, path, **options) -> dict:
             _warn_renamed(f"write_package({old}=...)", f"{new}=")
             options[new] = options.pop(old)
     _set_options(native, options, "write_package")
-    return _casual3d._write_package(pano, path, path.lower().endswith(".c3d"), native)
+    return _casual3d._write_package(pano, path, path.lower().endswith(".c3d"), native,
+                                    (max_kb or 0) * 1024, float(min_quality))
 
 
 def write_master(pano: Panorama, path) -> None:

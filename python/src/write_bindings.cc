@@ -7,6 +7,7 @@
 
 #include "encoder/gltf_export.h"
 #include "encoder/master_file.h"
+#include "encoder/package_fit.h"
 #include "encoder/package_writer.h"
 #include "format/color_atlas.h"
 #include "python/src/bindings.h"
@@ -19,24 +20,35 @@ namespace py = pybind11;
 namespace {
 
 // Returns the sizes written.
+// `fit`: a byte budget (encoder/package_fit.h; max_bytes 0 = none).
 py::dict WritePackage(py::handle pano_object, const std::string& path, bool single_file,
-                      const encoder::PackageOptions& options) {
+                      const encoder::PackageOptions& options, uint64_t max_bytes, float min_color_quality) {
   const TwoLayerPanorama pano = PanoramaFromPython(pano_object);
   encoder::PackageStats stats;
+  encoder::PackageOptions used = options;
   Status status;
   {
     py::gil_scoped_release release;
+    encoder::PackageFitOptions fit;
+    fit.max_bytes = max_bytes;
+    fit.min_color_quality = min_color_quality;
     status = options.Check();
     if (status.ok()) status = pano.Validate();
     if (status.ok()) {
-      StatusOr<encoder::PackageFiles> files = encoder::EncodePackage(pano, options, &stats);
-      status = !files.ok()   ? files.status()
-               : single_file ? encoder::WritePackageSingleFile(*files, path)
-                             : encoder::WritePackageFolder(*files, path);
+      StatusOr<encoder::PackageFit> fitted = encoder::EncodePackageWithin(pano, options, fit);
+      if (fitted.ok()) {
+        stats = fitted->stats;
+        used = fitted->options;
+      }
+      status = !fitted.ok() ? fitted.status()
+               : single_file ? encoder::WritePackageSingleFile(fitted->files, path)
+                             : encoder::WritePackageFolder(fitted->files, path);
     }
   }
   ThrowIfError(status, path);
   py::dict out;
+  out["color_quality"] = used.color_quality;
+  out["lossy_normals"] = used.lossy_normals;
   out["total_bytes"] = stats.total_bytes;
   py::list level_bytes;
   for (uint64_t bytes : stats.level_bytes) level_bytes.append(bytes);
@@ -125,7 +137,8 @@ void RegisterWriting(py::module_& m) {
       .def_readwrite("draco_texcoord_bits", &GltfExportOptions::draco_texcoord_bits)
       .def_readwrite("draco_compression_level", &GltfExportOptions::draco_compression_level);
   m.def("_write_package", &WritePackage, py::arg("panorama"), py::arg("path"),
-        py::arg("single_file"), py::arg("options"));
+        py::arg("single_file"), py::arg("options"), py::arg("max_bytes") = 0,
+        py::arg("min_color_quality") = 75.0f);
   m.def("_write_master", &WriteMaster, py::arg("panorama"), py::arg("path"));
   m.def("_export_glb", &ExportGlb, py::arg("panorama"), py::arg("path"), py::arg("choice"),
         py::arg("options"));

@@ -115,3 +115,18 @@ def test_lossy_normals_keep_their_declared_bounds(room, tmp_path, cli):
     assert angles.size > 1000
     assert angles.mean() <= 2.0
     assert np.percentile(angles, 99, method="inverted_cdf") <= 6.0
+
+
+def test_max_kb_fits_the_package_in_its_budget(room, tmp_path):
+    full = casual3d.write_package(room, tmp_path / "full")
+    assert full["color_quality"] == 90 and full["lossy_normals"] is False
+    budget_kb = full["total_bytes"] * 9 // 10 // 1024
+    fitted = casual3d.write_package(room, tmp_path / "fitted", max_kb=budget_kb)
+    assert fitted["total_bytes"] <= budget_kb * 1024
+    assert fitted["lossy_normals"] or fitted["color_quality"] < 90
+    casual3d.read(tmp_path / "fitted")
+    with pytest.raises(ValueError, match="does not fit in 1.0 KB: the smallest was"):
+        casual3d.write_package(room, tmp_path / "tiny", max_kb=1)
+    assert not (tmp_path / "tiny").exists()
+    with pytest.raises(ValueError, match="max_kb 0: expected a positive whole number"):
+        casual3d.write_package(room, tmp_path / "zero", max_kb=0)
