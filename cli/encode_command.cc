@@ -5,6 +5,7 @@
 // (spec/package.md), optionally also as one .c3d file.
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -58,7 +59,7 @@ void RunEncode(const EncodeCommandOptions& o) {
     util::LogInfo(std::string("--max-kb ") + std::to_string(o.max_kb) + ": " +
                   (changed ? "fitted with " : "fits with the given settings, ") +
                   (used.lossy_normals ? "lossy normals" : "lossless normals") + ", colour quality " +
-                  std::to_string(static_cast<int>(used.color_quality)) + " (" +
+                  std::to_string(static_cast<int>(std::lround(used.color_quality))) + " (" +
                   std::to_string(fitted->encodings) + (fitted->encodings == 1 ? " encoding)" : " encodings)"));
   }
   if (!o.output.empty()) {
@@ -108,7 +109,7 @@ void AddEncodeCommand(CLI::App& app) {
   AddDescribedOption(cmd, "--normal-mean-error", *options, options->package.normal_mean_error_deg);
   AddDescribedOption(cmd, "--normal-p99-error", *options, options->package.normal_p99_error_deg);
   AddDescribedOption(cmd, "--max-kb", *options, options->max_kb);
-  AddDescribedOption(cmd, "--min-quality", *options, options->min_quality);
+  AddDescribedOption(cmd, "--min-quality", *options, options->min_quality)->needs("--max-kb");
   AddDescribedOption(cmd, "--threads", *options, options->package.num_threads);
   cmd->add_flag("!--no-viewer", options->viewer, "Do not add index.html and the viewer");
   cmd->add_option("--title", options->title,

@@ -53,9 +53,9 @@ struct EncodeCommandOptions {
     v.Field("package.normal_p99_error_deg", o.package.normal_p99_error_deg, R::Closed(1, 90),
             "Lossy normals: each tile's 99th-percentile angular error at most this, degrees");
     v.Field("max_kb", o.max_kb, R::AtLeast(0),
-            "Fit the whole package in this many KB (1024 bytes): lossy normals first, then "
-            "colour quality down to --min-quality; fails naming the smallest size reached. "
-            "0 = no budget");
+            "Fit the package's tiles and manifest in this many KB (1024 bytes): lossy normals "
+            "first, then colour quality down to --min-quality; fails naming the smallest size "
+            "reached. 0 = no budget");
     v.Field("min_quality", o.min_quality, R::Closed(0, 100),
             "Lowest colour quality --max-kb may use");
     v.Field("package.num_threads", o.package.num_threads, R::Closed(0, 256),

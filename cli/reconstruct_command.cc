@@ -72,8 +72,9 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_option("--quality", args->options.color_quality, "WebP quality of colour tiles, 0..100")
       ->capture_default_str();
   cmd->add_option("--max-package-kb", args->options.max_package_kb,
-                  "Fit the web package in this many KB (1024 bytes): lossy normals first, then colour "
-                  "quality down to 75; fails naming the smallest size reached. 0 = no budget")
+                  "Fit the web package's tiles and manifest in this many KB (1024 bytes): lossy normals "
+                  "first, then colour quality down to 75; fails naming the smallest size reached. "
+                  "0 = no budget")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--threads", args->options.num_threads, "Worker threads; 0 = all cores")

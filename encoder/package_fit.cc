@@ -87,11 +87,15 @@ StatusOr<PackageFit> EncodePackageWithin(const TwoLayerPanorama& pano, const Pac
     }
   }
   const PackageOptions& o = best.options;
+  const std::string floor_advice =
+      low < high ? "a lower colour quality floor"
+                 : "a colour quality floor below the given quality " +
+                       std::to_string(static_cast<int>(std::lround(options.color_quality)));
   return InvalidArgument(
       "the package does not fit in " + Kb(fit.max_bytes) + ": the smallest was " + Kb(best.stats.total_bytes) +
       " (colour quality " + std::to_string(static_cast<int>(std::lround(o.color_quality))) +
-      (o.lossy_normals ? ", lossy normals" : ", lossless normals") +
-      "); allow more bytes, a lower colour quality floor, or encode a narrower panorama");
+      (o.lossy_normals ? ", lossy normals" : ", lossless normals") + "); allow more bytes, " + floor_advice +
+      ", or encode a narrower panorama");
 }
 
 }  // namespace casual3d::encoder

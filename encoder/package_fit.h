@@ -24,10 +24,13 @@
 namespace casual3d::encoder {
 
 struct PackageFitOptions {
-  // The whole package (every file, manifest included) at most this many
-  // bytes; 0: no budget, the given settings as they are.
+  // The package's files (tiles and manifest.json; not a viewer page beside
+  // them, and a .c3d adds its index of 16 bytes plus about 20 and the path's
+  // length per file) at most this many bytes; 0: no budget, the given
+  // settings as they are.
   uint64_t max_bytes = 0;
-  // The lowest colour quality step 3 may use, [0, 100].
+  // The lowest colour quality step 3 may use, [0, 100]; step 3 is skipped
+  // when it is not below the given quality.
   float min_color_quality = 75.0f;
   // Whether step 2 may switch to lossy normals.
   bool allow_lossy_normals = true;

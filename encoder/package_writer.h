@@ -93,11 +93,12 @@ using PackageFiles = std::vector<std::pair<std::string, std::vector<uint8_t>>>;
 StatusOr<PackageFiles> EncodePackage(const TwoLayerPanorama& pano, const PackageOptions& options,
                                      PackageStats* stats = nullptr);
 
-// EncodePackage at other colour settings: the depth, normal and graph tiles
+// EncodePackage at another colour quality: the depth, normal and graph tiles
 // are copied from `earlier`, the files EncodePackage gave for the same
-// panorama with options that differ from `options` in color_quality and
-// color_method only (the caller's promise), and only the colour tiles are
-// encoded again (package_fit.h).
+// panorama with options that differ from `options` in color_quality only
+// (the caller's promise, not checked: lossy normal tiles depend on
+// color_method, and the manifest declares the options given here), and only
+// the colour tiles are encoded again (package_fit.h).
 StatusOr<PackageFiles> ReencodeColor(const TwoLayerPanorama& pano, const PackageOptions& options,
                                      const PackageFiles& earlier, PackageStats* stats = nullptr);
 

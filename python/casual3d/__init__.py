@@ -29,6 +29,8 @@ the operating system refuses a read or write; messages name the file.
 
 import functools as _functools
 import json as _json
+import numbers as _numbers
+import operator as _operator
 import os as _os
 import warnings as _warnings
 from dataclasses import dataclass, field
@@ -382,11 +384,21 @@ def write_package(pano: Panorama, path, *, max_kb: Optional[int] = None, min_qua
     bounds (package version 1.2). With `max_kb` the whole package fits in
     that many KB (1024 bytes), as `casual3d encode --max-kb` does: lossy
     normals first, then the highest colour quality down to `min_quality` that
-    fits; a ValueError names the smallest size reached when nothing fits.
+    fits (the tiles and manifest; a .c3d adds its small index); a ValueError
+    names the smallest size reached when nothing fits.
     Returns the sizes written and the colour quality and normals used.
     """
-    if max_kb is not None and (isinstance(max_kb, bool) or not isinstance(max_kb, int) or max_kb < 1):
-        raise ValueError(f"max_kb {max_kb!r}: expected a positive whole number of KB, or None")
+    if max_kb is not None:
+        try:
+            kb = _operator.index(max_kb)
+        except TypeError:
+            kb = 0
+        if isinstance(max_kb, bool) or not 1 <= kb <= 2**53 // 1024:
+            raise ValueError(f"max_kb {max_kb!r}: expected a positive whole number of KB, or None")
+        max_kb = kb
+    if isinstance(min_quality, bool) or not isinstance(min_quality, _numbers.Real) \
+            or not 0 <= min_quality <= 100:
+        raise ValueError(f"min_quality {min_quality!r}: expected a number in [0, 100]")
     path = _os.fspath(path)
     native = _casual3d._PackageOptions()
     native.generator = f"casual3d {__version__}"

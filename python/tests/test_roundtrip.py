@@ -130,3 +130,13 @@ def test_max_kb_fits_the_package_in_its_budget(room, tmp_path):
     assert not (tmp_path / "tiny").exists()
     with pytest.raises(ValueError, match="max_kb 0: expected a positive whole number"):
         casual3d.write_package(room, tmp_path / "zero", max_kb=0)
+
+
+def test_max_kb_takes_numpy_integers_and_checks_min_quality(room, tmp_path):
+    fitted = casual3d.write_package(room, tmp_path / "np", max_kb=np.int64(10**6))
+    assert fitted["color_quality"] == 90
+    for bad in (120, -1, "80", True):
+        with pytest.raises(ValueError, match="min_quality .*: expected a number in \\[0, 100\\]"):
+            casual3d.write_package(room, tmp_path / "q", max_kb=100, min_quality=bad)
+    with pytest.raises(ValueError, match="max_kb .*: expected a positive whole number"):
+        casual3d.write_package(room, tmp_path / "big", max_kb=2**60)

@@ -59,9 +59,12 @@ void LoadViewPixels(LoadedWorkspace* ws, int i) {
     throw std::runtime_error(path + ": size " + std::to_string(full.width()) + "x" +
                              std::to_string(full.height()) + " does not match its camera (" +
                              std::to_string(v.full_width) + "x" + std::to_string(v.full_height) + ")");
-  v.gray_full = GrayOf(full);
-  v.color = ResizeArea(full, v.camera.width, v.camera.height);
-  v.gray = GrayOf(v.color);
+  // All three or none, so that a failure leaves the view without pixels.
+  ImageF gray_full = GrayOf(full);
+  ImageF color = ResizeArea(full, v.camera.width, v.camera.height);
+  v.gray = GrayOf(color);
+  v.color = std::move(color);
+  v.gray_full = std::move(gray_full);
 }
 
 bool HasViewPixels(const LoadedWorkspace& ws, int i) { return !ws.views.at(i).gray_full.empty(); }
