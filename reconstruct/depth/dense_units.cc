@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "reconstruct/depth/dense_passes.h"
+#include "reconstruct/depth/dense_plan_record.h"
 #include "reconstruct/depth/dense_report.h"
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
@@ -28,13 +29,14 @@ struct UnitFolder {
   std::string Dir(const char* sub) const { return (root / sub).string(); }
 };
 
-// What shapes the intermediate files: the photos and their sweeps.
+// What shapes the intermediate files: the options below and the plan (the
+// photos, their cameras, depth ranges and neighbours: dense_plan_record.h),
+// which units after the first read from here instead of the model.
 nlohmann::json PlanRecord(const DensePlan& plan, const DenseOptions& options) {
   nlohmann::json j;
   j["format"] = "casual3d-dense-units";
-  j["version"] = "1.0";
-  for (const DenseView& v : plan.ws.views) j["photos"].push_back(v.name);
-  j["num_labels"] = plan.num_labels;
+  j["version"] = "1.1";
+  j["plan"] = DensePlanToJson(plan);
   j["working_scale"] = options.working_scale;
   j["num_depths"] = options.sweep.num_depths;
   j["num_neighbors"] = options.num_neighbors;
@@ -44,25 +46,55 @@ nlohmann::json PlanRecord(const DensePlan& plan, const DenseOptions& options) {
   return j;
 }
 
+std::string PlanPath(const UnitFolder& units) { return (units.root / "plan.json").string(); }
+
+std::runtime_error OtherPlanError(const UnitFolder& units) {
+  return std::runtime_error(PlanPath(units) + ": made from other photos or with other options than this unit's; "
+                            "give every unit the same workspace and options, or remove " +
+                            units.root.string() + " to start afresh");
+}
+
+// plan.json, or null when there is none or it cannot be parsed.
+nlohmann::json ReadPlanRecord(const UnitFolder& units) {
+  std::error_code ec;
+  if (!fs::exists(PlanPath(units), ec)) return nullptr;
+  try {
+    return nlohmann::json::parse(io::ReadFile(PlanPath(units)));
+  } catch (const nlohmann::json::exception&) {
+    return nlohmann::json::object();  // Matches no record: refused as another plan.
+  }
+}
+
+// The plan recorded by an earlier unit, when its options are this unit's;
+// otherwise the plan made from the workspace (without pixels), which
+// CheckOrWritePlan then records or compares.
+DensePlan LoadPlan(const std::string& workspace_dir, const DenseOptions& options, const UnitFolder& units,
+                   DensePass pass) {
+  if (pass != DensePass::kPlan) {
+    const nlohmann::json record = ReadPlanRecord(units);
+    if (!record.is_null()) {
+      DensePlan plan;
+      try {
+        plan = DensePlanFromJson(record.at("plan"), (fs::path(workspace_dir) / "images").string());
+      } catch (const std::exception&) {
+        throw OtherPlanError(units);
+      }
+      if (PlanRecord(plan, options) != record) throw OtherPlanError(units);
+      return plan;
+    }
+  }
+  return PlanDense(workspace_dir, options, /*load_pixels=*/false);
+}
+
 // Writes plan.json, or checks that the one there matches.
 void CheckOrWritePlan(const UnitFolder& units, const DensePlan& plan, const DenseOptions& options) {
-  const std::string path = (units.root / "plan.json").string();
   const nlohmann::json record = PlanRecord(plan, options);
-  std::error_code ec;
-  if (fs::exists(path, ec)) {
-    nlohmann::json previous;
-    try {
-      previous = nlohmann::json::parse(io::ReadFile(path));
-    } catch (const nlohmann::json::exception&) {
-      previous = nullptr;
-    }
-    if (previous != record)
-      throw std::runtime_error(path + ": made from other photos or with other options than this unit's; "
-                               "give every unit the same workspace and options, or remove " +
-                               units.root.string() + " to start afresh");
+  const nlohmann::json previous = ReadPlanRecord(units);
+  if (!previous.is_null()) {
+    if (previous != record) throw OtherPlanError(units);
     return;
   }
-  io::WriteFileAtomic(path, record.dump(2) + "\n");
+  io::WriteFileAtomic(PlanPath(units), record.dump(2) + "\n");
 }
 
 std::string MissingUnitMessage(const DensePlan& plan, int i, const char* pass, const UnitFolder& units) {
@@ -233,8 +265,9 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
   if (!options.ground_truth_dir.empty() && !fs::is_directory(options.ground_truth_dir))
     throw std::runtime_error(options.ground_truth_dir + ": ground-truth folder does not exist");
   const auto start = Clock::now();
+  const UnitFolder units{fs::path(out_dir) / ".dense-units"};
   // Pixels are loaded below, only those of the photos this unit reads.
-  DensePlan plan = PlanDense(workspace_dir, options, /*load_pixels=*/false);
+  DensePlan plan = LoadPlan(workspace_dir, options, units, pass);
   const int n = plan.size();
   for (int i : photos)
     if (i >= n)
@@ -243,7 +276,6 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
 
   DenseUnitResult result;
   for (const DenseView& v : plan.ws.views) result.photos.push_back(v.name);
-  const UnitFolder units{fs::path(out_dir) / ".dense-units"};
   // The photos of this unit not yet done (their record is written last),
   // and what they need, checked before anything is written.
   std::vector<int> todo;

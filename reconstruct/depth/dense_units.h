@@ -6,7 +6,9 @@
 // confidence/ and envelope/ files as RunDenseStage (dense.json differs in
 // its timings only).
 //
-//   plan    checks the workspace and records its photos (OUT/.dense-units/plan.json)
+//   plan    checks the workspace and records its photos, cameras, depth ranges and
+//           neighbours (OUT/.dense-units/plan.json), which the other units read
+//           instead of the sparse model
 //   sweep   per photo: cost volume and WTA map;    needs: plan
 //   depth   per photo: envelope, MRF, upsampling;  needs: the sweeps of the
 //           photo and of its first gc.max_views ranked neighbours

@@ -168,6 +168,19 @@ TEST_F(DenseUnitsTest, UnitsReadOnlyThePhotosTheyNeed) {
   }
 }
 
+TEST_F(DenseUnitsTest, UnitsAfterThePlanReadItsRecordNotTheModel) {
+  const fs::path ws = *root_ / "ws-model-gone";
+  fs::copy(Workspace(), ws, fs::copy_options::recursive);
+  const auto unit = [&](DensePass pass, const std::vector<int>& photos) {
+    return RunDenseUnit(ws.string(), (*root_ / "model-gone").string(), Options(), pass, photos);
+  };
+  unit(DensePass::kPlan, {});
+  fs::remove_all(ws / "sparse");
+  EXPECT_EQ(unit(DensePass::kSweep, {0}).ran, 1);
+  // The plan pass itself reads the workspace again, and says what is missing.
+  EXPECT_THROW(unit(DensePass::kPlan, {}), std::runtime_error);
+}
+
 TEST(ParsePhotoListTest, IndicesAndRanges) {
   EXPECT_EQ(ParsePhotoList("3"), std::vector<int>({3}));
   EXPECT_EQ(ParsePhotoList("5-7,0,6"), std::vector<int>({0, 5, 6, 7}));
