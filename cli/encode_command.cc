@@ -49,7 +49,7 @@ void RunEncode(const EncodeCommandOptions& o) {
   if (!fitted.ok())
     throw std::runtime_error(o.master + ": " + fitted.status().message() +
                              (o.max_kb > 0 ? " (--max-kb, --min-quality)" : ""));
-  const encoder::PackageFiles* files = &fitted->files;
+  const encoder::PackageFiles& files = fitted->files;
   const encoder::PackageStats& stats = fitted->stats;
   const auto encoded = std::chrono::steady_clock::now();
   if (o.max_kb > 0) {
@@ -63,7 +63,7 @@ void RunEncode(const EncodeCommandOptions& o) {
                   std::to_string(fitted->encodings) + (fitted->encodings == 1 ? " encoding)" : " encodings)"));
   }
   if (!o.output.empty()) {
-    Status s = encoder::WritePackageFolder(*files, o.output);
+    Status s = encoder::WritePackageFolder(files, o.output);
     if (!s.ok()) throw std::runtime_error(s.message());
     if (o.viewer) {
       try {
@@ -74,7 +74,7 @@ void RunEncode(const EncodeCommandOptions& o) {
     }
   }
   if (!o.single_file.empty()) {
-    Status s = encoder::WritePackageSingleFile(*files, o.single_file);
+    Status s = encoder::WritePackageSingleFile(files, o.single_file);
     if (!s.ok()) throw std::runtime_error(s.message());
   }
   auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };

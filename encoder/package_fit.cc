@@ -50,8 +50,9 @@ StatusOr<PackageFit> EncodePackageWithin(const TwoLayerPanorama& pano, const Pac
     }
   }
 
-  // Step 3: the highest whole colour quality in [floor, given) that fits.
-  const PackageFiles base = best.files;
+  // Step 3: the highest whole colour quality in [floor, given) that fits,
+  // from `best`'s other tiles (`best` changes only after the last encoding).
+  const PackageFiles& base = best.files;
   const PackageOptions base_options = best.options;
   const auto at_quality = [&](int quality, PackageFit* out) -> Status {
     out->options = base_options;

@@ -43,10 +43,6 @@ TEST(ReconstructEndToEndTest, PhotosToWebPackageAndBack) {
 
   pipeline::PipelineOptions options;
   options.sparse.import.working_megapixels = 0.31;  // Keeps the 640x480 photos as they are.
-  // SIFT from the upsampled octave: photos this small give about 500 points
-  // each otherwise, and the mapper then sometimes leaves a third of them out
-  // (12 of 16 registered in one run of six).
-  options.sparse.sift_first_octave = -1;
   options.panorama.pano_width = 1024;
   options.panorama.stitch.solve_width = 256;
   options.panorama.stitch.solve_height = 128;

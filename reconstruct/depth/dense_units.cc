@@ -65,11 +65,12 @@ nlohmann::json ReadPlanRecord(const UnitFolder& units) {
   }
 }
 
-// The plan recorded by an earlier unit, when its options are this unit's;
-// otherwise the plan made from the workspace (without pixels), which
-// CheckOrWritePlan then records or compares.
+// The plan recorded by an earlier unit, checked against this unit's options
+// (`*recorded` true); otherwise the plan made from the workspace (without
+// pixels), which CheckOrWritePlan then records or compares.
 DensePlan LoadPlan(const std::string& workspace_dir, const DenseOptions& options, const UnitFolder& units,
-                   DensePass pass) {
+                   DensePass pass, bool* recorded) {
+  *recorded = false;
   if (pass != DensePass::kPlan) {
     const nlohmann::json record = ReadPlanRecord(units);
     if (!record.is_null()) {
@@ -80,6 +81,7 @@ DensePlan LoadPlan(const std::string& workspace_dir, const DenseOptions& options
         throw OtherPlanError(units);
       }
       if (PlanRecord(plan, options) != record) throw OtherPlanError(units);
+      *recorded = true;
       return plan;
     }
   }
@@ -267,7 +269,8 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
   const auto start = Clock::now();
   const UnitFolder units{fs::path(out_dir) / ".dense-units"};
   // Pixels are loaded below, only those of the photos this unit reads.
-  DensePlan plan = LoadPlan(workspace_dir, options, units, pass);
+  bool recorded = false;
+  DensePlan plan = LoadPlan(workspace_dir, options, units, pass, &recorded);
   const int n = plan.size();
   for (int i : photos)
     if (i >= n)
@@ -298,11 +301,7 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
   if (pass == DensePass::kPlan) {
     // Every photo must decode at its camera's size; one at a time, so that
     // the plan of a large capture needs the memory of one photo.
-    for (int i = 0; i < n; ++i) {
-      LoadViewPixels(&plan.ws, i);
-      DenseView& v = plan.ws.views[i];
-      v.gray_full = v.color = v.gray = ImageF();
-    }
+    for (int i = 0; i < n; ++i) CheckViewPhoto(plan.ws, i);
   } else {
     ForEachPhoto(plan, pass == DensePass::kFinish ? AllPhotos(n) : PhotosRead(plan, todo), threads,
                  [&](int i) { LoadViewPixels(&plan.ws, i); });
@@ -311,7 +310,7 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
 
   CreateDenseOutputFolders(out_dir, options);
   for (const char* sub : {"cost", "wta", "sweep", "depth"}) io::CreateDirectories(units.Dir(sub));
-  CheckOrWritePlan(units, plan, options);
+  if (!recorded) CheckOrWritePlan(units, plan, options);
   if (pass == DensePass::kPlan) return result;
   if (pass == DensePass::kFinish) {
     result.report = FinishUnit(plan, options, units, out_dir, start, seconds_load);

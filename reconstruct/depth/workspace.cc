@@ -16,12 +16,29 @@
 namespace casual3d::depth {
 namespace fs = std::filesystem;
 
-ImageF ReadPhotoFloat(const std::string& path) {
-  const Image8 rgb = io::ReadImage(path);
+namespace {
+
+ImageF ToFloat(const Image8& rgb) {
   ImageF out(rgb.width(), rgb.height(), 3);
   for (size_t i = 0; i < rgb.size(); ++i) out.data()[i] = rgb.data()[i] * (1.0f / 255.0f);
   return out;
 }
+
+// View i's photo as decoded, its size checked against its camera's.
+Image8 ReadViewPhoto(const LoadedWorkspace& ws, int i) {
+  const DenseView& v = ws.views.at(i);
+  const std::string path = (fs::path(ws.images_dir) / v.name).string();
+  Image8 rgb = io::ReadImage(path);
+  if (rgb.width() != v.full_width || rgb.height() != v.full_height)
+    throw std::runtime_error(path + ": size " + std::to_string(rgb.width()) + "x" +
+                             std::to_string(rgb.height()) + " does not match its camera (" +
+                             std::to_string(v.full_width) + "x" + std::to_string(v.full_height) + ")");
+  return rgb;
+}
+
+}  // namespace
+
+ImageF ReadPhotoFloat(const std::string& path) { return ToFloat(io::ReadImage(path)); }
 
 ImageF ResizeArea(const ImageF& image, int width, int height) {
   if (image.width() == width && image.height() == height) return image;
@@ -50,15 +67,12 @@ std::string OutputStem(const std::string& image_name) {
   return stem;
 }
 
+void CheckViewPhoto(const LoadedWorkspace& ws, int i) { ReadViewPhoto(ws, i); }
+
 void LoadViewPixels(LoadedWorkspace* ws, int i) {
   DenseView& v = ws->views.at(i);
   if (HasViewPixels(*ws, i)) return;
-  const std::string path = (fs::path(ws->images_dir) / v.name).string();
-  ImageF full = ReadPhotoFloat(path);
-  if (full.width() != v.full_width || full.height() != v.full_height)
-    throw std::runtime_error(path + ": size " + std::to_string(full.width()) + "x" +
-                             std::to_string(full.height()) + " does not match its camera (" +
-                             std::to_string(v.full_width) + "x" + std::to_string(v.full_height) + ")");
+  const ImageF full = ToFloat(ReadViewPhoto(*ws, i));
   // All three or none, so that a failure leaves the view without pixels.
   ImageF gray_full = GrayOf(full);
   ImageF color = ResizeArea(full, v.camera.width, v.camera.height);

@@ -37,6 +37,10 @@ LoadedWorkspace LoadWorkspace(const std::string& workspace_dir, double working_s
 // not its camera's.
 void LoadViewPixels(LoadedWorkspace* ws, int i);
 
+// Decodes view `i`'s photo and checks its size as LoadViewPixels does,
+// keeping nothing (the plan unit's check of every photo).
+void CheckViewPhoto(const LoadedWorkspace& ws, int i);
+
 // Whether view `i` has its images (LoadViewPixels ran).
 bool HasViewPixels(const LoadedWorkspace& ws, int i);
 

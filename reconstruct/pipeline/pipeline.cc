@@ -348,14 +348,14 @@ class PipelineRun {
     if (!fitted.ok())
       throw std::runtime_error(fitted.status().message() +
                                (fit.max_bytes > 0 ? " (--max-package-kb)" : ""));
-    const encoder::PackageFiles* files = &fitted->files;
+    const encoder::PackageFiles& files = fitted->files;
     const encoder::PackageStats& stats = fitted->stats;
     fs::remove(key_paths_[s], ec);
-    Status st = encoder::WritePackageFolder(*files, dirs_[s].string());
+    Status st = encoder::WritePackageFolder(files, dirs_[s].string());
     if (!st.ok()) throw std::runtime_error(st.ToString());
     if (options_.finish_web_package)
       options_.finish_web_package(dirs_[s].string(), report_.capture_advice);
-    st = encoder::WritePackageSingleFile(*files, (root_ / "photo.c3d").string());
+    st = encoder::WritePackageSingleFile(files, (root_ / "photo.c3d").string());
     if (!st.ok()) throw std::runtime_error(st.ToString());
     io::WriteFileAtomic((root_ / "master.exr").string(), io::ReadFile(master.string()));
     const fs::path preview = dirs_[2] / "preview";
