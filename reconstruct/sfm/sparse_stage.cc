@@ -415,11 +415,19 @@ PhotoImport ImportInput(const std::string& input, const std::string& video,
   return photos;
 }
 
+// COLMAP's extractor, matcher and mapper run on one thread. Each of its worker
+// threads draws from its own random generator, seeded alike, so with more
+// threads the RANSAC draws a task gets depend on scheduling and the model
+// changes from run to run (a 16-photo capture registered 12 photos in 2 runs
+// of 20); on one thread the same photos give the same model, byte for byte, at
+// about 5 s more on fern (docs/DECISIONS.md, "A deterministic sparse stage").
+constexpr const char* kColmapThreads = "1";
+
 // 2. Features, one extractor run per camera group so each gets its own
 // calibration and focal prior (TOOLCHAIN.md: resized photos lost their EXIF).
 void ExtractFeatures(const PhotoImport& photos, const SparseStageOptions& options, const std::string& db,
-                     const fs::path& image_dir, const fs::path& work, const std::string& threads,
-                     const std::string& log_path, ColmapSteps* steps) {
+                     const fs::path& image_dir, const fs::path& work, const std::string& log_path,
+                     ColmapSteps* steps) {
   for (size_t g = 0; g < photos.groups.size(); ++g) {
     const CameraGroup& group = photos.groups[g];
     const fs::path list = work / ("group" + std::to_string(g) + ".txt");
@@ -432,7 +440,7 @@ void ExtractFeatures(const PhotoImport& photos, const SparseStageOptions& option
         "--database_path", db, "--image_path", image_dir.string(), "--image_list_path",
         list.string(), "--ImageReader.camera_model", options.camera_model,
         "--ImageReader.single_camera", options.shared_camera ? "1" : "0",
-        "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
+        "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", kColmapThreads,
         "--SiftExtraction.max_num_features", std::to_string(options.max_features),
         "--SiftExtraction.first_octave", std::to_string(options.sift_first_octave)};
     if (group.focal_px > 0) {
@@ -450,8 +458,7 @@ void ExtractFeatures(const PhotoImport& photos, const SparseStageOptions& option
 // 3. Matching: casual3d's descriptor matching (native_matching), then
 // COLMAP's matcher, which verifies the stored matches.
 void MatchFeatures(int n, const SparseStageOptions& options, const std::string& db,
-                   const std::string& threads, const std::string& log_path, ColmapSteps* steps,
-                   SparseStageResult* result) {
+                   const std::string& log_path, ColmapSteps* steps, SparseStageResult* result) {
   const bool exhaustive =
       options.matcher == MatcherType::kExhaustive ||
       (options.matcher == MatcherType::kAuto && n <= options.exhaustive_max_photos);
@@ -467,7 +474,7 @@ void MatchFeatures(int n, const SparseStageOptions& options, const std::string& 
     steps->Add("descriptor_matching", seconds);
   }
   std::vector<std::string> match_args = {"--database_path", db, "--SiftMatching.use_gpu", "0",
-                                         "--SiftMatching.num_threads", threads};
+                                         "--SiftMatching.num_threads", kColmapThreads};
   if (!exhaustive) {
     match_args.insert(match_args.end(),
                       {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
@@ -480,7 +487,7 @@ void MatchFeatures(int n, const SparseStageOptions& options, const std::string& 
 // largest model it makes.
 RawModel RegisterPhotos(const std::string& input, const std::string& video,
                         const SparseStageOptions& options, const std::string& colmap,
-                        const std::string& threads, const fs::path& work, const std::string& log_path,
+                        const fs::path& work, const std::string& log_path,
                         SparseStageResult* result) {
   std::error_code ec;
   const PhotoImport photos = ImportInput(input, video, options, work, log_path, result);
@@ -494,15 +501,15 @@ RawModel RegisterPhotos(const std::string& input, const std::string& video,
   steps.nothing_registered = NothingRegisteredMessage(n, result->input_type, focal_unknown,
                                                       VideoFocalGuess(video, options));
   const std::string db = (work / "database.db").string();
-  ExtractFeatures(photos, options, db, raw.image_dir, work, threads, log_path, &steps);
-  MatchFeatures(n, options, db, threads, log_path, &steps, result);
+  ExtractFeatures(photos, options, db, raw.image_dir, work, log_path, &steps);
+  MatchFeatures(n, options, db, log_path, &steps, result);
 
   // 4. Mapping; keep the largest model.
   const fs::path mapped = work / "sparse";
   fs::create_directories(mapped);
   steps.Run("mapper",
             {"--database_path", db, "--image_path", raw.image_dir.string(), "--output_path",
-             mapped.string(), "--Mapper.num_threads", threads, "--Mapper.init_min_tri_angle",
+             mapped.string(), "--Mapper.num_threads", kColmapThreads, "--Mapper.init_min_tri_angle",
              FormatNumber(options.init_min_tri_angle_deg)},
             "mapping");
   std::vector<fs::path> models;
@@ -660,7 +667,6 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
   const std::vector<fs::path> workspace_models = WorkspaceModels(input_path);
   const bool workspace = IsWorkspace(input, video, workspace_models, options.input_type);
   const std::string colmap = FindColmap(options.colmap_path);
-  const std::string threads = std::to_string(options.num_threads == 0 ? -1 : options.num_threads);
 
   ScopedInterruptHandler interrupt_handler;
   StagingDir staging(output_path);
@@ -673,7 +679,7 @@ SparseStageResult RunSparseStage(const std::string& input, const std::string& ou
   SparseStageResult result;
   result.input_type = workspace ? "workspace" : video.empty() ? "photos" : "video";
   RawModel raw = workspace ? WorkspaceModel(input_path, workspace_models, log_path)
-                                 : RegisterPhotos(input, video, options, colmap, threads, work, log_path, &result);
+                                 : RegisterPhotos(input, video, options, colmap, work, log_path, &result);
   if (!workspace && options.min_photo_points > 0) LeaveOutUntiedPhotos(options, work, log_path, &raw);
   CheckRegistration(raw, options, &result);
   Undistort(raw, colmap, log_path, tmp, work, &result);

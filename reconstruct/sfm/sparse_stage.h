@@ -72,6 +72,8 @@ struct SparseStageOptions {
   // same criteria, about 9 times faster on 2 cores) and let COLMAP only verify
   // the matches geometrically; false runs COLMAP's own CPU matcher.
   bool native_matching = true;
+  // Threads of casual3d's descriptor matching. COLMAP's steps run on one
+  // thread, so that the same photos always give the same model.
   int num_threads = 0;             // Range [0, 1024]; 0 = all cores.
   // Smallest triangulation angle of the mapper's initial pair, degrees.
   // COLMAP's 16 suits walk-around captures; a casual capture's photos sit on a
@@ -111,7 +113,8 @@ struct SparseStageOptions {
     v.Field("max_features", o.max_features, R::Closed(500, 100000), "SIFT features per photo");
     v.Field("sift_first_octave", o.sift_first_octave, R::Closed(-1, 2), "First octave of the SIFT pyramid (-1: upsampled)");
     v.Field("native_matching", o.native_matching, R::Any(), "Match descriptors with casual3d's matcher, not COLMAP's");
-    v.Field("num_threads", o.num_threads, R::Closed(0, 1024), "Worker threads; 0 = all cores", util::Keyed::kNo);
+    v.Field("num_threads", o.num_threads, R::Closed(0, 1024), "Threads of the descriptor matching (COLMAP runs on one, for a repeatable model); 0 = all cores",
+            util::Keyed::kNo);
     v.Field("init_min_tri_angle_deg", o.init_min_tri_angle_deg, R::Closed(0.5, 60),
             "Smallest triangulation angle of the mapper's initial pair, degrees");
     v.Field("min_registered_fraction", o.min_registered_fraction, R::Closed(0, 1),
