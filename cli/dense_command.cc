@@ -42,7 +42,13 @@ void RunUnit(const DenseCommandOptions& o, const depth::DenseOptions& opt) {
   const depth::DenseUnitResult r = depth::RunDenseUnit(o.workspace, o.out, opt, pass, photos);
   switch (pass) {
     case depth::DensePass::kPlan:
-      for (size_t i = 0; i < r.photos.size(); ++i) std::printf("%zu\t%s\n", i, r.photos[i].c_str());
+      // One line per photo, in the order to sweep them: its index, its name
+      // and the sweeps its depth unit reads.
+      for (int i : r.sweep_order) {
+        std::string needs;
+        for (int j : r.needs[i]) needs += (needs.empty() ? "" : ",") + std::to_string(j);
+        std::printf("%d\t%s\t%s\n", i, r.photos[i].c_str(), needs.c_str());
+      }
       break;
     case depth::DensePass::kSweep:
     case depth::DensePass::kDepth:

@@ -10,9 +10,10 @@ with the same bytes as `casual3d reconstruct` on one machine gives. Its work
 is split into units that the scheduler spreads over the workers:
 
     sparse    casual3d reconstruct CAPTURE -o OUT/<name> --to sparse
-    plan      casual3d dense WS -o OUT/<name>/dense --pass plan     (lists the photos)
-    sweep     casual3d dense ... --pass sweep --photos a-b          (one unit per group of photos)
-    depth     casual3d dense ... --pass depth --photos a-b          (after every sweep of the capture)
+    plan      casual3d dense WS -o OUT/<name>/dense --pass plan     (the photos, in the order to sweep them)
+    sweep     casual3d dense ... --pass sweep --photos LIST         (one unit per group of photos)
+    depth     casual3d dense ... --pass depth --photos LIST         (after the sweeps it reads; first
+                                                                     when ready, freeing cost caches)
     finish    casual3d dense ... --pass finish
     panorama  casual3d panorama WS --depth OUT/<name>/dense -o OUT/<name>/panorama
     encode    casual3d encode OUT/<name>/panorama/master.exr -o OUT/<name>/web --single-file ...
@@ -75,9 +76,31 @@ def run_into_folder(casual3d, args, label, folder, *after):
     return str(folder)
 
 
-def photo_groups(count, per_unit):
-    """[(first, last)] covering 0..count-1 in groups of per_unit."""
-    return [(a, min(count, a + per_unit) - 1) for a in range(0, count, per_unit)]
+def dense_groups(plan_output, per_unit):
+    """The plan unit's lines (index, name, the sweeps its depth unit reads;
+    in the order to sweep) as groups of per_unit photos along that order, and
+    per group the indices of the groups whose sweeps its depth unit reads."""
+    rows = []
+    for line in plan_output.splitlines():
+        if line.strip():
+            fields = line.split("\t")
+            rows.append((int(fields[0]), [int(j) for j in fields[2].split(",")]))
+    groups = [rows[a:a + per_unit] for a in range(0, len(rows), per_unit)]
+    group_of = {i: g for g, group in enumerate(groups) for i, _ in group}
+    reads = [sorted({group_of[j] for _, needs in group for j in needs}) for group in groups]
+    return [[i for i, _ in group] for group in groups], reads
+
+
+def photo_list(photos):
+    """--photos value: indices, runs of three or more as a-b."""
+    out, k = [], 0
+    while k < len(photos):
+        e = k
+        while e + 1 < len(photos) and photos[e + 1] == photos[e] + 1:
+            e += 1
+        out.append("%d-%d" % (photos[k], photos[e]) if e - k >= 2 else ",".join(str(p) for p in photos[k:e + 1]))
+        k = e + 1
+    return ",".join(out)
 
 
 class Capture:
@@ -114,18 +137,29 @@ def submit_start(client, cfg, cap):
 
 def submit_rest(client, cfg, cap, plan_output):
     """The dense units, panorama and encode, once the plan has listed the photos."""
-    submit = lambda fn, *a, key: client.submit(fn, *a, key=key, retries=cfg.retries, pure=False)
-    count = len([line for line in plan_output.splitlines() if line.strip()])
+    submit = lambda fn, *a, key, priority=0: client.submit(fn, *a, key=key, retries=cfg.retries, pure=False,
+                                                           priority=priority)
     done = None
     if not (cap.dense / "dense.json").is_file():
-        groups = photo_groups(count, cfg.photos_per_unit)
-        sweeps = [submit(run_unit, cfg.casual3d, cap.dense_args(cfg, "--pass", "sweep", "--photos", "%d-%d" % g),
-                         "%s: dense sweep of photos %d-%d" % ((cap.name,) + g), key="sweep-%s-%d" % (cap.name, g[0]))
-                  for g in groups]
-        depths = [submit(run_unit, cfg.casual3d, cap.dense_args(cfg, "--pass", "depth", "--photos", "%d-%d" % g),
-                         "%s: dense depth of photos %d-%d" % ((cap.name,) + g), *sweeps,
-                         key="depth-%s-%d" % (cap.name, g[0]))
-                  for g in groups]
+        # Sweeps in the plan's order, each depth unit submitted once the
+        # sweeps it reads are, at a higher priority: it runs as soon as they
+        # are done and deletes its photos' cost caches (about 1 GB each at
+        # 4096x2048), so the disk holds a few groups' caches, not the capture's.
+        groups, reads = dense_groups(plan_output, cfg.photos_per_unit)
+        sweeps, depths = [], []
+        for g, photos in enumerate(groups):
+            listed = photo_list(photos)
+            sweeps.append(submit(run_unit, cfg.casual3d, cap.dense_args(cfg, "--pass", "sweep", "--photos", listed),
+                                 "%s: dense sweep of photos %s" % (cap.name, listed),
+                                 key="sweep-%s-%d" % (cap.name, g)))
+            for h in range(len(depths), len(groups)):
+                if max(reads[h]) > g:
+                    break
+                listed_h = photo_list(groups[h])
+                depths.append(submit(run_unit, cfg.casual3d,
+                                     cap.dense_args(cfg, "--pass", "depth", "--photos", listed_h),
+                                     "%s: dense depth of photos %s" % (cap.name, listed_h),
+                                     *[sweeps[k] for k in reads[h]], key="depth-%s-%d" % (cap.name, h), priority=1))
         done = submit(run_unit, cfg.casual3d, cap.dense_args(cfg, "--pass", "finish"), "%s: dense finish" % cap.name,
                       *depths, key="finish-%s" % cap.name)
     if not (cap.panorama / "master.exr").is_file():

@@ -297,6 +297,14 @@ void CheckPixelsLoaded(const DensePlan& plan, int i) {
 
 }  // namespace
 
+std::vector<int> SweepsNeeded(const DensePlan& plan, const DenseOptions& options, int i) {
+  std::vector<int> needed = {i};
+  if (options.use_gc_filter)
+    for (int j : plan.ws.ranked_neighbors[i])
+      if (j != i && static_cast<int>(needed.size()) <= options.gc.max_views) needed.push_back(j);
+  return needed;
+}
+
 double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

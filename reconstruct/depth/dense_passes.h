@@ -48,6 +48,11 @@ DensePlan PlanDense(const std::string& workspace_dir, const DenseOptions& option
 // one and its swept neighbours, sorted. (Pass 3 reads every photo's.)
 std::vector<int> PhotosRead(const DensePlan& plan, const std::vector<int>& photos);
 
+// The photos whose sweeps pass 2 reads for photo i: its own (cost cache and
+// WTA map) and, for the GC filter's WTA maps, those of its first max_views
+// ranked neighbours (gc_filter.h).
+std::vector<int> SweepsNeeded(const DensePlan& plan, const DenseOptions& options, int i);
+
 // The parts of photo i's report known before any pass runs.
 PhotoReport PhotoHeader(const DensePlan& plan, int i);
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "reconstruct/depth/dense_passes.h"
+#include "reconstruct/depth/dense_schedule.h"
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/util/log.h"
 
@@ -46,7 +47,7 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   for (int i = 0; i < n; ++i) wta_ptrs[i] = &wta[i];
   std::vector<CostVolume> shells(n);  // Sizes and depth grid; costs live in the cache.
 
-  // Photos run `outer` at a time in both per-photo passes, `inner` threads
+  // Photos run `outer` at a time in the per-photo passes, `inner` threads
   // each: whole photos in parallel scale better than a sweep's planes split
   // over threads, and TRW-S is sequential (docs/DECISIONS.md, "Dense: photos
   // swept in parallel"). Results do not depend on the split.
@@ -59,31 +60,39 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   // and reused buffers").
   BufferPool pool(3);
 
-  // Pass 1: cost volumes and WTA maps of every photo (the GC filter needs
-  // all WTA maps before any envelope can be built).
-  util::Progress sweep_progress("dense: plane sweep", n);
-  ForEachPhoto(plan, AllPhotos(n), outer, [&](int i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    shells[i] = SweepPhoto(plan, i, options, inner, cache_path(i), &pool, &wta[i]);
-    photos[i].t_sweep = SecondsSince(t0);
-    sweep_progress.Advance();
-  });
-  sweep_progress.Finish();
-
-  // Pass 2: envelope, MRF, upsampling; the final maps stay in memory for
-  // the free-space check (pass 3) before any is written. Ground truth
-  // (evaluation only) is read once: each photo's is also needed by the
-  // photos that sweep it. Empty where missing.
+  // Ground truth (evaluation only) is read once: each photo's is also
+  // needed by the photos that sweep it. Empty where missing.
   std::vector<ImageF> ground_truth(n);
   if (!options.ground_truth_dir.empty())
     for (int i = 0; i < n; ++i) ground_truth[i] = ReadDepthMap(options.ground_truth_dir, OutputStem(plan.ws.views[i].name));
+
+  // Passes 1 and 2 interleaved (dense_schedule.h): each photo's sweep (cost
+  // volume and WTA map), and its depth pass (envelope, MRF, upsampling) as
+  // soon as the photos whose WTA maps it reads are swept, its cost cache
+  // deleted after it. The final maps stay in memory for the free-space
+  // check (pass 3) before any is written.
+  const DenseSchedule schedule = ScheduleDense(plan, options);
+  CheckCacheSpace(plan, schedule, outer, cache_dir);
+  util::LogInfo("dense: at most " + std::to_string(std::min(n, schedule.peak_caches + outer - 1)) + " of " +
+                std::to_string(n) + " cost caches on disk at once (" +
+                std::to_string(CostCacheBytes(plan, 0) >> 20) + " MB each)");
   std::vector<ImageF> depth(n);
-  util::Progress progress("dense: envelope + MRF", n);
-  ForEachPhoto(plan, AllPhotos(n), outer, [&](int i) {
-    depth[i] = DepthPhoto(plan, i, options, inner, wta_ptrs, shells[i], cache_path(i), ground_truth[i], out_dir,
-                          &pool, &photos[i]);
-    progress.Advance();
-  });
+  util::Progress progress("dense: sweep, envelope + MRF", 2 * n);
+  RunScheduled(
+      plan, schedule, outer,
+      [&](int i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        shells[i] = SweepPhoto(plan, i, options, inner, cache_path(i), &pool, &wta[i]);
+        photos[i].t_sweep = SecondsSince(t0);
+        progress.Advance();
+      },
+      [&](int i) {
+        depth[i] = DepthPhoto(plan, i, options, inner, wta_ptrs, shells[i], cache_path(i), ground_truth[i],
+                              out_dir, &pool, &photos[i]);
+        std::error_code ec;
+        fs::remove(cache_path(i), ec);
+        progress.Advance();
+      });
   progress.Finish();
 
   // Pass 3.

@@ -10,6 +10,7 @@
 
 #include "reconstruct/depth/dense_passes.h"
 #include "reconstruct/depth/dense_plan_record.h"
+#include "reconstruct/depth/dense_schedule.h"
 #include "reconstruct/depth/dense_report.h"
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
@@ -121,16 +122,6 @@ CostVolume ReadSweepRecord(const DensePlan& plan, int i, const UnitFolder& units
   return shell;
 }
 
-// The sweeps photo i's depth unit reads: its own and, for the GC filter's
-// WTA maps, those of its first max_views ranked neighbours (gc_filter.h).
-std::vector<int> SweepsNeeded(const DensePlan& plan, const DenseOptions& options, int i) {
-  std::vector<int> needed = {i};
-  if (options.use_gc_filter)
-    for (int j : plan.ws.ranked_neighbors[i])
-      if (j != i && static_cast<int>(needed.size()) <= options.gc.max_views) needed.push_back(j);
-  return needed;
-}
-
 bool HasRecord(const UnitFolder& units, const char* pass, const DensePlan& plan, int i) {
   std::error_code ec;
   return fs::exists(units.Path(pass, OutputStem(plan.ws.views[i].name), ".json"), ec);
@@ -176,6 +167,11 @@ void DepthUnit(const DensePlan& plan, const DenseOptions& options, const UnitFol
     plain.compression = io::ExrCompression::kNone;
     io::WriteExr(units.Path("depth", stem, ".exr"), depth, {"Z"}, plain);
     io::WriteFileAtomic(units.Path("depth", stem, ".json"), PhotoReportToJson(pr).dump(2) + "\n");
+    // Only this pass reads the photo's cost cache, and its record now says
+    // it is done: the cache's gigabyte goes before the other photos' sweeps
+    // need the disk.
+    std::error_code ec;
+    fs::remove(units.Path("cost", stem, ".cost"), ec);
   });
 }
 
@@ -311,7 +307,12 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
   CreateDenseOutputFolders(out_dir, options);
   for (const char* sub : {"cost", "wta", "sweep", "depth"}) io::CreateDirectories(units.Dir(sub));
   if (!recorded) CheckOrWritePlan(units, plan, options);
-  if (pass == DensePass::kPlan) return result;
+  if (pass == DensePass::kPlan) {
+    DenseSchedule schedule = ScheduleDense(plan, options);
+    result.sweep_order = std::move(schedule.sweep_order);
+    result.needs = std::move(schedule.needs);
+    return result;
+  }
   if (pass == DensePass::kFinish) {
     result.report = FinishUnit(plan, options, units, out_dir, start, seconds_load);
     result.ran = n;

@@ -41,6 +41,11 @@ std::vector<int> ParsePhotoList(const std::string& text);
 
 struct DenseUnitResult {
   std::vector<std::string> photos;  // The workspace's photos, by index.
+  // kPlan only: the order in which to sweep the photos so that depth units
+  // can run early and free their cost caches, and per photo the sweeps its
+  // depth unit reads (dense_schedule.h).
+  std::vector<int> sweep_order;
+  std::vector<std::vector<int>> needs;
   int ran = 0;                      // Photos this unit computed.
   int skipped = 0;                  // Photos already done.
   DenseReport report;               // kFinish only.

@@ -67,8 +67,20 @@ TEST_F(DenseUnitsTest, UnitsGiveTheOneProcessOutputs) {
   const DenseUnitResult again = Unit("units", DensePass::kSweep, {3, 4});
   EXPECT_EQ(again.ran, 0);
   EXPECT_EQ(again.skipped, 2);
+  // The plan lists every photo once in its sweep order, and each photo's
+  // depth unit reads its own sweep first.
+  std::vector<int> order = plan.sweep_order;
+  std::sort(order.begin(), order.end());
+  EXPECT_EQ(order, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7, 8}));
+  ASSERT_EQ(plan.needs.size(), 9u);
+  for (int i = 0; i < 9; ++i) EXPECT_EQ(plan.needs[i].front(), i);
+  const fs::path costs = *root_ / "units" / ".dense-units" / "cost";
+  auto cost_files = [&] { return std::distance(fs::directory_iterator(costs), fs::directory_iterator()); };
+  EXPECT_EQ(cost_files(), 9);
   EXPECT_EQ(Unit("units", DensePass::kDepth, {8, 0, 5}).ran, 3);
+  EXPECT_EQ(cost_files(), 6);  // A depth unit frees its photos' cost caches.
   EXPECT_EQ(Unit("units", DensePass::kDepth, {1, 2, 3, 4, 6, 7}).ran, 6);
+  EXPECT_EQ(cost_files(), 0);
   const DenseUnitResult done = Unit("units", DensePass::kFinish);
   ExpectSameFiles("units");
   EXPECT_FALSE(fs::exists(*root_ / "units" / ".dense-units"));  // Spent once dense.json exists.
