@@ -83,8 +83,9 @@ def dense_groups(plan_output, per_unit):
     rows = []
     for line in plan_output.splitlines():
         if line.strip():
-            fields = line.split("\t")
-            rows.append((int(fields[0]), [int(j) for j in fields[2].split(",")]))
+            index, rest = line.split("\t", 1)
+            needs = rest.rsplit("\t", 1)[1]  # The name between may hold anything.
+            rows.append((int(index), [int(j) for j in needs.split(",")]))
     groups = [rows[a:a + per_unit] for a in range(0, len(rows), per_unit)]
     group_of = {i: g for g, group in enumerate(groups) for i, _ in group}
     reads = [sorted({group_of[j] for _, needs in group for j in needs}) for group in groups]

@@ -72,7 +72,8 @@ void CheckCacheSpace(const DensePlan& plan, const DenseSchedule& schedule, int o
   char msg[512];
   std::snprintf(msg, sizeof(msg),
                 "%s: the dense stage needs %.1f GB of free disk for %zu cost caches at once, and %.1f GB are "
-                "free; free some space, or lower the working resolution (--scale)",
+                "free; free some space, or lower the working resolution (dense --scale, reconstruct "
+                "--working-megapixels)",
                 cache_dir.c_str(), need / 1e9, count, space.available / 1e9);
   throw std::runtime_error(msg);
 }
@@ -131,6 +132,8 @@ void RunScheduled(const DensePlan& plan, const DenseSchedule& schedule, int oute
         (is_sweep ? sweep : depth)(photo);
       } catch (const std::exception& e) {
         error = plan.ws.views[photo].name + ": " + e.what();
+      } catch (...) {
+        error = plan.ws.views[photo].name + ": unknown error";
       }
       lock.lock();
       --running;

@@ -117,7 +117,8 @@ TEST(DenseScheduleTest, CacheSpaceIsCheckedBeforeAnySweep) {
   } catch (const std::runtime_error& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find(dir + ": the dense stage needs "), std::string::npos) << what;
-    EXPECT_NE(what.find("GB are free; free some space, or lower the working resolution (--scale)"),
+    EXPECT_NE(what.find("GB are free; free some space, or lower the working resolution (dense --scale, "
+                        "reconstruct --working-megapixels)"),
               std::string::npos)
         << what;
   }

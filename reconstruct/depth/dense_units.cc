@@ -288,9 +288,18 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
     }
   }
   if (pass == DensePass::kDepth)
-    for (int i : todo)
+    for (int i : todo) {
       for (int j : SweepsNeeded(plan, options, i))
         if (!HasRecord(units, "sweep", plan, j)) throw std::runtime_error(MissingUnitMessage(plan, j, "sweep", units));
+      // A depth unit deletes its cost cache after its record; a cache gone
+      // without that record (the record removed by hand) needs a new sweep.
+      std::error_code ec;
+      const std::string stem = OutputStem(plan.ws.views[i].name);
+      if (!fs::exists(units.Path("cost", stem, ".cost"), ec))
+        throw std::runtime_error(units.Path("cost", stem, ".cost") + ": cost cache missing; delete " +
+                                 units.Path("sweep", stem, ".json") + " and run `casual3d dense ... --pass sweep " +
+                                 "--photos " + std::to_string(i) + "` again");
+    }
   if (pass == DensePass::kFinish) CheckDepthUnitsDone(plan, units);
 
   const int threads = base::ResolveThreads(options.num_threads);

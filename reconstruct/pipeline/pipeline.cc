@@ -35,7 +35,8 @@ using Clock = std::chrono::steady_clock;
 // the photos that agree, depth smoothed along surfaces
 // (spec/stage-panorama.md, version 7). encode-3: coarser levels take the mean
 // normal of their block, the manifest is compact. encode-4: 9-bit depth.
-constexpr const char* kStageVersions[kNumStages] = {"sparse-4", "dense-5", "panorama-8",
+// sparse-5: COLMAP's steps on one thread (the same photos, the same model).
+constexpr const char* kStageVersions[kNumStages] = {"sparse-5", "dense-5", "panorama-8",
                                                     "encode-4"};
 
 std::string HashHex(const std::string& text) {
