@@ -12,18 +12,32 @@
 
 namespace casual3d::depth {
 namespace fs = std::filesystem;
+namespace {
+
+// Per photo j, the photos whose depth pass needs j's sweep; and per photo,
+// how many of its needs are not swept yet (all of them).
+struct NeedCounts {
+  std::vector<std::vector<int>> needed_by;
+  std::vector<int> missing;
+};
+
+NeedCounts CountNeeds(const std::vector<std::vector<int>>& needs) {
+  NeedCounts c;
+  c.needed_by.resize(needs.size());
+  for (size_t i = 0; i < needs.size(); ++i) {
+    c.missing.push_back(static_cast<int>(needs[i].size()));
+    for (int j : needs[i]) c.needed_by[j].push_back(static_cast<int>(i));
+  }
+  return c;
+}
+
+}  // namespace
 
 DenseSchedule ScheduleDense(const DensePlan& plan, const DenseOptions& options) {
   const int n = plan.size();
   DenseSchedule s;
-  s.needs.resize(n);
-  std::vector<std::vector<int>> needed_by(n);
-  for (int i = 0; i < n; ++i) {
-    s.needs[i] = SweepsNeeded(plan, options, i);
-    for (int j : s.needs[i]) needed_by[j].push_back(i);
-  }
-  std::vector<int> missing(n);
-  for (int i = 0; i < n; ++i) missing[i] = static_cast<int>(s.needs[i].size());
+  for (int i = 0; i < n; ++i) s.needs.push_back(SweepsNeeded(plan, options, i));
+  auto [needed_by, missing] = CountNeeds(s.needs);
   std::vector<bool> swept(n, false), done(n, false);
   int on_disk = 0, left = n;
   while (left > 0) {
@@ -38,11 +52,10 @@ DenseSchedule ScheduleDense(const DensePlan& plan, const DenseOptions& options) 
       swept[j] = true;
       s.sweep_order.push_back(j);
       s.peak_caches = std::max(s.peak_caches, ++on_disk);
-      for (int i : needed_by[j]) --missing[i];
-      // Every photo whose needs are now all swept runs its depth pass and
-      // frees its cache.
-      for (int i = 0; i < n; ++i) {
-        if (done[i] || missing[i] > 0 || !swept[i]) continue;
+      // Every photo whose needs are now all swept (its own among them) runs
+      // its depth pass and frees its cache.
+      for (int i : needed_by[j]) {
+        if (--missing[i] > 0) continue;
         done[i] = true;
         --on_disk;
         --left;
@@ -58,35 +71,30 @@ uint64_t CostCacheBytes(const DensePlan& plan, int i) {
   return pixels * static_cast<uint64_t>(plan.num_labels[i]) * 2 + pixels * 4;
 }
 
-void CheckCacheSpace(const DensePlan& plan, const DenseSchedule& schedule, int outer,
-                     const std::string& cache_dir) {
+CacheNeed CheckCacheSpace(const DensePlan& plan, const DenseSchedule& schedule, int outer,
+                          const std::string& cache_dir) {
   std::vector<uint64_t> bytes;
   for (int i = 0; i < plan.size(); ++i) bytes.push_back(CostCacheBytes(plan, i));
   std::sort(bytes.rbegin(), bytes.rend());
-  const size_t count = std::min(bytes.size(), static_cast<size_t>(schedule.peak_caches + outer - 1));
-  uint64_t need = 0;
-  for (size_t k = 0; k < count; ++k) need += bytes[k];
+  CacheNeed need;
+  need.count = static_cast<int>(std::min(bytes.size(), static_cast<size_t>(schedule.peak_caches + outer - 1)));
+  for (int k = 0; k < need.count; ++k) need.bytes += bytes[k];
   std::error_code ec;
   const fs::space_info space = fs::space(cache_dir, ec);
-  if (ec || space.available >= need) return;
+  if (ec || space.available >= need.bytes) return need;  // Unknown free space: let the writes tell.
   char msg[512];
   std::snprintf(msg, sizeof(msg),
                 "%s: the dense stage needs %.1f GB of free disk for %zu cost caches at once, and %.1f GB are "
                 "free; free some space, or lower the working resolution (dense --scale, reconstruct "
                 "--working-megapixels)",
-                cache_dir.c_str(), need / 1e9, count, space.available / 1e9);
+                cache_dir.c_str(), need.bytes / 1e9, static_cast<size_t>(need.count), space.available / 1e9);
   throw std::runtime_error(msg);
 }
 
 void RunScheduled(const DensePlan& plan, const DenseSchedule& schedule, int outer,
                   const std::function<void(int)>& sweep, const std::function<void(int)>& depth) {
   const int n = plan.size();
-  std::vector<std::vector<int>> needed_by(n);
-  std::vector<int> missing(n);
-  for (int i = 0; i < n; ++i) {
-    missing[i] = static_cast<int>(schedule.needs[i].size());
-    for (int j : schedule.needs[i]) needed_by[j].push_back(i);
-  }
+  NeedCounts counts = CountNeeds(schedule.needs);
   std::mutex mutex;
   std::condition_variable changed;
   std::set<int> ready;  // Photos whose depth pass may run, lowest first.
@@ -139,8 +147,8 @@ void RunScheduled(const DensePlan& plan, const DenseSchedule& schedule, int oute
       --running;
       if (!error.empty() && first_error.empty()) first_error = error;
       if (error.empty() && is_sweep) {
-        for (int i : needed_by[photo])
-          if (--missing[i] == 0) ready.insert(i);
+        for (int i : counts.needed_by[photo])
+          if (--counts.missing[i] == 0) ready.insert(i);
       } else if (error.empty()) {
         ++depths_done;
         --live;

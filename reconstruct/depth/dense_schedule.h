@@ -35,11 +35,17 @@ DenseSchedule ScheduleDense(const DensePlan& plan, const DenseOptions& options);
 // label, and a float photo weight per pixel, at working resolution.
 uint64_t CostCacheBytes(const DensePlan& plan, int i);
 
-// Throws std::runtime_error naming `cache_dir` when its file system has less
-// free space than the caches the schedule keeps at once with `outer` photos
-// in flight (the largest caches, peak_caches + outer - 1 of them).
-void CheckCacheSpace(const DensePlan& plan, const DenseSchedule& schedule, int outer,
-                     const std::string& cache_dir);
+// The cost caches on disk at once with `outer` photos in flight: the largest
+// ones, peak_caches + outer - 1 of them (at most every photo's).
+struct CacheNeed {
+  int count = 0;
+  uint64_t bytes = 0;
+};
+
+// Returns what the schedule needs; throws std::runtime_error naming
+// `cache_dir` when its file system has less free space than that.
+CacheNeed CheckCacheSpace(const DensePlan& plan, const DenseSchedule& schedule, int outer,
+                          const std::string& cache_dir);
 
 // Runs sweep(i) and depth(i) for every photo on `outer` threads: each thread
 // takes a depth pass whose needs are swept when there is one (the lowest

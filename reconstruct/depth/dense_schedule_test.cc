@@ -44,9 +44,20 @@ TEST(DenseScheduleTest, SweepsEveryPhotoOnceAndKeepsFewCaches) {
   // (the last photos of the ring close it, needing photo 0's neighbours).
   EXPECT_GE(s.peak_caches, 3);
   EXPECT_LE(s.peak_caches, 8);
-  // Sweeping in index order would keep about as many as needed by the first
-  // photo's far neighbour; the schedule never keeps all of them.
   EXPECT_LT(s.peak_caches, 100);
+
+  // Two rings of 50 photos, each photo's nearest neighbour on the other ring
+  // (index +-50), as on a sphere rig: sweeping in index order would keep
+  // every photo of the first ring until its partner is swept, 50 or more
+  // caches; the schedule completes photos across both rings.
+  DensePlan rings = RingPlan(100);
+  for (int i = 0; i < 100; ++i) {
+    const int ring = i / 50, k = i % 50;
+    rings.ws.ranked_neighbors[i] = {(1 - ring) * 50 + k, ring * 50 + (k + 1) % 50, ring * 50 + (k + 49) % 50,
+                                    (1 - ring) * 50 + (k + 1) % 50, (1 - ring) * 50 + (k + 49) % 50};
+  }
+  const DenseSchedule r = ScheduleDense(rings, options);
+  EXPECT_LE(r.peak_caches, 12);
 
   options.use_gc_filter = false;  // Each photo needs only itself: one cache.
   EXPECT_EQ(ScheduleDense(plan, options).peak_caches, 1);

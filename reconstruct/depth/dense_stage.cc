@@ -72,12 +72,9 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
   // deleted after it. The final maps stay in memory for the free-space
   // check (pass 3) before any is written.
   const DenseSchedule schedule = ScheduleDense(plan, options);
-  CheckCacheSpace(plan, schedule, outer, cache_dir);
-  uint64_t largest = 0;
-  for (int i = 0; i < n; ++i) largest = std::max(largest, CostCacheBytes(plan, i));
-  util::LogInfo("dense: at most " + std::to_string(std::min(n, schedule.peak_caches + outer - 1)) + " of " +
-                std::to_string(n) + " cost caches on disk at once (at most " + std::to_string(largest >> 20) +
-                " MB each)");
+  const CacheNeed need = CheckCacheSpace(plan, schedule, outer, cache_dir);
+  util::LogInfo("dense: at most " + std::to_string(need.count) + " of " + std::to_string(n) +
+                " cost caches on disk at once (" + std::to_string(need.bytes >> 20) + " MB)");
   std::vector<ImageF> depth(n);
   util::Progress progress("dense: sweep, envelope + MRF", 2 * n);
   RunScheduled(
