@@ -19,8 +19,8 @@
 //   build/bench/package_budget MASTER.exr [--normal-bits B] [--depth-bits B]
 //       [--lossless-effort F] [--lossless-method M] [--tile-size T]
 //       [--color-quality Q] [--color-method M] [--no-fill-absent]
-//       [--reference-only] [--shading out.png] [--write-package DIR]
-//       [--against OTHER.exr]
+//       [--omit-level-width W] [--reference-only] [--shading out.png]
+//       [--write-package DIR] [--against OTHER.exr]
 
 #include <algorithm>
 #include <chrono>
@@ -200,7 +200,7 @@ int Main(int argc, char** argv) {
                          "[--lossless-effort F] [--lossless-method M] [--tile-size T] "
                          "[--color-quality Q] [--color-method M] [--no-fill-absent] "
                          "[--lossy-normals | --lossless-normals] [--normal-mean-error DEG] "
-                         "[--normal-p99-error DEG] "
+                         "[--normal-p99-error DEG] [--omit-level-width W] "
                          "[--reference-only] [--shading out.png] [--write-package DIR] "
                          "[--against OTHER.exr]\n");
     return 2;
@@ -224,6 +224,7 @@ int Main(int argc, char** argv) {
     else if (arg == "--lossy-normals") candidate.lossy_normals = true;
     else if (arg == "--normal-mean-error" && has_value) candidate.normal_mean_error_deg = std::atof(argv[++a]);
     else if (arg == "--normal-p99-error" && has_value) candidate.normal_p99_error_deg = std::atof(argv[++a]);
+    else if (arg == "--omit-level-width" && has_value) candidate.omit_level_width = std::atoi(argv[++a]);
     else if (arg == "--shading" && has_value) shading = argv[++a];
     else if (arg == "--write-package" && has_value) package_dir = argv[++a];
     else if (arg == "--against" && has_value) against = argv[++a];
@@ -278,9 +279,13 @@ int Main(int argc, char** argv) {
     }
     std::printf("wrote %s\n", package_dir.c_str());
   }
+  // Each candidate level against the reference level of its size (the
+  // candidate may leave out a level the reference, which keeps every one, has).
   for (size_t l = 0; l < encoded.levels.size(); ++l)
-    PrintErrors(static_cast<int>(l), reference.levels[l], encoded.levels[l],
-                l == 0 && against.empty() ? &*master : nullptr, !against.empty());
+    for (const TwoLayerPanorama& same : reference.levels)
+      if (same.width() == encoded.levels[l].width())
+        PrintErrors(static_cast<int>(l), same, encoded.levels[l],
+                    l == 0 && against.empty() ? &*master : nullptr, !against.empty());
   if (!shading.empty()) {
     const TwoLayerPanorama& a = reference.levels[0];
     Image8 image(2 * (a.width() / 4) + 8, a.height() / 4, 1, 255);

@@ -1,5 +1,5 @@
 // `casual3d encode <master.exr> -o <package> [--quality Q] [--tile-size N]
-// [--levels N] [--depth-bits B] [--normal-bits B] [--lossy-normals]
+// [--levels N] [--omit-level-width W] [--depth-bits B] [--normal-bits B] [--lossy-normals]
 // [--normal-mean-error DEG] [--normal-p99-error DEG] [--single-file out.c3d]
 // [--max-kb N [--min-quality Q]] [--capture SPARSE_DIR] [--title T]`: turns a master file into a web package
 // (spec/package.md), optionally also as one .c3d file.
@@ -100,6 +100,7 @@ void AddEncodeCommand(CLI::App& app) {
   AddDescribedOption(cmd, "--quality", *options, options->package.color_quality);
   AddDescribedOption(cmd, "--tile-size", *options, options->package.tile_size);
   AddDescribedOption(cmd, "--levels", *options, options->package.levels);
+  AddDescribedOption(cmd, "--omit-level-width", *options, options->package.omit_level_width);
   AddDescribedOption(cmd, "--depth-bits", *options, options->package.depth_bits);
   AddDescribedOption(cmd, "--normal-bits", *options, options->package.normal_bits);
   cmd->add_flag("--lossy-normals", options->package.lossy_normals,

@@ -262,7 +262,7 @@ std::vector<InvalidVector> MakeInvalidVectors(const PackageFiles& base, const Pa
     std::vector<uint8_t> c = container(files);
     v.push_back({name, std::move(files), std::move(c)});
   };
-  both("unknown-major", WithManifest(base, "\"version\": \"1.0\"", "\"version\": \"2.0\""));
+  both("unknown-major", WithManifest(base, "\"version\": \"1.0\"", "\"version\": \"3.0\""));
   both("nesting-too-deep", EditManifest(base, [](Value* root) {
          Value nested = Value::Array();  // 16 arrays in the root object: depth 17.
          for (int i = 1; i < kMaxManifestNesting; ++i) {
@@ -438,11 +438,16 @@ void Regenerate() {
     for (int x = 40; x < 56; ++x)
       for (int l = 0; l < kNumLayers; ++l)
         std::fill_n(&lossy_pano.layer(l).normal[3 * lossy_pano.index(x, y)], 3, 0.0f);
+  // Version 2.0: three levels computed, the middle one (32x16) left out.
+  PackageOptions left_out = two_levels;
+  left_out.levels = 3;
+  left_out.omit_level_width = 32;
   Vector vectors[] = {
       {"two-layer-64x32", casual3d::testing::MakePackageTestPanorama(64, 32, 3), two_levels},
       {"front-only-48x24", std::move(front_only), one_level},
       {"cross-layer-64x32", std::move(cross), two_levels},
       {"lossy-normals-64x32", std::move(lossy_pano), lossy},
+      {"level-left-out-64x32", casual3d::testing::MakePackageTestPanorama(64, 32, 3), left_out},
   };
   std::map<std::string, PackageFiles> encoded;
   for (Vector& v : vectors) {
@@ -453,8 +458,10 @@ void Regenerate() {
     ASSERT_TRUE(WritePackageSingleFile(*files, (dir / (std::string(v.name) + ".c3d")).string()).ok());
     MemoryFileSource source;
     for (const auto& [p, b] : *files) source.Add(p, b);
+    StatusOr<Manifest> manifest = ReadManifest(source);
+    ASSERT_TRUE(manifest.ok()) << manifest.status().ToString();
     Value levels = Value::Array();
-    for (int level = 0; level < (v.options.levels); ++level) {
+    for (int level = 0; level < static_cast<int>(manifest->levels.size()); ++level) {
       ReadOptions read;
       read.level = level;
       StatusOr<TwoLayerPanorama> pano = ReadPackage(source, decoder, read);
@@ -492,7 +499,7 @@ TEST(PackageVectorsTest, ValidVectorsDecodeToTheExpectedValues) {
   StatusOr<Value> expected = json::Parse(std::string_view(reinterpret_cast<const char*>(text.data()), text.size()));
   ASSERT_TRUE(expected.ok()) << expected.status().ToString();
   WebpImageDecoder decoder;
-  ASSERT_EQ(expected->object().size(), 4u);
+  ASSERT_EQ(expected->object().size(), 5u);
   for (const auto& [name, levels] : expected->object()) {
     for (const std::string& form : {name, name + ".c3d"}) {
       StatusOr<std::unique_ptr<FileSource>> source = OpenPackage((dir / form).string());

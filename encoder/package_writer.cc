@@ -64,6 +64,9 @@ Status PackageOptions::Check() const {
   if (levels < 0 || levels > kMaxLevels)
     return InvalidArgument("levels " + std::to_string(levels) + " is outside [0, " +
                            std::to_string(kMaxLevels) + "] (0 = automatic)");
+  if (omit_level_width < 0)
+    return InvalidArgument("omit_level_width " + std::to_string(omit_level_width) +
+                           " is negative (0 writes every level)");
   if (!(color_quality >= 0.0f && color_quality <= 100.0f))
     return InvalidArgument("color_quality " + std::to_string(color_quality) +
                            " is outside [0, 100]");
@@ -101,6 +104,7 @@ PackageOptions DeliveryPackageOptions() {
   options.lossless_effort = 75.0f;
   options.fill_absent = true;
   options.compact_manifest = true;
+  options.omit_level_width = 2048;
   return options;
 }
 
@@ -127,15 +131,20 @@ StatusOr<PackageFiles> Encode(const TwoLayerPanorama& pano, const PackageOptions
                            std::to_string(pano.width()) + "x" + std::to_string(pano.height()) +
                            "; use fewer levels");
 
-  // Coarser levels by repeated halving.
+  // Coarser levels by repeated halving; the one omit_level_width names is
+  // computed for those below it but not stored, unless it is the first or
+  // the last.
   std::vector<TwoLayerPanorama> coarse;
   std::vector<const TwoLayerPanorama*> level_pano = {&pano};
   coarse.reserve(num_levels);
   for (int l = 1; l < num_levels; ++l) {
-    CASUAL3D_ASSIGN_OR_RETURN(TwoLayerPanorama half, HalvePanorama(*level_pano.back()));
+    CASUAL3D_ASSIGN_OR_RETURN(TwoLayerPanorama half,
+                              HalvePanorama(coarse.empty() ? pano : coarse.back()));
     coarse.push_back(std::move(half));
-    level_pano.push_back(&coarse.back());
+    if (l + 1 == num_levels || coarse.back().width() != options.omit_level_width)
+      level_pano.push_back(&coarse.back());
   }
+  const int stored_levels = static_cast<int>(level_pano.size());
 
   Manifest manifest;
   manifest.generator = options.generator;
@@ -144,7 +153,12 @@ StatusOr<PackageFiles> Encode(const TwoLayerPanorama& pano, const PackageOptions
   manifest.frame = pano.frame();
   // The lowest minor version whose members the manifest uses.
   manifest.view = pano.view_hints();
-  manifest.version_minor = options.lossy_normals ? 2 : manifest.view ? 1 : 0;
+  if (stored_levels < num_levels) {
+    manifest.version_major = 2;  // A level left out: 2.0 has every 1.x member.
+    manifest.version_minor = 0;
+  } else {
+    manifest.version_minor = options.lossy_normals ? 2 : manifest.view ? 1 : 0;
+  }
   manifest.tile_size = options.tile_size;
   manifest.depth = DepthRange(pano);
   manifest.depth.bits = options.depth_bits;
@@ -166,7 +180,7 @@ StatusOr<PackageFiles> Encode(const TwoLayerPanorama& pano, const PackageOptions
     std::vector<uint8_t> bytes;
   };
   std::vector<Job> jobs;
-  for (int l = 0; l < num_levels; ++l) {
+  for (int l = 0; l < stored_levels; ++l) {
     LevelEntry L;
     L.width = level_pano[l]->width();
     L.height = level_pano[l]->height();
@@ -248,7 +262,7 @@ StatusOr<PackageFiles> Encode(const TwoLayerPanorama& pano, const PackageOptions
   files.reserve(jobs.size() + 1);
   files.emplace_back(kManifestFileName, std::vector<uint8_t>());
   PackageStats s;
-  s.level_bytes.assign(num_levels, 0);
+  s.level_bytes.assign(stored_levels, 0);
   for (Job& job : jobs) {
     manifest.files.push_back(
         {job.path, job.bytes.size(), Sha256Hex(job.bytes.data(), job.bytes.size())});

@@ -173,6 +173,57 @@ TEST_F(PackageWriterTest, FolderRoundTripAtEveryLevel) {
   EXPECT_EQ(entries, 1);
 }
 
+// A level left out (package 2.0): the others are the same files as in the
+// package with every level, under the next level numbers; the level may not
+// be level 0 or the coarsest.
+TEST_F(PackageWriterTest, OmittedLevelLeavesTheOthersAsTheyWere) {
+  options_.levels = 4;  // 512, 256, 128 and 64 pixels wide.
+  PackageStats all_stats;
+  const PackageFiles all = Encode(&all_stats);
+  options_.omit_level_width = 256;
+  PackageStats stats;
+  const PackageFiles files = Encode(&stats);
+  MemoryFileSource source;
+  for (const auto& [path, bytes] : files) source.Add(path, bytes);
+  StatusOr<Manifest> manifest = ReadManifest(source);
+  ASSERT_TRUE(manifest.ok()) << manifest.status().ToString();
+  EXPECT_EQ(manifest->version_major, 2);
+  EXPECT_EQ(manifest->version_minor, 0);
+  ASSERT_EQ(manifest->levels.size(), 3u);
+  ASSERT_EQ(stats.level_bytes.size(), 3u);
+  const int widths[3] = {512, 128, 64};
+  for (int l = 0; l < 3; ++l) EXPECT_EQ(manifest->levels[l].width, widths[l]);
+  EXPECT_EQ(stats.level_bytes[0], all_stats.level_bytes[0]);
+  EXPECT_EQ(stats.level_bytes[1], all_stats.level_bytes[2]);
+  EXPECT_EQ(stats.level_bytes[2], all_stats.level_bytes[3]);
+  EXPECT_EQ(stats.total_bytes - stats.manifest_bytes + all_stats.level_bytes[1],
+            all_stats.total_bytes - all_stats.manifest_bytes);
+  std::map<std::string, const std::vector<uint8_t>*> all_files;
+  for (const auto& [path, bytes] : all) all_files[path] = &bytes;
+  for (const auto& [path, bytes] : files) {
+    if (path == kManifestFileName) continue;
+    const int level = path[1] - '0';
+    const std::string same = "l" + std::to_string(level == 0 ? 0 : level + 1) + path.substr(2);
+    ASSERT_EQ(all_files.count(same), 1u) << same;
+    EXPECT_TRUE(*all_files[same] == bytes) << path;
+  }
+  // Decoded, level 1 is the panorama halved twice.
+  ReadOptions read;
+  read.level = 1;
+  StatusOr<TwoLayerPanorama> decoded = ReadPackage(source, decoder_, read);
+  ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+  ExpectDecodedMatches(*HalvePanorama(*HalvePanorama(pano_)), *decoded, manifest->depth, 33.5);
+  // Level 0 and the coarsest level are never left out: then it is 1.0.
+  for (int width : {512, 64, 100}) {
+    options_.omit_level_width = width;
+    PackageStats kept;
+    const PackageFiles again = Encode(&kept);
+    EXPECT_EQ(kept.level_bytes, all_stats.level_bytes) << width;
+    const std::string text(again.front().second.begin(), again.front().second.end());
+    EXPECT_NE(text.find("\"version\": \"1.0\""), std::string::npos) << width;
+  }
+}
+
 // The largest angle between a unit normal and its decoded `bits`-bit
 // octahedral code, over a dense spiral of normals.
 double WorstOctahedralErrorDeg(int bits) {
@@ -362,6 +413,11 @@ TEST_F(PackageWriterTest, CorruptPackagesGiveClearErrors) {
 TEST_F(PackageWriterTest, RefusesBadOptionsAndUnrelatedFolders) {
   options_.tile_size = 8;
   EXPECT_EQ(EncodePackage(pano_, options_).status().code(), StatusCode::kInvalidArgument);
+  options_.tile_size = 128;
+  options_.omit_level_width = -1;
+  EXPECT_EQ(EncodePackage(pano_, options_).status().message(),
+            "omit_level_width -1 is negative (0 writes every level)");
+  options_.omit_level_width = 0;
   options_.tile_size = 128;
   options_.levels = 8;  // 520 is not divisible by 128.
   Status s = EncodePackage(casual3d::testing::MakePackageTestPanorama(520, 260), options_).status();

@@ -115,6 +115,39 @@ bool IsHex64(const std::string& s) {
   return true;
 }
 
+
+bool KnownMajor(int major) {
+  return major >= kOldestPackageVersionMajor && major <= kPackageVersionMajor;
+}
+
+constexpr const char* kReadsVersions = " (this reader reads 1.x and 2.x)";
+
+// Level `l` of `m` is (width >> s) x (height >> s), exactly: s = l in 1.x; in
+// 2.x s = 0 at level 0 and any shift above the level before's (`*shift`,
+// which is updated) further on (spec/package.md Sec. 2).
+Status CheckLevelSize(const Manifest& m, int l, const std::string& where, int* shift) {
+  const LevelEntry& L = m.levels[l];
+  auto exact = [&](int s) {
+    return L.width >= 1 && L.height >= 1 && (m.width >> s) == L.width &&
+           (m.height >> s) == L.height && (L.width << s) == m.width && (L.height << s) == m.height;
+  };
+  const std::string size = ": size " + std::to_string(L.width) + "x" + std::to_string(L.height) +
+                           " is not the full size " + std::to_string(m.width) + "x" +
+                           std::to_string(m.height) + " divided by 2^";
+  if (m.version_major < 2 || l == 0) {
+    if (!exact(l)) return InvalidData(where + size + std::to_string(l));
+    *shift = l;
+    return Status::Ok();
+  }
+  for (int s = *shift + 1; s < 31 && (m.width >> s) >= L.width; ++s) {
+    if (exact(s)) {
+      *shift = s;
+      return Status::Ok();
+    }
+  }
+  return InvalidData(where + size + "s for an s above the level before's " +
+                     std::to_string(*shift));
+}
 }  // namespace
 
 bool IsSafePackagePath(std::string_view path) {
@@ -160,10 +193,10 @@ uint64_t Manifest::LevelBytes(int level) const {
 }
 
 Status Manifest::Validate(const ReaderChecks& checks) const {
-  if (version_major != kPackageVersionMajor && checks.on(ReaderCheck::kUnknownMajor))
+  if (!KnownMajor(version_major) && checks.on(ReaderCheck::kUnknownMajor))
     return UnsupportedVersion("version " + std::to_string(version_major) + "." +
-                              std::to_string(version_minor) +
-                              " is not supported (this reader reads 1.x)");
+                              std::to_string(version_minor) + " is not supported" +
+                              kReadsVersions);
   if (width < 1 || height < 1 || width > kMaxPackageWidth || height > kMaxPackageHeight)
     return LimitExceeded("size " + std::to_string(width) + "x" + std::to_string(height) +
                          " is outside 1x1 .. " + std::to_string(kMaxPackageWidth) + "x" +
@@ -209,15 +242,11 @@ Status Manifest::Validate(const ReaderChecks& checks) const {
       return InvalidData(where + ".sha256: expected 64 lower-case hexadecimal digits");
   }
   std::vector<uint8_t> used(files.size(), 0);
+  int shift = -1;  // Of the level before.
   for (size_t l = 0; l < levels.size(); ++l) {
     const LevelEntry& L = levels[l];
     const std::string where = "levels[" + std::to_string(l) + "]";
-    if (L.width != (width >> l) || L.height != (height >> l) || (L.width << l) != width ||
-        (L.height << l) != height || L.width < 1 || L.height < 1)
-      return InvalidData(where + ": size " + std::to_string(L.width) + "x" +
-                         std::to_string(L.height) + " is not the full size " +
-                         std::to_string(width) + "x" + std::to_string(height) + " divided by 2^" +
-                         std::to_string(l));
+    CASUAL3D_RETURN_IF_ERROR(CheckLevelSize(*this, static_cast<int>(l), where, &shift));
     const int columns = (L.width + tile_size - 1) / tile_size;
     const int rows = (L.height + tile_size - 1) / tile_size;
     if (L.columns != columns || L.rows != rows)
@@ -291,9 +320,9 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes, const ReaderChecks& che
     };
     m.version_major = number(0, dot);
     m.version_minor = number(dot + 1, version.size());
-    if (m.version_major != kPackageVersionMajor && checks.on(ReaderCheck::kUnknownMajor))
-      return fail(UnsupportedVersion("version " + version +
-                                     " is not supported (this reader reads 1.x)"));
+    if (!KnownMajor(m.version_major) && checks.on(ReaderCheck::kUnknownMajor))
+      return fail(UnsupportedVersion("version " + version + " is not supported" +
+                                     kReadsVersions));
   }
   if (const Value* g = root.Find("generator"); g != nullptr && g->is_string())
     m.generator = g->string_value();

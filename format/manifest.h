@@ -7,7 +7,9 @@
 //
 // Versioning: "version" is "major.minor". Readers refuse an unknown major
 // (kUnsupportedVersion) and ignore members they do not know, so a minor
-// version may add optional members.
+// version may add optional members. This reader reads majors 1 and 2; 2.0 is
+// 1.2 with levels that may leave out halvings between level 0 and the
+// coarsest (spec/package.md Sec. 2).
 
 #include <cstdint>
 #include <map>
@@ -25,11 +27,12 @@
 namespace casual3d {
 
 constexpr const char* kPackageFormatName = "casual3d";
-constexpr int kPackageVersionMajor = 1;
-// The newest minor version this reader knows. Writers write the lowest minor
-// version whose members they use: 1.0 without "view", 1.1 with it, 1.2 with
-// lossy normals ("octahedral-lossy").
-constexpr int kPackageVersionMinor = 2;
+// The majors this reader reads. Writers write the lowest version whose
+// members and rules they use: 1.0 without "view", 1.1 with it, 1.2 with lossy
+// normals ("octahedral-lossy"), 2.0 when a level is left out (then with any
+// of those).
+constexpr int kOldestPackageVersionMajor = 1;
+constexpr int kPackageVersionMajor = 2;
 constexpr const char* kManifestFileName = "manifest.json";
 
 // Limits of spec/package.md, "Limits".
@@ -49,8 +52,11 @@ struct TileEntry {
 };
 
 // One level of detail. Level 0 is the full resolution; level k has the size
-// (width >> k) x (height >> k). Tiles cover the level in a grid of tile_size
-// squares (the last column and row may be smaller), listed row by row.
+// (width >> s) x (height >> s) for a shift s that grows with k: s = k in
+// version 1.x, any larger shift than level k-1's from 2.0, where a writer may
+// leave out halvings (spec/package.md Sec. 2). Tiles cover the level in a
+// grid of tile_size squares (the last column and row may be smaller), listed
+// row by row.
 struct LevelEntry {
   int width = 0;
   int height = 0;
@@ -67,8 +73,8 @@ struct FileEntry {
 };
 
 struct Manifest {
-  int version_major = kPackageVersionMajor;
-  int version_minor = 0;  // Writers: the lowest minor whose members they use.
+  int version_major = kOldestPackageVersionMajor;  // Writers: the lowest version
+  int version_minor = 0;                            // whose members and rules they use.
   std::string generator;  // Free text naming the writing program (optional).
   int width = 0;          // Full-resolution panorama size, pixels.
   int height = 0;

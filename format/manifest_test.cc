@@ -72,10 +72,52 @@ TEST(ManifestTest, VersioningRules) {
               "\"future\": {\"x\": [1, 2]}, \"tile_size\""));
   ASSERT_TRUE(newer.ok()) << newer.status().ToString();
   EXPECT_EQ(newer->version_minor, 7);
-  EXPECT_EQ(ParseManifest(Replace(text, "\"1.0\"", "\"2.0\"")).status().code(),
+  EXPECT_TRUE(ParseManifest(Replace(text, "\"1.0\"", "\"2.0\"")).ok());
+  EXPECT_TRUE(ParseManifest(Replace(text, "\"1.0\"", "\"2.9\"")).ok());
+  const StatusOr<Manifest> major3 = ParseManifest(Replace(text, "\"1.0\"", "\"3.0\""));
+  EXPECT_EQ(major3.status().code(), StatusCode::kUnsupportedVersion);
+  EXPECT_EQ(major3.status().message(),
+            "manifest.json: version 3.0 is not supported (this reader reads 1.x and 2.x)");
+  EXPECT_EQ(ParseManifest(Replace(text, "\"1.0\"", "\"0.9\"")).status().code(),
             StatusCode::kUnsupportedVersion);
   EXPECT_EQ(ParseManifest(Replace(text, "\"1.0\"", "\"1\"")).status().code(),
             StatusCode::kInvalidData);
+}
+
+// Level 1 a quarter of level 0's width: version 2.x only (spec/package.md
+// Sec. 2); its shift must be above the level before's and exact.
+TEST(ManifestTest, LevelsMayLeaveOutHalvingsFromVersion2) {
+  Manifest m = SmallManifest();
+  m.levels[1].width = 16;
+  m.levels[1].height = 8;
+  const Status v1 = m.Validate();
+  EXPECT_EQ(v1.code(), StatusCode::kInvalidData);
+  EXPECT_EQ(v1.message(), "levels[1]: size 16x8 is not the full size 64x32 divided by 2^1");
+  m.version_major = 2;
+  EXPECT_TRUE(m.Validate().ok()) << m.Validate().ToString();
+  const StatusOr<Manifest> parsed = ParseManifest(SerializeManifest(m));
+  ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
+  EXPECT_EQ(parsed->levels[1].width, 16);
+  // Halved alike in both directions, or not at all.
+  m.levels[1].height = 16;
+  EXPECT_EQ(m.Validate().message(),
+            "levels[1]: size 16x16 is not the full size 64x32 divided by 2^s for an s above the "
+            "level before's 0");
+  // Not finer than the level before, nor equal to it.
+  m.levels[1] = m.levels[0];
+  EXPECT_EQ(m.Validate().code(), StatusCode::kInvalidData);
+  m = SmallManifest();
+  m.version_major = 2;
+  m.levels.push_back(m.levels[1]);
+  EXPECT_EQ(m.Validate().message(),
+            "levels[2]: size 32x16 is not the full size 64x32 divided by 2^s for an s above the "
+            "level before's 1");
+  // Level 0 is the full size in every version.
+  m = SmallManifest();
+  m.version_major = 2;
+  m.levels.erase(m.levels.begin());
+  EXPECT_EQ(m.Validate().message(),
+            "levels[0]: size 32x16 is not the full size 64x32 divided by 2^0");
 }
 
 TEST(ManifestTest, LossyNormalEncoding) {

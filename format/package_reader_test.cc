@@ -154,12 +154,12 @@ TEST_F(PackageReaderTest, ReadManifestNamesTheManifest) {
   StatusOr<Manifest> ok = ReadManifest(source);
   ASSERT_TRUE(ok.ok()) << ok.status().ToString();
   EXPECT_EQ(ok->levels.size(), 1u);
-  text.replace(text.find("\"1."), 3, "\"2.");
+  text.replace(text.find("\"1."), 3, "\"3.");
   MemoryFileSource newer;
   newer.Add(kManifestFileName, std::vector<uint8_t>(text.begin(), text.end()));
   StatusOr<Manifest> refused = ReadManifest(newer);
   ASSERT_FALSE(refused.ok());
-  EXPECT_EQ(refused.status().message().rfind("manifest.json: version 2.", 0), 0u)
+  EXPECT_EQ(refused.status().message().rfind("manifest.json: version 3.", 0), 0u)
       << refused.status().message();
 }
 

@@ -16,7 +16,7 @@
 namespace casual3d {
 
 enum class ReaderCheck : int {
-  kUnknownMajor = 0,          // manifest "version" with a major other than 1
+  kUnknownMajor = 0,          // manifest "version" with a major other than 1 or 2
   kNestingTooDeep,            // manifest.json nested deeper than 16
   kNearEqualsFar,             // depth_encoding near_m == far_m
   kPathEscape,                // a path that is not a safe package-relative path

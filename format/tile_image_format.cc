@@ -25,9 +25,9 @@ constexpr const TileImageFormat* kFormats[] = {&kWebp};
 const TileImageFormat& WebpTileImageFormat() { return kWebp; }
 
 StatusOr<const TileImageFormat*> TileImageFormatForVersion(int major) {
-  if (major == 1) return &kWebp;
+  if (major == 1 || major == 2) return &kWebp;
   return UnsupportedVersion("packages of major version " + std::to_string(major) +
-                            " have no known tile image format (1.x: WebP)");
+                            " have no known tile image format (1.x and 2.x: WebP)");
 }
 
 StatusOr<const TileImageFormat*> FindTileImageFormat(std::string_view name) {

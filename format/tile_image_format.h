@@ -35,7 +35,7 @@ struct TileImageFormat {
 // WebP (RIFF container; lossless when VP8L, WebpContainerCoding).
 const TileImageFormat& WebpTileImageFormat();
 
-// The tile image format of packages of major version `major`: WebP for 1;
+// The tile image format of packages of major version `major`: WebP for 1 and 2;
 // kUnsupportedVersion naming the version otherwise.
 StatusOr<const TileImageFormat*> TileImageFormatForVersion(int major);
 

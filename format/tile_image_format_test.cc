@@ -27,10 +27,11 @@ TEST(TileImageFormatTest, PackagesOfVersionOneHoldWebp) {
 }
 
 TEST(TileImageFormatTest, UnknownVersionOrNameIsAClearError) {
-  const Status version = TileImageFormatForVersion(2).status();
+  EXPECT_EQ(*TileImageFormatForVersion(2), &WebpTileImageFormat());
+  const Status version = TileImageFormatForVersion(3).status();
   EXPECT_EQ(version.code(), StatusCode::kUnsupportedVersion);
-  EXPECT_EQ(version.message(), "packages of major version 2 have no known tile image format "
-                               "(1.x: WebP)");
+  EXPECT_EQ(version.message(), "packages of major version 3 have no known tile image format "
+                               "(1.x and 2.x: WebP)");
   EXPECT_EQ(*FindTileImageFormat("webp"), &WebpTileImageFormat());
   const Status name = FindTileImageFormat("avif").status();
   EXPECT_EQ(name.code(), StatusCode::kNotFound);

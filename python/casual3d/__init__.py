@@ -253,8 +253,10 @@ class Package:
     Attributes:
         path: as given.
         manifest: manifest.json as a dict (spec/package.md Sec. 3).
-        num_levels: levels of detail; level 0 is the full resolution, level k
-            is (W >> k) x (H >> k).
+        num_levels: levels of detail; level 0 is the full resolution, each
+            next level smaller by a power of two: (W >> k) x (H >> k) in 1.x
+            packages, possibly smaller from 2.0, which may leave out
+            halvings (`levels()` gives the sizes).
     """
 
     def __init__(self, path):
@@ -374,7 +376,9 @@ def write_package(pano: Panorama, path, *, max_kb: Optional[int] = None, min_qua
 
     Written atomically; an existing folder is replaced only if it is empty or
     holds a package. Options (encoder/package_writer.h, defaults in brackets):
-    tile_size [512], levels [0: automatic], color_quality [90] (lossy WebP,
+    tile_size [512], levels [0: automatic], omit_level_width [0: every
+    level; 2048 leaves out that level, package version 2.0, as `casual3d
+    encode` does], color_quality [90] (lossy WebP,
     0..100), color_method [3], lossless_effort [25], lossless_method [1],
     depth_bits [12], normal_bits [8], lossy_normals [False],
     normal_mean_error_deg [2.5], normal_p99_error_deg [8.0], threads [0: all

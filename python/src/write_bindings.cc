@@ -109,6 +109,7 @@ void RegisterWriting(py::module_& m) {
       .def(py::init<>())
       .def_readwrite("tile_size", &PackageOptions::tile_size)
       .def_readwrite("levels", &PackageOptions::levels)
+      .def_readwrite("omit_level_width", &PackageOptions::omit_level_width)
       .def_readwrite("color_quality", &PackageOptions::color_quality)
       .def_readwrite("color_method", &PackageOptions::color_method)
       .def_readwrite("lossless_effort", &PackageOptions::lossless_effort)

@@ -60,6 +60,19 @@ def test_package_levels(room, tmp_path):
         package.read(2)
 
 
+def test_package_with_a_level_left_out(room, tmp_path, cli):
+    path = tmp_path / "web"
+    casual3d.write_package(room, path, tile_size=16, levels=3, omit_level_width=room.width // 2,
+                           threads=1)
+    out = cli("validate", path)
+    assert out.returncode == 0, out.stderr
+    assert "valid casual3d 2.0 package" in out.stdout
+    package = casual3d.Package(path)
+    assert [p.width for p in package.levels()] == [room.width, room.width // 4]
+    coarse = package.read(1)
+    assert (coarse.width, coarse.height) == (room.width // 4, room.height // 4)
+
+
 def test_master_file_reads_back_exactly(room, tmp_path, cli):
     room.centre = np.array([0.5, -1.25, 3.0])
     room.rotation = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
