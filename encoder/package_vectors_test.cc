@@ -438,7 +438,8 @@ void Regenerate() {
     for (int x = 40; x < 56; ++x)
       for (int l = 0; l < kNumLayers; ++l)
         std::fill_n(&lossy_pano.layer(l).normal[3 * lossy_pano.index(x, y)], 3, 0.0f);
-  // Version 2.0: three levels computed, the middle one (32x16) left out.
+  // Version 2.0: three levels computed, the middle one (32x16) left out, and
+  // graph images of right and down links, front and back nodes linked.
   PackageOptions left_out = two_levels;
   left_out.levels = 3;
   left_out.omit_level_width = 32;
@@ -447,7 +448,7 @@ void Regenerate() {
       {"front-only-48x24", std::move(front_only), one_level},
       {"cross-layer-64x32", std::move(cross), two_levels},
       {"lossy-normals-64x32", std::move(lossy_pano), lossy},
-      {"level-left-out-64x32", casual3d::testing::MakePackageTestPanorama(64, 32, 3), left_out},
+      {"level-left-out-64x32", CrossLayerPanorama(64, 32, 11, &cross_links), left_out},
   };
   std::map<std::string, PackageFiles> encoded;
   for (Vector& v : vectors) {

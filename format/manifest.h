@@ -87,7 +87,10 @@ struct Manifest {
   std::vector<LevelEntry> levels;  // Finest first.
   std::vector<FileEntry> files;
 
-  TileQuantization quantization() const { return {depth, normal}; }
+  // How tiles are quantized; in version 2.x graph images hold right and down
+  // links only (a major this reader does not know, read with the
+  // unknown-major check off, is read as 1.x).
+  TileQuantization quantization() const { return {depth, normal, version_major == 2}; }
 
   // The entry of `path`, or nullptr.
   const FileEntry* FindFile(const std::string& path) const;

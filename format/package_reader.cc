@@ -126,6 +126,12 @@ StatusOr<TwoLayerPanorama> PackageReader::FinishLevel(int num_threads) {
   if (!nodes.ok())
     return Status(nodes.code(), TileFileAt(problem.x, problem.y, problem.kind) + ": " +
                                     nodes.message());
+  if (tile_decoder_->quantization().right_down_links) {
+    Status completed = CompleteLinks(&pano_, num_threads, checks_, &problem);
+    if (!completed.ok())
+      return Status(completed.code(), TileFileAt(problem.x, problem.y, problem.kind) + ": " +
+                                          completed.message());
+  }
   // FinishDecodedPanorama leaves only valid node values, so the links are
   // what remains to check. A link is stored in the graph image of its node's
   // tile; one to a node of another tile also names that tile's graph image.

@@ -20,6 +20,8 @@ namespace {
 constexpr int kFlagFrontPresent = 1, kFlagBackPresent = 2, kFlagFrontLabel = 4,
               kFlagBackLabel = 8;
 constexpr int kFlagReserved = 0xF0;
+// The right and down links of a packed links byte (directions 0 and 1).
+constexpr uint8_t kRightDownLinkBits = 0x0F;
 
 std::string PixelName(int x, int y) {
   return "(" + std::to_string(x) + ", " + std::to_string(y) + ")";
@@ -260,8 +262,9 @@ Image8 EncodeTileImage(const TwoLayerPanorama& pano, int x0, int y0, int w, int 
         uint8_t* px = &image.at(x, y);
         const LayerData& F = pano.layer(kFront);
         const LayerData& B = pano.layer(kBack);
-        px[0] = F.present[i] ? F.links[i] : 0;
-        px[1] = B.present[i] ? B.links[i] : 0;
+        const uint8_t kept = q.right_down_links ? kRightDownLinkBits : 0xFF;
+        px[0] = F.present[i] ? F.links[i] & kept : 0;
+        px[1] = B.present[i] ? B.links[i] & kept : 0;
         px[2] = static_cast<uint8_t>((F.present[i] ? kFlagFrontPresent : 0) |
                                      (B.present[i] ? kFlagBackPresent : 0) |
                                      (F.present[i] && F.label[i] ? kFlagFrontLabel : 0) |
@@ -603,6 +606,62 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads, const Read
       }
     });
   }
+  return Status::Ok();
+}
+
+Status CompleteLinks(TwoLayerPanorama* pano, int num_threads, const ReaderChecks& checks,
+                     DecodedNodeProblem* problem) {
+  const int width = pano->width(), height = pano->height();
+  const int threads = ResolveThreads(num_threads);
+  // Left and up bits of present nodes: refused, or dropped with the check off.
+  for (int l = 0; l < kNumLayers; ++l) {
+    LayerData& L = pano->layer(l);
+    for (size_t i = 0; i < L.links.size(); ++i) {
+      if (!L.present[i] || (L.links[i] & ~kRightDownLinkBits) == 0) continue;
+      if (checks.on(ReaderCheck::kReservedFlagBits)) {
+        if (problem != nullptr) {
+          problem->x = static_cast<int>(i % width);
+          problem->y = static_cast<int>(i / width);
+          problem->layer = l;
+          problem->kind = TileImageKind::kGraph;
+        }
+        return InvalidData(std::string("graph image: ") + (l == kFront ? "front" : "back") +
+                           " node at pixel " +
+                           PixelName(static_cast<int>(i % width), static_cast<int>(i / width)) +
+                           " has left or up link bits set (this version stores right and down "
+                           "links only)");
+      }
+      L.links[i] &= kRightDownLinkBits;
+    }
+  }
+  // Each node's left and up links from its left and upper neighbours' right
+  // and down links: a pass that reads the right-and-down bytes and writes
+  // new ones, so that rows can go to different threads.
+  NodeArray<uint8_t> completed[kNumLayers] = {pano->layer(kFront).links, pano->layer(kBack).links};
+  ParallelFor(0, height, threads, [&](int64_t row) {
+    const int y = static_cast<int>(row);
+    for (int x = 0; x < width; ++x) {
+      const size_t i = pano->index(x, y);
+      for (int m = 0; m < kNumLayers; ++m) {
+        if (!pano->layer(m).present[i]) continue;
+        uint8_t links = completed[m][i];
+        for (Direction from : {kRight, kDown}) {
+          int sx, sy;
+          if (!pano->Neighbour(x, y, Opposite(from), &sx, &sy)) continue;
+          const size_t j = pano->index(sx, sy);
+          const Link into = m == kFront ? Link::kFront : Link::kBack;
+          for (int l = 0; l < kNumLayers; ++l) {
+            if (pano->layer(l).present[j] && GetLink(pano->layer(l).links[j], from) == into) {
+              links = SetLink(links, Opposite(from), l == kFront ? Link::kFront : Link::kBack);
+              break;
+            }
+          }
+        }
+        completed[m][i] = links;
+      }
+    }
+  }, /*grain=*/16);
+  for (int l = 0; l < kNumLayers; ++l) pano->layer(l).links = std::move(completed[l]);
   return Status::Ok();
 }
 

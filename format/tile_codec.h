@@ -21,9 +21,10 @@
 //                     y) its v code (EncodeOctahedralLossy); alpha below 128
 //                     at (x, y) marks the zero normal (unlit).
 //   graph (lossless): R = front links, G = back links (TwoLayerPanorama's packed
-//                     byte: 2 bits per direction), B = flags: bit 0 front present,
-//                     bit 1 back present, bit 2 front label, bit 3 back label;
-//                     bits 4-7 are 0.
+//                     byte: 2 bits per direction; from version 2.0 the right
+//                     and down links only, bits 4-7 zero, CompleteLinks),
+//                     B = flags: bit 0 front present, bit 1 back present,
+//                     bit 2 front label, bit 3 back label; bits 4-7 are 0.
 
 #include <cstdint>
 #include <vector>
@@ -135,6 +136,9 @@ void DecodeOctahedralLossy(const uint8_t code[2], float normal[3]);
 struct TileQuantization {
   DepthQuantization depth;
   NormalQuantization normal;
+  // Graph images hold each node's right and down links only (version 2.x);
+  // the left and up links follow from them (CompleteLinks).
+  bool right_down_links = false;
 
   Status Check() const;
 };
@@ -208,5 +212,20 @@ struct DecodedNodeProblem {
 Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads = 1,
                              const ReaderChecks& checks = ReaderChecks(),
                              DecodedNodeProblem* problem = nullptr);
+
+// For graph images of right and down links only (version 2.x,
+// TileQuantization::right_down_links), after FinishDecodedPanorama: gives
+// every present node the left and up links that its neighbours' right and
+// down links imply (links are mutual, spec/package.md Sec. 4.1). A node
+// linked into from one side by both nodes of the neighbouring pixel keeps
+// the front one's link, and the back one's stays without its reverse; a
+// link into an absent node gives nothing: TwoLayerPanorama::ValidateLinks
+// then refuses both. A present node with left or up bits set is refused
+// (kInvalidData, the node in `problem`) when the reserved-flag-bits check is
+// on, and those bits are dropped otherwise. Rows are shared among
+// `num_threads` threads; the result does not depend on it.
+Status CompleteLinks(TwoLayerPanorama* pano, int num_threads = 1,
+                     const ReaderChecks& checks = ReaderChecks(),
+                     DecodedNodeProblem* problem = nullptr);
 
 }  // namespace casual3d

@@ -121,6 +121,120 @@ TEST(TileCodecTest, TileRoundTripKeepsTheGraphExactly) {
   }
 }
 
+// Graph images of right and down links only (version 2.x): the left and up
+// links come back exactly, across tiles, the seam and the two layers.
+TEST(TileCodecTest, RightAndDownLinksGiveBackEveryLink) {
+  TwoLayerPanorama pano = casual3d::testing::MakePackageTestPanorama(96, 48, 5);
+  // Cross-layer links: where a front node's right link is cut (a depth edge)
+  // and the back node beside it is linked from the left by a back node, the
+  // front node takes that link over.
+  int cross = 0;
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 96; ++x) {
+      int nx, ny;
+      pano.Neighbour(x, y, kRight, &nx, &ny);
+      const size_t i = pano.index(x, y), j = pano.index(nx, ny);
+      uint8_t& front = pano.layer(kFront).links[i];
+      uint8_t& back = pano.layer(kBack).links[i];
+      uint8_t& to = pano.layer(kBack).links[j];
+      if (!pano.layer(kFront).present[i] || !pano.layer(kBack).present[j]) continue;
+      if (GetLink(front, kRight) != Link::kNone || GetLink(to, kLeft) != Link::kBack) continue;
+      back = SetLink(back, kRight, Link::kNone);
+      front = SetLink(front, kRight, Link::kBack);
+      to = SetLink(to, kLeft, Link::kFront);
+      ++cross;
+    }
+  }
+  ASSERT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
+  TileQuantization q;
+  q.depth.near_m = 2.0;
+  q.depth.far_m = 100.0;
+  q.right_down_links = true;
+  const TileDecoder decoder(q);
+  TwoLayerPanorama out(96, 48);
+  for (int y0 = 0; y0 < 48; y0 += 32) {
+    for (int x0 = 0; x0 < 96; x0 += 40) {
+      const int w = std::min(40, 96 - x0), h = std::min(32, 48 - y0);
+      for (int k = 0; k < kNumTileImageKinds; ++k) {
+        const Image8 image = EncodeTileImage(pano, x0, y0, w, h, static_cast<TileImageKind>(k), q);
+        if (k == static_cast<int>(TileImageKind::kGraph)) {
+          for (int y = 0; y < h; ++y) {
+            for (int x = 0; x < w; ++x) {
+              const uint8_t* px = &image.at(x, y);
+              ASSERT_EQ((px[0] | px[1]) & 0xF0, 0);
+            }
+          }
+        }
+        ASSERT_TRUE(DecodeTileImage(image.view(), static_cast<TileImageKind>(k), x0, y0, w, h,
+                                    decoder, &out).ok());
+      }
+    }
+  }
+  ASSERT_TRUE(FinishDecodedPanorama(&out).ok());
+  TwoLayerPanorama two_threads = out;
+  ASSERT_TRUE(CompleteLinks(&out).ok());
+  ASSERT_TRUE(CompleteLinks(&two_threads, 2).ok());
+  EXPECT_GT(cross, 0);
+  for (int l = 0; l < kNumLayers; ++l) {
+    EXPECT_EQ(out.layer(l).links, pano.layer(l).links) << l;
+    EXPECT_EQ(two_threads.layer(l).links, pano.layer(l).links) << l;
+  }
+  EXPECT_TRUE(out.ValidateLinks().ok());
+
+  // Left or up bits at a present node: refused naming it, dropped with the
+  // check off.
+  TwoLayerPanorama bad = out;
+  const size_t i = bad.index(20, 8);
+  ASSERT_TRUE(bad.layer(kFront).present[i]);
+  const TwoLayerPanorama stored = [&] {
+    TwoLayerPanorama p = out;
+    for (int l = 0; l < kNumLayers; ++l)
+      for (uint8_t& links : p.layer(l).links) links &= 0x0F;
+    return p;
+  }();
+  bad = stored;
+  bad.layer(kFront).links[i] |= 0x40;
+  DecodedNodeProblem problem;
+  const Status refused = CompleteLinks(&bad, 1, ReaderChecks(), &problem);
+  EXPECT_EQ(refused.message(), "graph image: front node at pixel (20, 8) has left or up link bits "
+                               "set (this version stores right and down links only)");
+  EXPECT_EQ(problem.x, 20);
+  EXPECT_EQ(problem.y, 8);
+  EXPECT_EQ(problem.kind, TileImageKind::kGraph);
+  bad = stored;
+  bad.layer(kFront).links[i] |= 0x40;
+  ReaderChecks off;
+  off.Disable(ReaderCheck::kReservedFlagBits);
+  ASSERT_TRUE(CompleteLinks(&bad, 1, off).ok());
+  EXPECT_EQ(bad.layer(kFront).links, out.layer(kFront).links);
+
+  // A right link into an absent node, or two into one node's left side:
+  // ValidateLinks refuses what CompleteLinks leaves.
+  for (int trial = 0; trial < 2; ++trial) {
+    bad = stored;
+    bool made = false;
+    for (size_t n = 0; n < bad.layer(kBack).present.size() && !made; ++n) {
+      const int x = static_cast<int>(n % 96), y = static_cast<int>(n / 96);
+      int nx, ny;
+      bad.Neighbour(x, y, kRight, &nx, &ny);
+      const size_t j = bad.index(nx, ny);
+      uint8_t& links = bad.layer(kBack).links[n];
+      if (!bad.layer(kBack).present[n] || GetLink(links, kRight) != Link::kNone) continue;
+      if (trial == 0 && !bad.layer(kBack).present[j]) {
+        links = SetLink(links, kRight, Link::kBack);  // Into an absent node.
+        made = true;
+      } else if (trial == 1 && bad.layer(kFront).present[j] && bad.layer(kFront).present[n] &&
+                 GetLink(bad.layer(kFront).links[n], kRight) == Link::kFront) {
+        links = SetLink(links, kRight, Link::kFront);  // The front node's side, taken.
+        made = true;
+      }
+    }
+    ASSERT_TRUE(made) << trial;
+    ASSERT_TRUE(CompleteLinks(&bad).ok());
+    EXPECT_FALSE(bad.ValidateLinks().ok()) << trial;
+  }
+}
+
 TEST(TileCodecTest, LossyNormalCodesWithinOneDegreeAndUnlitByAlpha) {
   double worst = 0;
   for (int i = 0; i < 20000; ++i) {

@@ -58,6 +58,15 @@ int FuzzTileDecode(const uint8_t* data, size_t size) {
   const Image8& const_image = image;
   Status s = DecodeTileImage(const_image.view(), kind, 8, 4, w, h, decoder, &pano);
   if (!s.ok() || !FinishDecodedPanorama(&pano, 1, checks).ok()) return 0;
+  // Version 2.x graph images (right and down links only), for odd depth bits.
+  if (kind == TileImageKind::kGraph && (data[4] & 1) != 0) {
+    DecodedNodeProblem problem;
+    if (!CompleteLinks(&pano, 1 + (data[5] & 1), checks, &problem).ok()) {
+      if (problem.x < 0 || problem.x >= pano.width() || problem.y < 0 || problem.y >= pano.height())
+        __builtin_trap();
+      return 0;
+    }
+  }
   (void)pano.Validate();
   // PackageReader names the graph images of a wrong link from where
   // ValidateLinks found it: the node and the pixel it points at lie inside.
