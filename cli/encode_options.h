@@ -40,8 +40,10 @@ struct EncodeCommandOptions {
     v.Field("package.levels", o.package.levels, R::ZeroOr(R::Closed(1, kMaxLevels)),
             "Levels of detail; 0 = automatic");
     v.Field("package.omit_level_width", o.package.omit_level_width, R::AtLeast(0),
-            "Leave out the level this many pixels wide unless it is the finest or the coarsest "
-            "(package version 2.0, which 1.x readers refuse); 0 writes every level (1.x)");
+            "Leave out the level more than half this and at most this many pixels wide (the "
+            "2048 one of a 4096 or 8192 panorama, 1536 of 6144) unless it is the finest or the "
+            "coarsest (package version 2.0, which 1.x readers refuse); 0 writes every level "
+            "(1.x)");
     v.Field("package.depth_bits", o.package.depth_bits, R::Closed(8, 16),
             "Bits of the log-depth code (9: relative error at most 0.68% for far/near 1000; "
             "10 for 0.34%, 12 for 0.084%)");

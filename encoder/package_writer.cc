@@ -132,8 +132,7 @@ StatusOr<PackageFiles> Encode(const TwoLayerPanorama& pano, const PackageOptions
                            "; use fewer levels");
 
   // Coarser levels by repeated halving; the one omit_level_width names is
-  // computed for those below it but not stored, unless it is the first or
-  // the last.
+  // computed for those below it but not stored, unless it is the last.
   std::vector<TwoLayerPanorama> coarse;
   std::vector<const TwoLayerPanorama*> level_pano = {&pano};
   coarse.reserve(num_levels);
@@ -141,7 +140,8 @@ StatusOr<PackageFiles> Encode(const TwoLayerPanorama& pano, const PackageOptions
     CASUAL3D_ASSIGN_OR_RETURN(TwoLayerPanorama half,
                               HalvePanorama(coarse.empty() ? pano : coarse.back()));
     coarse.push_back(std::move(half));
-    if (l + 1 == num_levels || coarse.back().width() != options.omit_level_width)
+    const int w = coarse.back().width();
+    if (l + 1 == num_levels || !(w > options.omit_level_width / 2 && w <= options.omit_level_width))
       level_pano.push_back(&coarse.back());
   }
   const int stored_levels = static_cast<int>(level_pano.size());

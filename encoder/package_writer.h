@@ -23,10 +23,12 @@ struct PackageOptions {
   // Levels of detail, 1..kMaxLevels; 0 = automatic: halve while the coarsest
   // level is wider than 512 pixels and its size is even.
   int levels = 0;
-  // Leave out the level this many pixels wide unless it is level 0 or the
-  // coarsest (package version 2.0, which 1.x readers refuse; spec/package.md
-  // Sec. 2); 0 writes every level (version 1.x). The others are computed by
-  // halving as before, so they have the same pixels either way.
+  // Leave out the level more than half this and at most this many pixels
+  // wide (2048: the 2048 level of 4096 and 8192 panoramas, the 1536 one of
+  // 6144), unless it is level 0 or the coarsest (package version 2.0, which
+  // 1.x readers refuse; spec/package.md Sec. 2); 0 writes every level
+  // (version 1.x). The others are computed by halving as before, so they
+  // have the same pixels either way.
   int omit_level_width = 0;
   // Lossy WebP quality of the colour images, 0..100.
   float color_quality = 90.0f;
@@ -70,9 +72,9 @@ struct PackageOptions {
 // size of reconstructions"; docs/DECISIONS.md, "Delivery budget" and "Lossy
 // normals"): PackageOptions' defaults but 5-bit normals (angular error at most
 // 8.1 degrees, about 2.6 on average against 8 bits on reconstructions, whose
-// normals are noisier than that), no 2048-wide level (omit_level_width: the
-// viewer steps from 1024 to 4096, and a 4096x2048 package is about a quarter
-// smaller), 9-bit depth (relative error at most
+// normals are noisier than that), no level of 1025..2048 pixels wide
+// (omit_level_width: the viewer steps from 1024 to 4096, and a 4096x2048
+// package is about a quarter smaller), 9-bit depth (relative error at most
 // exp(ln(far_m / near_m) / 1020) - 1: 0.68% for far/near = 1000; the viewer's
 // simplifier allows one code step beyond its 1%, wasm-viewer/js/mesh-error.js),
 // absent nodes filled (fill_absent), lossless WebP method 4, effort 75 and a compact

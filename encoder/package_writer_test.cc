@@ -223,8 +223,14 @@ TEST_F(PackageWriterTest, OmittedLevelLeavesTheOthersAsTheyWere) {
     ASSERT_TRUE(all_decoded.ok()) << all_decoded.status().ToString();
     EXPECT_TRUE(*decoded == *all_decoded) << "level " << level;
   }
-  // Level 0 and the coarsest level are never left out: then it is 1.0.
-  for (int width : {512, 64, 100}) {
+  // Any width in (128, 256] names the 256 level.
+  options_.omit_level_width = 300;
+  PackageStats wider;
+  Encode(&wider);
+  EXPECT_EQ(wider.level_bytes, stats.level_bytes);
+  // Level 0 and the coarsest level are never left out, nor one that no
+  // level's width is in (W/2, W] for: then it is 1.0.
+  for (int width : {512, 64, 100, 1023}) {
     options_.omit_level_width = width;
     PackageStats kept;
     const PackageFiles again = Encode(&kept);

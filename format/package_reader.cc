@@ -127,7 +127,7 @@ StatusOr<TwoLayerPanorama> PackageReader::FinishLevel(int num_threads) {
     return Status(nodes.code(), TileFileAt(problem.x, problem.y, problem.kind) + ": " +
                                     nodes.message());
   if (tile_decoder_->quantization().right_down_links) {
-    Status completed = CompleteLinks(&pano_, num_threads, checks_, &problem);
+    Status completed = CompleteLinks(&pano_, checks_, &problem);
     if (!completed.ok())
       return Status(completed.code(), TileFileAt(problem.x, problem.y, problem.kind) + ": " +
                                           completed.message());

@@ -609,59 +609,72 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads, const Read
   return Status::Ok();
 }
 
-Status CompleteLinks(TwoLayerPanorama* pano, int num_threads, const ReaderChecks& checks,
+namespace {
+
+// Which node of a pixel links into layer `m` along one direction, given the
+// two nodes' 2-bit link codes in that direction: the front one, else the
+// back one, else none (a Link code).
+inline uint8_t FromWhich(unsigned front_code, unsigned back_code, unsigned m_code) {
+  return front_code == m_code ? 1 : back_code == m_code ? 2 : 0;
+}
+
+}  // namespace
+
+Status CompleteLinks(TwoLayerPanorama* pano, const ReaderChecks& checks,
                      DecodedNodeProblem* problem) {
   const int width = pano->width(), height = pano->height();
-  const int threads = ResolveThreads(num_threads);
-  // Left and up bits of present nodes: refused, or dropped with the check off.
+  uint8_t* links[kNumLayers] = {pano->layer(kFront).links.data(), pano->layer(kBack).links.data()};
+  const uint8_t* present[kNumLayers] = {pano->layer(kFront).present.data(),
+                                        pano->layer(kBack).present.data()};
+  const size_t n = pano->layer(kFront).links.size();
+  // Left and up bits: absent nodes hold no links (FinishDecodedPanorama), so
+  // any bit set belongs to a present node: refused, or dropped with the check off.
   for (int l = 0; l < kNumLayers; ++l) {
-    LayerData& L = pano->layer(l);
-    for (size_t i = 0; i < L.links.size(); ++i) {
-      if (!L.present[i] || (L.links[i] & ~kRightDownLinkBits) == 0) continue;
+    unsigned any = 0;
+    for (size_t i = 0; i < n; ++i) any |= links[l][i];
+    if ((any & ~kRightDownLinkBits & 0xFF) == 0) continue;
+    for (size_t i = 0; i < n; ++i) {
+      if ((links[l][i] & ~kRightDownLinkBits & 0xFF) == 0) continue;
       if (checks.on(ReaderCheck::kReservedFlagBits)) {
+        const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
         if (problem != nullptr) {
-          problem->x = static_cast<int>(i % width);
-          problem->y = static_cast<int>(i / width);
+          problem->x = x;
+          problem->y = y;
           problem->layer = l;
           problem->kind = TileImageKind::kGraph;
         }
         return InvalidData(std::string("graph image: ") + (l == kFront ? "front" : "back") +
-                           " node at pixel " +
-                           PixelName(static_cast<int>(i % width), static_cast<int>(i / width)) +
+                           " node at pixel " + PixelName(x, y) +
                            " has left or up link bits set (this version stores right and down "
                            "links only)");
       }
-      L.links[i] &= kRightDownLinkBits;
+      links[l][i] &= kRightDownLinkBits;
     }
   }
-  // Each node's left and up links from its left and upper neighbours' right
-  // and down links: a pass that reads the right-and-down bytes and writes
-  // new ones, so that rows can go to different threads.
-  NodeArray<uint8_t> completed[kNumLayers] = {pano->layer(kFront).links, pano->layer(kBack).links};
-  ParallelFor(0, height, threads, [&](int64_t row) {
-    const int y = static_cast<int>(row);
+  // Node (x, y) of layer m: its left link from the right links of pixel
+  // x - 1 (wrapping), its up link from the down links of row y - 1. Only
+  // bits 0..3 are read and only bits 4..7 written, so one pass in place
+  // reads what it needs whatever it has written.
+  for (int y = 0; y < height; ++y) {
+    const size_t row = static_cast<size_t>(y) * width;
     for (int x = 0; x < width; ++x) {
-      const size_t i = pano->index(x, y);
+      const size_t i = row + x;
+      const size_t left = row + (x == 0 ? width - 1 : x - 1);
+      const unsigned front_right = links[kFront][left] & 3, back_right = links[kBack][left] & 3;
+      unsigned front_down = 0, back_down = 0;
+      if (y > 0) {
+        front_down = (links[kFront][i - width] >> 2) & 3;
+        back_down = (links[kBack][i - width] >> 2) & 3;
+      }
       for (int m = 0; m < kNumLayers; ++m) {
-        if (!pano->layer(m).present[i]) continue;
-        uint8_t links = completed[m][i];
-        for (Direction from : {kRight, kDown}) {
-          int sx, sy;
-          if (!pano->Neighbour(x, y, Opposite(from), &sx, &sy)) continue;
-          const size_t j = pano->index(sx, sy);
-          const Link into = m == kFront ? Link::kFront : Link::kBack;
-          for (int l = 0; l < kNumLayers; ++l) {
-            if (pano->layer(l).present[j] && GetLink(pano->layer(l).links[j], from) == into) {
-              links = SetLink(links, Opposite(from), l == kFront ? Link::kFront : Link::kBack);
-              break;
-            }
-          }
-        }
-        completed[m][i] = links;
+        if (!present[m][i]) continue;
+        const unsigned code = m == kFront ? 1 : 2;
+        links[m][i] = static_cast<uint8_t>(links[m][i] |
+                                           FromWhich(front_right, back_right, code) << 4 |
+                                           FromWhich(front_down, back_down, code) << 6);
       }
     }
-  }, /*grain=*/16);
-  for (int l = 0; l < kNumLayers; ++l) pano->layer(l).links = std::move(completed[l]);
+  }
   return Status::Ok();
 }
 

@@ -222,10 +222,9 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads = 1,
 // link into an absent node gives nothing: TwoLayerPanorama::ValidateLinks
 // then refuses both. A present node with left or up bits set is refused
 // (kInvalidData, the node in `problem`) when the reserved-flag-bits check is
-// on, and those bits are dropped otherwise. Rows are shared among
-// `num_threads` threads; the result does not depend on it.
-Status CompleteLinks(TwoLayerPanorama* pano, int num_threads = 1,
-                     const ReaderChecks& checks = ReaderChecks(),
+// on, and those bits are dropped otherwise. One pass in place over the
+// nodes.
+Status CompleteLinks(TwoLayerPanorama* pano, const ReaderChecks& checks = ReaderChecks(),
                      DecodedNodeProblem* problem = nullptr);
 
 }  // namespace casual3d

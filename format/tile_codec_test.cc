@@ -171,13 +171,10 @@ TEST(TileCodecTest, RightAndDownLinksGiveBackEveryLink) {
     }
   }
   ASSERT_TRUE(FinishDecodedPanorama(&out).ok());
-  TwoLayerPanorama two_threads = out;
   ASSERT_TRUE(CompleteLinks(&out).ok());
-  ASSERT_TRUE(CompleteLinks(&two_threads, 2).ok());
   EXPECT_GT(cross, 0);
   for (int l = 0; l < kNumLayers; ++l) {
     EXPECT_EQ(out.layer(l).links, pano.layer(l).links) << l;
-    EXPECT_EQ(two_threads.layer(l).links, pano.layer(l).links) << l;
   }
   EXPECT_TRUE(out.ValidateLinks().ok());
 
@@ -195,7 +192,7 @@ TEST(TileCodecTest, RightAndDownLinksGiveBackEveryLink) {
   bad = stored;
   bad.layer(kFront).links[i] |= 0x40;
   DecodedNodeProblem problem;
-  const Status refused = CompleteLinks(&bad, 1, ReaderChecks(), &problem);
+  const Status refused = CompleteLinks(&bad, ReaderChecks(), &problem);
   EXPECT_EQ(refused.message(), "graph image: front node at pixel (20, 8) has left or up link bits "
                                "set (this version stores right and down links only)");
   EXPECT_EQ(problem.x, 20);
@@ -205,7 +202,7 @@ TEST(TileCodecTest, RightAndDownLinksGiveBackEveryLink) {
   bad.layer(kFront).links[i] |= 0x40;
   ReaderChecks off;
   off.Disable(ReaderCheck::kReservedFlagBits);
-  ASSERT_TRUE(CompleteLinks(&bad, 1, off).ok());
+  ASSERT_TRUE(CompleteLinks(&bad, off).ok());
   EXPECT_EQ(bad.layer(kFront).links, out.layer(kFront).links);
 
   // A right link into an absent node, or two into one node's left side:

@@ -61,7 +61,7 @@ int FuzzTileDecode(const uint8_t* data, size_t size) {
   // Version 2.x graph images (right and down links only), for odd depth bits.
   if (kind == TileImageKind::kGraph && (data[4] & 1) != 0) {
     DecodedNodeProblem problem;
-    if (!CompleteLinks(&pano, 1 + (data[5] & 1), checks, &problem).ok()) {
+    if (!CompleteLinks(&pano, checks, &problem).ok()) {
       if (problem.x < 0 || problem.x >= pano.width() || problem.y < 0 || problem.y >= pano.height())
         __builtin_trap();
       return 0;

@@ -377,8 +377,8 @@ def write_package(pano: Panorama, path, *, max_kb: Optional[int] = None, min_qua
     Written atomically; an existing folder is replaced only if it is empty or
     holds a package. Options (encoder/package_writer.h, defaults in brackets):
     tile_size [512], levels [0: automatic], omit_level_width [0: every
-    level; 2048 leaves out that level, package version 2.0, as `casual3d
-    encode` does], color_quality [90] (lossy WebP,
+    level; 2048 leaves out the level of 1025..2048 pixels wide, package
+    version 2.0, as `casual3d encode` does], color_quality [90] (lossy WebP,
     0..100), color_method [3], lossless_effort [25], lossless_method [1],
     depth_bits [12], normal_bits [8], lossy_normals [False],
     normal_mean_error_deg [2.5], normal_p99_error_deg [8.0], threads [0: all
