@@ -38,7 +38,8 @@ struct EncodeCommandOptions {
     v.Field("package.tile_size", o.package.tile_size, R::Closed(kMinTileSize, kMaxTileSize),
             "Tile side in pixels");
     v.Field("package.levels", o.package.levels, R::ZeroOr(R::Closed(1, kMaxLevels)),
-            "Levels of detail; 0 = automatic");
+            "Levels of detail computed (one fewer stored with --omit-level-width); 0 = "
+            "automatic");
     v.Field("package.omit_level_width", o.package.omit_level_width, R::AtLeast(0),
             "Leave out the level more than half this and at most this many pixels wide (the "
             "2048 one of a 4096 or 8192 panorama, 1536 of 6144) unless it is the finest or the "

@@ -20,8 +20,9 @@ namespace casual3d::encoder {
 struct PackageOptions {
   // Tile side, pixels, at every level: [kMinTileSize, kMaxTileSize] (16..4096).
   int tile_size = 512;
-  // Levels of detail, 1..kMaxLevels; 0 = automatic: halve while the coarsest
-  // level is wider than 512 pixels and its size is even.
+  // Levels of detail computed, 1..kMaxLevels; 0 = automatic: halve while the
+  // coarsest level is wider than 512 pixels and its size is even. One fewer
+  // is stored when omit_level_width leaves one out.
   int levels = 0;
   // Leave out the level more than half this and at most this many pixels
   // wide (2048: the 2048 level of 4096 and 8192 panoramas, the 1536 one of
@@ -47,7 +48,8 @@ struct PackageOptions {
   // whose decoded normals are within normal_mean_error_deg on average and
   // normal_p99_error_deg at the 99th percentile of the panorama's, over the
   // tile's lit present nodes (lossy_normal_tile.h); bounds in degrees,
-  // [1, 90]. The manifest declares the bounds and says version 1.2.
+  // [1, 90]. The manifest declares the bounds and says version 1.2 (2.0
+  // when a level is left out).
   bool lossy_normals = false;
   double normal_mean_error_deg = 2.5;
   double normal_p99_error_deg = 9.0;

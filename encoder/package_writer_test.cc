@@ -223,7 +223,7 @@ TEST_F(PackageWriterTest, OmittedLevelLeavesTheOthersAsTheyWere) {
     ASSERT_TRUE(all_decoded.ok()) << all_decoded.status().ToString();
     EXPECT_TRUE(*decoded == *all_decoded) << "level " << level;
   }
-  // Any width in (128, 256] names the 256 level.
+  // Any width in [256, 511] names the 256 level (it lies in (W/2, W]).
   options_.omit_level_width = 300;
   PackageStats wider;
   Encode(&wider);

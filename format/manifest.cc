@@ -122,9 +122,10 @@ bool KnownMajor(int major) {
 
 constexpr const char* kReadsVersions = " (this reader reads 1.x and 2.x)";
 
-// Level `l` of `m` is (width >> s) x (height >> s), exactly: s = l in 1.x; in
-// 2.x s = 0 at level 0 and any shift above the level before's (`*shift`,
-// which is updated) further on (spec/package.md Sec. 2).
+// Level `l` of `m` is (width >> s) x (height >> s), exactly: s = l in 1.x (and
+// in a major this reader does not know, read with the unknown-major check
+// off, as 1.x); in 2.x s = 0 at level 0 and any shift above the level
+// before's (`*shift`, which is updated) further on (spec/package.md Sec. 2).
 Status CheckLevelSize(const Manifest& m, int l, const std::string& where, int* shift) {
   const LevelEntry& L = m.levels[l];
   auto exact = [&](int s) {
@@ -134,7 +135,7 @@ Status CheckLevelSize(const Manifest& m, int l, const std::string& where, int* s
   const std::string size = ": size " + std::to_string(L.width) + "x" + std::to_string(L.height) +
                            " is not the full size " + std::to_string(m.width) + "x" +
                            std::to_string(m.height) + " divided by 2^";
-  if (m.version_major < 2 || l == 0) {
+  if (m.version_major != 2 || l == 0) {
     if (!exact(l)) return InvalidData(where + size + std::to_string(l));
     *shift = l;
     return Status::Ok();

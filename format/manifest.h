@@ -9,7 +9,8 @@
 // (kUnsupportedVersion) and ignore members they do not know, so a minor
 // version may add optional members. This reader reads majors 1 and 2; 2.0 is
 // 1.2 with levels that may leave out halvings between level 0 and the
-// coarsest (spec/package.md Sec. 2).
+// coarsest (spec/package.md Sec. 2) and graph images of right and down links
+// only (Sec. 4.1).
 
 #include <cstdint>
 #include <map>

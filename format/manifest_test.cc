@@ -105,7 +105,9 @@ TEST(ManifestTest, LevelsMayLeaveOutHalvingsFromVersion2) {
             "level before's 0");
   // Not finer than the level before, nor equal to it.
   m.levels[1] = m.levels[0];
-  EXPECT_EQ(m.Validate().code(), StatusCode::kInvalidData);
+  EXPECT_EQ(m.Validate().message(),
+            "levels[1]: size 64x32 is not the full size 64x32 divided by 2^s for an s above the "
+            "level before's 0");
   m = SmallManifest();
   m.version_major = 2;
   m.levels.push_back(m.levels[1]);

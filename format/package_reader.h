@@ -30,7 +30,7 @@
 
 namespace casual3d {
 
-// Decodes a compressed image (WebP in packages 1.x) to 8-bit pixels with 3
+// Decodes a compressed image (WebP in packages 1.x and 2.x) to 8-bit pixels with 3
 // (RGB) or 4 (RGBA) channels. Must be safe to call from several threads.
 class ImageDecoder {
  public:

@@ -24,7 +24,7 @@ enum class ReaderCheck : int {
   kChecksumMismatch,          // a file's SHA-256 differs from its "sha256"
   kLossyDataTile,             // a depth, normal or graph image that is not lossless WebP
   kWrongTileSize,             // a tile image of another size than Sec. 4 gives
-  kReservedFlagBits,          // graph flag bits 4..7 set
+  kReservedFlagBits,          // graph flag bits 4..7 set; 2.x: left or up link bits
   kDepthCodeAboveMax,         // a present node's depth code above 2^bits - 1
   kNormalCodeInvalid,         // a present node's octahedral code with one 0 or above the maximum
   kPresentNodeWithoutDepth,   // a present node with depth code 0

@@ -56,9 +56,12 @@ int FuzzTileDecode(const uint8_t* data, size_t size) {
   const TileDecoder& decoder = CachedDecoder(q, check_off);
   const ReaderChecks& checks = decoder.checks();
   const Image8& const_image = image;
-  Status s = DecodeTileImage(const_image.view(), kind, 8, 4, w, h, decoder, &pano);
+  // At the panorama's left column and top row too (the seam and row 0 of
+  // CompleteLinks), from bits 6 and 7 of byte 5.
+  const int x0 = (data[5] & 0x40) ? 0 : 8, y0 = (data[5] & 0x80) ? 0 : 4;
+  Status s = DecodeTileImage(const_image.view(), kind, x0, y0, w, h, decoder, &pano);
   if (!s.ok() || !FinishDecodedPanorama(&pano, 1, checks).ok()) return 0;
-  // Version 2.x graph images (right and down links only), for odd depth bits.
+  // Version 2.x graph images (right and down links only) when byte 4 is odd.
   if (kind == TileImageKind::kGraph && (data[4] & 1) != 0) {
     DecodedNodeProblem problem;
     if (!CompleteLinks(&pano, checks, &problem).ok()) {

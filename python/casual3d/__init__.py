@@ -256,7 +256,7 @@ class Package:
         num_levels: levels of detail; level 0 is the full resolution, each
             next level smaller by a power of two: (W >> k) x (H >> k) in 1.x
             packages, possibly smaller from 2.0, which may leave out
-            halvings (`levels()` gives the sizes).
+            halvings (`manifest["levels"]` gives the sizes).
     """
 
     def __init__(self, path):

@@ -35,9 +35,10 @@ using Clock = std::chrono::steady_clock;
 // the photos that agree, depth smoothed along surfaces
 // (spec/stage-panorama.md, version 7). encode-3: coarser levels take the mean
 // normal of their block, the manifest is compact. encode-4: 9-bit depth.
+// encode-5: package 2.0 (no 2048-wide level, links stored once).
 // sparse-5: COLMAP's steps on one thread (the same photos, the same model).
 constexpr const char* kStageVersions[kNumStages] = {"sparse-5", "dense-5", "panorama-8",
-                                                    "encode-4"};
+                                                    "encode-5"};
 
 std::string HashHex(const std::string& text) {
   return Sha256Hex(reinterpret_cast<const uint8_t*>(text.data()), text.size());

@@ -308,7 +308,7 @@ export class PackageReader {
     return this.format.m._c3d_reader_depth_far_m(this.ptr);
   }
 
-  /** MIME type of the tile images ('image/webp' in packages 1.x). */
+  /** MIME type of the tile images ('image/webp' in packages 1.x and 2.x). */
   get tileImageType() {
     return this.format.m.UTF8ToString(this.format.m._c3d_reader_tile_image_type(this.ptr));
   }

@@ -85,7 +85,7 @@ export class Casual3dPackage {
   readonly numLevels: number;
   /** The largest depth the package encodes, metres. */
   readonly depthFarM: number;
-  /** MIME type of the tile images ('image/webp' in packages 1.x). */
+  /** MIME type of the tile images ('image/webp' in packages 1.x and 2.x). */
   readonly tileImageType: string;
   levelInfo(level: number): LevelInfo;
   /** Reads, checks (size, SHA-256), decodes and validates a level. */

@@ -58,7 +58,7 @@ export class Casual3dPackage {
     return this.reader.depthFarM;
   }
 
-  /** MIME type of the tile images ('image/webp' in packages 1.x). */
+  /** MIME type of the tile images ('image/webp' in packages 1.x and 2.x). */
   get tileImageType() {
     return this.reader.tileImageType;
   }

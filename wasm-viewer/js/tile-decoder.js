@@ -1,5 +1,5 @@
 // Decodes a package's tile images with the browser's own image decoder (for the
-// MIME type the reader names: WebP in packages 1.x) into exact RGBA pixels, off
+// MIME type the reader names: WebP in packages 1.x and 2.x) into exact RGBA pixels, off
 // the main thread (works in workers).
 // createImageBitmap with colour-space conversion and premultiplication off, and
 // an OffscreenCanvas 2D readback: the package's images are opaque RGB (alpha is

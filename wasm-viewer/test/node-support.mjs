@@ -84,6 +84,7 @@ export function copyPackageWithView(from, to, view) {
   const manifest = JSON.parse(fs.readFileSync(file, 'utf8'));
   if (view === undefined) delete manifest.view;
   else manifest.view = view;
-  if (view !== undefined) manifest.version = '1.1';
+  // A view needs 1.1; a 2.x package keeps its version.
+  if (view !== undefined && manifest.version.startsWith('1.')) manifest.version = '1.1';
   fs.writeFileSync(file, JSON.stringify(manifest));
 }
