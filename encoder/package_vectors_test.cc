@@ -248,9 +248,11 @@ struct InvalidVector {
 };
 
 // Invalid vectors (spec/package.md Sec. 9), each breaking exactly one rule of
-// a valid vector: `base` (two-layer-64x32) or `deep` (front-only-48x24, 16-bit
-// depth codes, for the lossy tile whose changed codes stay valid).
-std::vector<InvalidVector> MakeInvalidVectors(const PackageFiles& base, const PackageFiles& deep) {
+// a valid vector: `base` (two-layer-64x32), `deep` (front-only-48x24, 16-bit
+// depth codes, for the lossy tile whose changed codes stay valid) or `v2`
+// (level-left-out-64x32, for the rules of version 2.x).
+std::vector<InvalidVector> MakeInvalidVectors(const PackageFiles& base, const PackageFiles& deep,
+                                              const PackageFiles& v2) {
   const std::string graph = "l0/0-1.graph.webp", depth = "l0/0-1.depth.webp";
   const std::string normal = "l0/0-1.normal.webp", color = "l0/0-1.color.webp";
   auto container = [](const PackageFiles& files) { return *BuildSingleFile(files); };
@@ -319,6 +321,11 @@ std::vector<InvalidVector> MakeInvalidVectors(const PackageFiles& base, const Pa
        }));
   both("reserved-flag-bits",
        EditTileImage(base, graph, [&](Image8* g) { g->at(lx, ly, 2) |= 0x80; }));
+  // A left link stored at a front node that its left neighbour's front node
+  // links into: with the check off the bits are dropped and the link is
+  // completed from that neighbour as it would be.
+  both("left-up-link-bits",
+       EditTileImage(v2, graph, [&](Image8* g) { g->at(lx, ly, 0) |= 0x10; }));
   both("depth-code-above-max", EditTileImage(base, depth, [&](Image8* d) {
          d->at(lx, ly, 0) = 0x10;  // Code 4096 > 4095 (12 bits).
          d->at(lx, ly, 1) = 0x00;
@@ -479,7 +486,8 @@ void Regenerate() {
 
   fs::remove_all(dir / "invalid");
   for (const InvalidVector& v :
-       MakeInvalidVectors(encoded["two-layer-64x32"], encoded["front-only-48x24"])) {
+       MakeInvalidVectors(encoded["two-layer-64x32"], encoded["front-only-48x24"],
+                          encoded["level-left-out-64x32"])) {
     if (!v.files.empty()) {
       // path-escape keeps the graph file under its own name, which its
       // manifest's "l0/../l0/..." path also reaches.

@@ -24,7 +24,7 @@ enum class ReaderCheck : int {
   kChecksumMismatch,          // a file's SHA-256 differs from its "sha256"
   kLossyDataTile,             // a depth, normal or graph image that is not lossless WebP
   kWrongTileSize,             // a tile image of another size than Sec. 4 gives
-  kReservedFlagBits,          // graph flag bits 4..7 set; 2.x: left or up link bits
+  kReservedFlagBits,          // graph flag bits 4..7 set
   kDepthCodeAboveMax,         // a present node's depth code above 2^bits - 1
   kNormalCodeInvalid,         // a present node's octahedral code with one 0 or above the maximum
   kPresentNodeWithoutDepth,   // a present node with depth code 0
@@ -33,8 +33,9 @@ enum class ReaderCheck : int {
   kManifestNotFirst,          // .c3d first entry other than manifest.json
   kDuplicateEntry,            // .c3d entries sharing a path
   kEntryOutsideFile,          // .c3d entry whose data range leaves the file
+  kLeftUpLinkBits,            // 2.x: a present node's graph byte with left or up link bits
 };
-constexpr int kNumReaderChecks = 17;
+constexpr int kNumReaderChecks = 18;
 
 // The check's name: the name of its invalid vector ("checksum-mismatch").
 constexpr std::string_view ReaderCheckName(ReaderCheck check) {
@@ -44,7 +45,7 @@ constexpr std::string_view ReaderCheckName(ReaderCheck check) {
       "lossy-data-tile",     "wrong-tile-size",           "reserved-flag-bits",
       "depth-code-above-max", "normal-code-invalid",      "present-node-without-depth",
       "link-not-mutual",     "container-unknown-major",   "manifest-not-first",
-      "duplicate-entry",     "entry-outside-file"};
+      "duplicate-entry",     "entry-outside-file",        "left-up-link-bits"};
   const int i = static_cast<int>(check);
   return i >= 0 && i < kNumReaderChecks ? kNames[i] : std::string_view("unknown");
 }

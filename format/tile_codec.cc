@@ -635,7 +635,7 @@ Status CompleteLinks(TwoLayerPanorama* pano, const ReaderChecks& checks,
     if ((any & ~kRightDownLinkBits & 0xFF) == 0) continue;
     for (size_t i = 0; i < n; ++i) {
       if ((links[l][i] & ~kRightDownLinkBits & 0xFF) == 0) continue;
-      if (checks.on(ReaderCheck::kReservedFlagBits)) {
+      if (checks.on(ReaderCheck::kLeftUpLinkBits)) {
         const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
         if (problem != nullptr) {
           problem->x = x;

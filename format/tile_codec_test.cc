@@ -201,7 +201,7 @@ TEST(TileCodecTest, RightAndDownLinksGiveBackEveryLink) {
   bad = stored;
   bad.layer(kFront).links[i] |= 0x40;
   ReaderChecks off;
-  off.Disable(ReaderCheck::kReservedFlagBits);
+  off.Disable(ReaderCheck::kLeftUpLinkBits);
   ASSERT_TRUE(CompleteLinks(&bad, off).ok());
   EXPECT_EQ(bad.layer(kFront).links, out.layer(kFront).links);
 
