@@ -54,6 +54,33 @@ Status WriteBytes(const fs::path& path, const std::vector<uint8_t>& bytes) {
   return Status::Ok();
 }
 
+// ReencodeColor copies tiles by path, so the earlier encoding must have the
+// levels, tile grid, version and quantization this one has (different
+// omit_level_width, levels or depth_bits would put tiles of another size or
+// meaning under the same names).
+Status CheckSameLayout(const PackageFiles& earlier, const Manifest& now) {
+  if (earlier.empty() || earlier.front().first != kManifestFileName)
+    return InvalidArgument("the earlier encoding has no manifest.json first");
+  const std::vector<uint8_t>& bytes = earlier.front().second;
+  StatusOr<Manifest> before =
+      ParseManifest(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  if (!before.ok())
+    return InvalidArgument("the earlier encoding's manifest: " + before.status().message());
+  bool same = before->version_major == now.version_major && before->width == now.width &&
+              before->height == now.height && before->tile_size == now.tile_size &&
+              before->levels.size() == now.levels.size() &&
+              before->depth.bits == now.depth.bits && before->normal.type == now.normal.type &&
+              before->normal.bits == now.normal.bits;
+  for (size_t l = 0; same && l < now.levels.size(); ++l)
+    same = before->levels[l].width == now.levels[l].width &&
+           before->levels[l].height == now.levels[l].height;
+  if (!same)
+    return InvalidArgument("the earlier encoding has other levels, tiles, version or "
+                           "quantization than these options give; only the colour quality may "
+                           "differ");
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status PackageOptions::Check() const {
@@ -206,8 +233,10 @@ StatusOr<PackageFiles> Encode(const TwoLayerPanorama& pano, const PackageOptions
 
   // The earlier encoding's tiles by path.
   std::map<std::string, const std::vector<uint8_t>*> earlier_tiles;
-  if (earlier != nullptr)
+  if (earlier != nullptr) {
+    CASUAL3D_RETURN_IF_ERROR(CheckSameLayout(*earlier, manifest));
     for (const auto& [path, bytes] : *earlier) earlier_tiles[path] = &bytes;
+  }
 
   // Tiles are encoded in parallel; after a failure no further tile starts,
   // and the first failing tile in job order is reported.

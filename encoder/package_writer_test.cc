@@ -223,6 +223,15 @@ TEST_F(PackageWriterTest, OmittedLevelLeavesTheOthersAsTheyWere) {
     ASSERT_TRUE(all_decoded.ok()) << all_decoded.status().ToString();
     EXPECT_TRUE(*decoded == *all_decoded) << "level " << level;
   }
+  // Colour alone encoded again needs an earlier encoding of the same levels.
+  const StatusOr<PackageFiles> mixed = ReencodeColor(pano_, options_, all);
+  EXPECT_EQ(mixed.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(mixed.status().message().find("other levels"), std::string::npos);
+  PackageOptions lower = options_;
+  lower.color_quality = 70;
+  PackageStats reencoded;
+  ASSERT_TRUE(ReencodeColor(pano_, lower, files, &reencoded).ok());
+  EXPECT_LT(reencoded.total_bytes, stats.total_bytes);
   // Any width in [256, 511] names the 256 level (it lies in (W/2, W]).
   options_.omit_level_width = 300;
   PackageStats wider;
