@@ -321,9 +321,8 @@ std::vector<InvalidVector> MakeInvalidVectors(const PackageFiles& base, const Pa
        }));
   both("reserved-flag-bits",
        EditTileImage(base, graph, [&](Image8* g) { g->at(lx, ly, 2) |= 0x80; }));
-  // A left link stored at a front node that its left neighbour's front node
-  // links into: with the check off the bits are dropped and the link is
-  // completed from that neighbour as it would be.
+  // A left link stored at a present front node: with the check off the bits
+  // are dropped and the links completed as in the valid vector.
   both("left-up-link-bits",
        EditTileImage(v2, graph, [&](Image8* g) { g->at(lx, ly, 0) |= 0x10; }));
   both("depth-code-above-max", EditTileImage(base, depth, [&](Image8* d) {

@@ -443,7 +443,6 @@ TEST_F(PackageWriterTest, RefusesBadOptionsAndUnrelatedFolders) {
   EXPECT_EQ(EncodePackage(pano_, options_).status().message(),
             "omit_level_width -1 is negative (0 writes every level)");
   options_.omit_level_width = 0;
-  options_.tile_size = 128;
   options_.levels = 8;  // 520 is not divisible by 128.
   Status s = EncodePackage(casual3d::testing::MakePackageTestPanorama(520, 260), options_).status();
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);

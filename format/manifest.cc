@@ -115,11 +115,6 @@ bool IsHex64(const std::string& s) {
   return true;
 }
 
-
-bool KnownMajor(int major) {
-  return major >= kOldestPackageVersionMajor && major <= kPackageVersionMajor;
-}
-
 constexpr const char* kReadsVersions = " (this reader reads 1.x and 2.x)";
 
 // Level `l` of `m` is (width >> s) x (height >> s), exactly: s = l in 1.x (and
@@ -194,7 +189,7 @@ uint64_t Manifest::LevelBytes(int level) const {
 }
 
 Status Manifest::Validate(const ReaderChecks& checks) const {
-  if (!KnownMajor(version_major) && checks.on(ReaderCheck::kUnknownMajor))
+  if (!IsKnownPackageMajor(version_major) && checks.on(ReaderCheck::kUnknownMajor))
     return UnsupportedVersion("version " + std::to_string(version_major) + "." +
                               std::to_string(version_minor) + " is not supported" +
                               kReadsVersions);
@@ -321,7 +316,7 @@ StatusOr<Manifest> ParseManifest(std::string_view bytes, const ReaderChecks& che
     };
     m.version_major = number(0, dot);
     m.version_minor = number(dot + 1, version.size());
-    if (!KnownMajor(m.version_major) && checks.on(ReaderCheck::kUnknownMajor))
+    if (!IsKnownPackageMajor(m.version_major) && checks.on(ReaderCheck::kUnknownMajor))
       return fail(UnsupportedVersion("version " + version + " is not supported" +
                                      kReadsVersions));
   }

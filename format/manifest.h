@@ -34,6 +34,9 @@ constexpr const char* kPackageFormatName = "casual3d";
 // of those).
 constexpr int kOldestPackageVersionMajor = 1;
 constexpr int kPackageVersionMajor = 2;
+constexpr bool IsKnownPackageMajor(int major) {
+  return major >= kOldestPackageVersionMajor && major <= kPackageVersionMajor;
+}
 constexpr const char* kManifestFileName = "manifest.json";
 
 // Limits of spec/package.md, "Limits".

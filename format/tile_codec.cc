@@ -611,11 +611,11 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads, const Read
 
 namespace {
 
-// Which node of a pixel links into layer `m` along one direction, given the
-// two nodes' 2-bit link codes in that direction: the front one, else the
-// back one, else none (a Link code).
-inline uint8_t FromWhich(unsigned front_code, unsigned back_code, unsigned m_code) {
-  return front_code == m_code ? 1 : back_code == m_code ? 2 : 0;
+// Which node of a pixel links into a node of layer `into` along one
+// direction, given the two nodes' links in that direction: the front one,
+// else the back one, else none.
+inline Link FromWhich(Link front, Link back, Link into) {
+  return front == into ? Link::kFront : back == into ? Link::kBack : Link::kNone;
 }
 
 }  // namespace
@@ -626,52 +626,42 @@ Status CompleteLinks(TwoLayerPanorama* pano, const ReaderChecks& checks,
   uint8_t* links[kNumLayers] = {pano->layer(kFront).links.data(), pano->layer(kBack).links.data()};
   const uint8_t* present[kNumLayers] = {pano->layer(kFront).present.data(),
                                         pano->layer(kBack).present.data()};
-  const size_t n = pano->layer(kFront).links.size();
-  // Left and up bits: absent nodes hold no links (FinishDecodedPanorama), so
-  // any bit set belongs to a present node: refused, or dropped with the check off.
-  for (int l = 0; l < kNumLayers; ++l) {
-    unsigned any = 0;
-    for (size_t i = 0; i < n; ++i) any |= links[l][i];
-    if ((any & ~kRightDownLinkBits & 0xFF) == 0) continue;
-    for (size_t i = 0; i < n; ++i) {
-      if ((links[l][i] & ~kRightDownLinkBits & 0xFF) == 0) continue;
-      if (checks.on(ReaderCheck::kLeftUpLinkBits)) {
-        const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
-        if (problem != nullptr) {
-          problem->x = x;
-          problem->y = y;
-          problem->layer = l;
-          problem->kind = TileImageKind::kGraph;
-        }
-        return InvalidData(std::string("graph image: ") + (l == kFront ? "front" : "back") +
-                           " node at pixel " + PixelName(x, y) +
-                           " has left or up link bits set (this version stores right and down "
-                           "links only)");
-      }
-      links[l][i] &= kRightDownLinkBits;
-    }
-  }
+  const bool refuse = checks.on(ReaderCheck::kLeftUpLinkBits);
   // Node (x, y) of layer m: its left link from the right links of pixel
   // x - 1 (wrapping), its up link from the down links of row y - 1. Only
-  // bits 0..3 are read and only bits 4..7 written, so one pass in place
-  // reads what it needs whatever it has written.
+  // right and down links are read and only left and up ones written, so one
+  // pass in place reads what it needs whatever it has written; a node's own
+  // left and up bits are looked at before they are written.
   for (int y = 0; y < height; ++y) {
     const size_t row = static_cast<size_t>(y) * width;
     for (int x = 0; x < width; ++x) {
       const size_t i = row + x;
       const size_t left = row + (x == 0 ? width - 1 : x - 1);
-      const unsigned front_right = links[kFront][left] & 3, back_right = links[kBack][left] & 3;
-      unsigned front_down = 0, back_down = 0;
-      if (y > 0) {
-        front_down = (links[kFront][i - width] >> 2) & 3;
-        back_down = (links[kBack][i - width] >> 2) & 3;
-      }
+      const Link front_right = GetLink(links[kFront][left], kRight);
+      const Link back_right = GetLink(links[kBack][left], kRight);
+      const Link front_down = y > 0 ? GetLink(links[kFront][i - width], kDown) : Link::kNone;
+      const Link back_down = y > 0 ? GetLink(links[kBack][i - width], kDown) : Link::kNone;
       for (int m = 0; m < kNumLayers; ++m) {
-        if (!present[m][i]) continue;
-        const unsigned code = m == kFront ? 1 : 2;
-        links[m][i] = static_cast<uint8_t>(links[m][i] |
-                                           FromWhich(front_right, back_right, code) << 4 |
-                                           FromWhich(front_down, back_down, code) << 6);
+        if (!present[m][i]) continue;  // Absent nodes hold no links (FinishDecodedPanorama).
+        uint8_t stored = links[m][i];
+        if ((stored & ~kRightDownLinkBits & 0xFF) != 0) {
+          if (refuse) {
+            if (problem != nullptr) {
+              problem->x = x;
+              problem->y = y;
+              problem->layer = m;
+              problem->kind = TileImageKind::kGraph;
+            }
+            return InvalidData(std::string("graph image: ") + (m == kFront ? "front" : "back") +
+                               " node at pixel " + PixelName(x, y) +
+                               " has left or up link bits set (this version stores right and "
+                               "down links only)");
+          }
+          stored &= kRightDownLinkBits;
+        }
+        const Link into = m == kFront ? Link::kFront : Link::kBack;
+        stored = SetLink(stored, kLeft, FromWhich(front_right, back_right, into));
+        links[m][i] = SetLink(stored, kUp, FromWhich(front_down, back_down, into));
       }
     }
   }

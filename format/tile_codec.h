@@ -221,9 +221,9 @@ Status FinishDecodedPanorama(TwoLayerPanorama* pano, int num_threads = 1,
 // the front one's link, and the back one's stays without its reverse; a
 // link into an absent node gives nothing: TwoLayerPanorama::ValidateLinks
 // then refuses both. A present node with left or up bits set is refused
-// (kInvalidData, the node in `problem`) when the left-up-link-bits check is
-// on, and those bits are dropped otherwise. One pass in place over the
-// nodes.
+// (kInvalidData, the first in node order in `problem`; the panorama is then
+// left half completed) when the left-up-link-bits check is on, and those
+// bits are dropped otherwise. One pass in place over the nodes.
 Status CompleteLinks(TwoLayerPanorama* pano, const ReaderChecks& checks = ReaderChecks(),
                      DecodedNodeProblem* problem = nullptr);
 

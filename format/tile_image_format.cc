@@ -25,7 +25,7 @@ constexpr const TileImageFormat* kFormats[] = {&kWebp};
 const TileImageFormat& WebpTileImageFormat() { return kWebp; }
 
 StatusOr<const TileImageFormat*> TileImageFormatForVersion(int major) {
-  if (major == 1 || major == 2) return &kWebp;
+  if (IsKnownPackageMajor(major)) return &kWebp;
   return UnsupportedVersion("packages of major version " + std::to_string(major) +
                             " have no known tile image format (1.x and 2.x: WebP)");
 }
