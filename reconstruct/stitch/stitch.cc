@@ -1,6 +1,7 @@
 #include "reconstruct/stitch/stitch.h"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -220,11 +221,50 @@ int UpsampleLabel(const FullWarps& warps, const StitchedLayer& out, const Image8
   return best;
 }
 
+// Fragments more stretched than this (triangles across a photo's depth edge,
+// warp.h) neither propose nor support a front surface.
+constexpr float kMaxSupportStretch = 0.5f;
+
+// The front layer's label at (x, y): `best`, unless a surface nearer than
+// best's by more than blend_depth_tolerance has the support of at least
+// front_support unstretched warps (itself included); then the warp of the
+// nearest such surface. A thin structure that some photos' depth maps miss by
+// a pixel or two (a leaflet, a pole) then stays in front where the label's
+// photo shows what lies behind it. `scratch` holds (depth, label) pairs.
+int NearestSupported(const FullWarps& warps, int best, int x, int y, const StitchOptions& options,
+                     std::vector<std::pair<float, int>>* scratch) {
+  std::vector<std::pair<float, int>>& found = *scratch;
+  found.clear();
+  for (int l = 0; l < static_cast<int>(warps.full.size()); ++l) {
+    int lx, ly;
+    if (!warps.Usable(l, x, y, 0.0f, &lx, &ly)) continue;
+    const warp::WarpedLayer& w = warps.layer(l);
+    if (w.stretch.at(lx, ly) > kMaxSupportStretch) continue;
+    found.emplace_back(w.depth_m.at(lx, ly), l);
+  }
+  int lx, ly;
+  warps.layer(best).ToCrop(x, y, warps.width, &lx, &ly);
+  const double tol = options.blend_depth_tolerance;
+  const float limit = static_cast<float>(warps.layer(best).depth_m.at(lx, ly) * (1.0 - tol));
+  // Nearest first: the first surface with enough support wins.
+  std::sort(found.begin(), found.end());
+  for (const auto& [d, l] : found) {
+    if (!(d < limit)) break;
+    int support = 0;
+    for (const auto& other : found) support += std::abs(other.first - d) <= tol * d;
+    if (support >= options.front_support) return l;
+  }
+  return best;
+}
+
 // Writes pixel (x, y) of `out` from label `best`: its depth and colour, or
 // with blend_depth_tolerance > 0 the mean colour and the geometric mean depth
 // of the warps that agree with it, stretched fragments weighing less.
 void WritePixel(const FullWarps& warps, int best, int x, int y, float front_depth,
-                const StitchOptions& options, StitchedLayer* out) {
+                const StitchOptions& options, std::vector<std::pair<float, int>>* scratch,
+                StitchedLayer* out) {
+  if (!warps.back && options.front_support > 0 && options.blend_depth_tolerance > 0)
+    best = NearestSupported(warps, best, x, y, options, scratch);
   const warp::WarpedLayer& layer = warps.layer(best);
   int lx, ly;
   layer.ToCrop(x, y, warps.width, &lx, &ly);
@@ -306,10 +346,11 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
     const int y = static_cast<int>(y64);
     std::vector<int> candidates;
     std::vector<double> scores;
+    std::vector<std::pair<float, int>> scratch;
     for (int x = 0; x < W; ++x) {
       const float front_depth = front ? front->depth_m.at(x, y) : 0.0f;
       const int best = UpsampleLabel(warps, out, solve_rgb, x, y, front_depth, options, &candidates, &scores);
-      if (best >= 0) WritePixel(warps, best, x, y, front_depth, options, &out);
+      if (best >= 0) WritePixel(warps, best, x, y, front_depth, options, &scratch, &out);
     }
   });
   return out;

@@ -65,6 +65,12 @@ struct StitchOptions {
   // out, and so does the depth maps' independent noise. The label stays the
   // chosen photo. 0 keeps the chosen label's colour and depth alone.
   double blend_depth_tolerance = 0.03;
+  // Front layer: a pixel whose label's surface lies behind a nearer one that
+  // at least this many unstretched warps agree on (within
+  // blend_depth_tolerance) takes the nearest such surface: the labelling,
+  // solved at a fraction of the resolution, loses thin structures that only
+  // some photos' depth maps hold at a pixel. 0 keeps the label's.
+  int front_support = 2;
 
   AlphaExpansionOptions solver;
 
@@ -88,6 +94,8 @@ struct StitchOptions {
     v.Field("upsample_sigma_color", o.upsample_sigma_color, R::Above(0), "Label upsampling colour sigma, 8-bit units");
     v.Field("blend_depth_tolerance", o.blend_depth_tolerance, R::ClosedOpen(0, 1),
             "Colour and depth are the means of the warps within this relative depth of the label's; 0: the label's alone");
+    v.Field("front_support", o.front_support, R::AtLeast(0),
+            "Front pixels take the nearest surface this many unstretched warps agree on; 0: the label's");
     v.Struct("solver", o.solver);
     v.Require(o.solve_width == 2 * o.solve_height, "solve_width", "must be 2 * solve_height");
   }
