@@ -182,14 +182,16 @@ TEST(StitchTest, FrontKeepsANearSurfaceTwoPhotosAgreeOn) {
   no_square.half_size = 0;
   for (int i = 2; i < 4; ++i)
     wt::RenderSquareScene(no_square, cap.views[i].camera, cap.views[i].pose, &cap.depth[i], &cap.rgb[i]);
-  StitchOptions options = SmallSolve();
   const int W = 1024;
   const auto full = Warp(cap, W);
-  const auto coarse = Warp(cap, options.solve_width);
-  options.front_support = 2;
-  const StitchedLayer kept = StitchFront(full, coarse, cap.geometry, W, options);
-  options.front_support = 0;
-  const StitchedLayer labelled = StitchFront(full, coarse, cap.geometry, W, options);
+  const auto coarse = Warp(cap, SmallSolve().solve_width);
+  auto front_with_support = [&](int support) {
+    StitchOptions options = SmallSolve();
+    options.front_support = support;
+    return StitchFront(full, coarse, cap.geometry, W, options);
+  };
+  const StitchedLayer kept = front_with_support(2);
+  const StitchedLayer labelled = front_with_support(0);
 
   // Where the square's interior is seen by both photos 0 and 1 (unstretched),
   // the front holds it; the labelling alone shows the plane at some of them.
