@@ -7,12 +7,17 @@
 // reaches) are scored by `casual3d evaluate --rendered`; the gap between
 // that figure and the 3D photo's own is what the panorama stage loses
 // (docs/DECISIONS.md, "Stitch: the nearest surface two photos agree on").
+// With --surface MASTER.exr the 3D photo's own mesh is drawn instead and
+// each of its pixels coloured from the same photos where their depth maps
+// see that point (within 3%): the gap to the 3D photo's own figure is its
+// colour's, the gap to the depth maps' figure its surface's. Sky (depth
+// not finite) is left undrawn: compare captures without sky, such as fern.
 //
 //   casual3d evaluate CAPTURE OUT --width 1008 --write-cameras eval.json
 //   casual3d evaluate CAPTURE OUT --width W --photos <OUT/work/train/images/*> \
 //       --write-cameras sources.json        # W: the depth maps' width
 //   depth_map_views eval.json sources.json OUT/work/dense/depth \
-//       OUT/work/train/images DIR [--k 8] [--cut 1.05]
+//       OUT/work/train/images DIR [--k 8] [--cut 1.05] [--surface OUT/master.exr]
 //   casual3d evaluate CAPTURE OUT --width 1008 --rendered DIR
 
 #include <algorithm>
@@ -30,8 +35,12 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "encoder/master_file.h"
+#include "format/color_atlas.h"
 #include "format/image.h"
 #include "format/mesh.h"
+#include "format/mesh_builder.h"
+#include "reconstruct/depth/workspace.h"
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/image_io.h"
 #include "reconstruct/render/mesh_renderer.h"
@@ -56,9 +65,9 @@ struct NamedView {
 std::map<std::string, NamedView> ReadCameras(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot read the cameras (write them with `casual3d evaluate --write-cameras`)");
-  nlohmann::json j;
-  in >> j;
   std::map<std::string, NamedView> out;
+  try {
+  const nlohmann::json j = nlohmann::json::parse(in);
   for (const auto& c : j.at("cameras")) {
     const auto& m = c.at("view_matrix");
     Eigen::Matrix3d r;
@@ -78,10 +87,21 @@ std::map<std::string, NamedView> ReadCameras(const std::string& path) {
     v.view.cx = c.at("cx");
     v.view.cy = c.at("cy");
     v.centre = -v.view.rotation.transpose() * v.view.translation;
-    out[c.at("name").get<std::string>()] = v;
+    const std::string name = c.at("name").get<std::string>();
+    if (const casual3d::Status st = v.view.Check(); !st.ok()) throw std::runtime_error(name + ": " + st.message());
+    out[name] = v;
+  }
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": not a cameras file of `casual3d evaluate --write-cameras`: " + e.what());
   }
   if (out.empty()) throw std::runtime_error(path + ": no cameras");
   return out;
+}
+
+// Pixel (x, y) of `view` at camera-frame depth z, in the panorama frame.
+Eigen::Vector3d Unproject(const PinholeView& view, double x, double y, double z) {
+  const Eigen::Vector3d cam((x - view.cx) / view.fx * z, (y - view.cy) / view.fy * z, z);
+  return view.rotation.transpose() * (cam - view.translation);
 }
 
 // A photo's depth map as a mesh in the panorama frame, coloured by the photo.
@@ -90,13 +110,10 @@ Mesh DepthMapMesh(const NamedView& source, const ImageF& depth, const Image8& rg
   Mesh m;
   m.positions.reserve(3 * size_t(w) * h);
   m.colors.reserve(3 * size_t(w) * h);
-  const Eigen::Matrix3d rt = source.view.rotation.transpose();
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const double z = depth.at(x, y) > 0 ? depth.at(x, y) : 1e-6;
-      const Eigen::Vector3d cam((x + 0.5 - source.view.cx) / source.view.fx * z,
-                                (y + 0.5 - source.view.cy) / source.view.fy * z, z);
-      const Eigen::Vector3d p = rt * (cam - source.view.translation);
+      const Eigen::Vector3d p = Unproject(source.view, x + 0.5, y + 0.5, z);
       for (int c = 0; c < 3; ++c) {
         m.positions.push_back(static_cast<float>(p[c]));
         m.colors.push_back(rgb.at(x, y, c));
@@ -119,27 +136,95 @@ Mesh DepthMapMesh(const NamedView& source, const ImageF& depth, const Image8& rg
   return m;
 }
 
+// The whole of `text` as a number, or an error naming `flag`.
+double ParseNumber(const std::string& flag, const char* text) {
+  char* end = nullptr;
+  const double value = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !std::isfinite(value))
+    throw std::runtime_error(flag + ": '" + text + "' is not a number");
+  return value;
+}
+
+// A source photo with its depth map, checked against its camera.
+struct Source {
+  const NamedView* camera;
+  ImageF depth;
+  Image8 rgb;
+  double weight;
+};
+
+Source LoadSource(const std::string& name, const NamedView& camera, const std::string& depth_dir,
+                  const std::string& image_dir, double distance) {
+  Source s{&camera, casual3d::io::ReadExrChannels(depth_dir + "/" + casual3d::depth::OutputStem(name) + ".exr", {"Z"}),
+           casual3d::io::ReadImage(image_dir + "/" + name), 1.0 / (distance + 1e-3)};
+  if (s.depth.width() != camera.view.width || s.depth.height() != camera.view.height ||
+      s.rgb.width() != s.depth.width() || s.rgb.height() != s.depth.height())
+    throw std::runtime_error(name + ": the photo, its depth map and its camera differ in size (write the "
+                             "source cameras with --width equal to the depth maps' width)");
+  return s;
+}
+
+// The colour the sources give the point `p` (panorama frame): the weighted
+// mean of the bilinear colours of those whose depth map sees it within 3%;
+// false if none does.
+bool ColourFromSources(const std::vector<Source>& sources, const Eigen::Vector3d& p, uint8_t rgb[3]) {
+  double sum[3] = {0, 0, 0}, weight = 0;
+  for (const Source& s : sources) {
+    const PinholeView& v = s.camera->view;
+    const Eigen::Vector3d q = v.rotation * p + v.translation;
+    if (!(q.z() > 0)) continue;
+    const double u = v.fx * q.x() / q.z() + v.cx - 0.5, w = v.fy * q.y() / q.z() + v.cy - 0.5;
+    const int ui = static_cast<int>(std::lround(u)), wi = static_cast<int>(std::lround(w));
+    if (ui < 0 || wi < 0 || ui >= v.width || wi >= v.height) continue;
+    const double d = s.depth.at(ui, wi);
+    if (!(d > 0) || std::abs(d - q.z()) > 0.03 * q.z()) continue;
+    const int u0 = std::clamp(static_cast<int>(std::floor(u)), 0, v.width - 2);
+    const int w0 = std::clamp(static_cast<int>(std::floor(w)), 0, v.height - 2);
+    const double fu = std::clamp(u - u0, 0.0, 1.0), fw = std::clamp(w - w0, 0.0, 1.0);
+    for (int c = 0; c < 3; ++c)
+      sum[c] += s.weight * ((1 - fu) * (1 - fw) * s.rgb.at(u0, w0, c) + fu * (1 - fw) * s.rgb.at(u0 + 1, w0, c) +
+                            (1 - fu) * fw * s.rgb.at(u0, w0 + 1, c) + fu * fw * s.rgb.at(u0 + 1, w0 + 1, c));
+    weight += s.weight;
+  }
+  if (!(weight > 0)) return false;
+  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<uint8_t>(std::lround(sum[c] / weight));
+  return true;
+}
+
 int Run(int argc, char** argv) {
   if (argc < 6) {
     std::fprintf(stderr,
-                 "usage: depth_map_views EVAL_CAMERAS SOURCE_CAMERAS DEPTH_DIR IMAGE_DIR OUT_DIR [--k N] [--cut R]\n");
+                 "usage: depth_map_views EVAL_CAMERAS SOURCE_CAMERAS DEPTH_DIR IMAGE_DIR OUT_DIR [--k N] [--cut R] "
+                 "[--surface MASTER.exr]\n");
     return 2;
   }
-  int k = 8;
+  double k = 8;
   double cut = 1.05;
+  std::string surface;
   for (int a = 6; a < argc; a += 2) {
     const std::string flag = argv[a];
     if (a + 1 >= argc) throw std::runtime_error(flag + ": needs a value");
-    if (flag == "--k") k = std::atoi(argv[a + 1]);
-    else if (flag == "--cut") cut = std::atof(argv[a + 1]);
-    else throw std::runtime_error(flag + ": unknown option (--k N, --cut R)");
+    if (flag == "--k") k = ParseNumber(flag, argv[a + 1]);
+    else if (flag == "--cut") cut = ParseNumber(flag, argv[a + 1]);
+    else if (flag == "--surface") surface = argv[a + 1];
+    else throw std::runtime_error(flag + ": unknown option (--k N, --cut R, --surface MASTER.exr)");
   }
-  if (k < 1) throw std::runtime_error("--k: give at least 1 photo");
+  if (!(k >= 1 && k == std::floor(k))) throw std::runtime_error("--k: give a whole number of photos, at least 1");
   if (!(cut > 1)) throw std::runtime_error("--cut: give a depth ratio above 1 (e.g. 1.05)");
   const auto evaluated = ReadCameras(argv[1]);
   const auto sources = ReadCameras(argv[2]);
   const std::string depth_dir = argv[3], image_dir = argv[4], out_dir = argv[5];
   fs::create_directories(out_dir);
+  Mesh surface_mesh;
+  Image8 surface_atlas;
+  if (!surface.empty()) {
+    auto pano = casual3d::encoder::ReadMasterFile(surface);
+    if (!pano.ok()) throw std::runtime_error(surface + ": " + pano.status().message());
+    auto mesh = casual3d::BuildMesh(*pano);
+    if (!mesh.ok()) throw std::runtime_error(surface + ": " + mesh.status().message());
+    surface_mesh = std::move(*mesh);
+    surface_atlas = casual3d::BuildColorAtlas(*pano);
+  }
   casual3d::render::RenderOptions options;
   options.color_source = casual3d::render::ColorSource::kVertexColors;
   options.near_m = 1e-3;
@@ -148,44 +233,52 @@ int Run(int argc, char** argv) {
     std::vector<std::pair<double, std::string>> nearest;
     for (const auto& [source_name, source] : sources)
       if (source_name != name) nearest.emplace_back((source.centre - target.centre).norm(), source_name);
+    if (nearest.empty()) throw std::runtime_error(name + ": no other photo among the source cameras");
     std::sort(nearest.begin(), nearest.end());
-    nearest.resize(std::min<size_t>(nearest.size(), k));
-    std::vector<RenderResult> renders;
-    std::vector<double> weights;
-    for (const auto& [distance, source_name] : nearest) {
-      const NamedView& source = sources.at(source_name);
-      const std::string stem = fs::path(source_name).stem().string();
-      const ImageF depth = casual3d::io::ReadExrChannels(depth_dir + "/" + stem + ".exr", {"Z"});
-      const Image8 rgb = casual3d::io::ReadImage(image_dir + "/" + source_name);
-      if (depth.width() != source.view.width || depth.height() != source.view.height ||
-          rgb.width() != depth.width() || rgb.height() != depth.height())
-        throw std::runtime_error(source_name + ": the photo, its depth map and its camera differ in size (write the "
-                                 "source cameras with --width equal to the depth maps' width)");
-      renders.push_back(casual3d::render::RenderMesh(DepthMapMesh(source, depth, rgb, cut),
-                                                             casual3d::ImageView<const uint8_t>(), target.view, options));
-      weights.push_back(1.0 / (distance + 1e-3));
-    }
+    nearest.resize(std::min<size_t>(nearest.size(), static_cast<size_t>(k)));
+    std::vector<Source> loaded;
+    for (const auto& [distance, source_name] : nearest)
+      loaded.push_back(LoadSource(source_name, sources.at(source_name), depth_dir, image_dir, distance));
     const int w = target.view.width, h = target.view.height;
     Image8 out(w, h, 4, 0);
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) {
-        double nearest_z = HUGE_VAL;
-        for (const RenderResult& r : renders)
-          if (r.mask.at(x, y)) nearest_z = std::min<double>(nearest_z, r.depth.at(x, y));
-        double sum[3] = {0, 0, 0}, weight = 0;
-        for (size_t i = 0; i < renders.size(); ++i) {
-          if (!renders[i].mask.at(x, y) || renders[i].depth.at(x, y) > 1.03 * nearest_z) continue;
-          for (int c = 0; c < 3; ++c) sum[c] += weights[i] * renders[i].color.at(x, y, c);
-          weight += weights[i];
+    if (!surface.empty()) {
+      // The 3D photo's surface, coloured from the sources where they see it.
+      const RenderResult r = casual3d::render::RenderMesh(surface_mesh, std::as_const(surface_atlas).view(),
+                                                          target.view, {});
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          if (!r.mask.at(x, y)) continue;
+          out.at(x, y, 3) = 255;
+          uint8_t rgb[3];
+          const bool seen = ColourFromSources(loaded, Unproject(target.view, x + 0.5, y + 0.5, r.depth.at(x, y)), rgb);
+          for (int c = 0; c < 3; ++c) out.at(x, y, c) = seen ? rgb[c] : r.color.at(x, y, c);
         }
-        if (!(weight > 0)) continue;
-        for (int c = 0; c < 3; ++c) out.at(x, y, c) = static_cast<uint8_t>(std::lround(sum[c] / weight));
-        out.at(x, y, 3) = 255;
+      }
+    } else {
+      std::vector<RenderResult> renders;
+      for (const Source& s : loaded)
+        renders.push_back(casual3d::render::RenderMesh(DepthMapMesh(*s.camera, s.depth, s.rgb, cut),
+                                                       casual3d::ImageView<const uint8_t>(), target.view, options));
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          double nearest_z = HUGE_VAL;
+          for (const RenderResult& r : renders)
+            if (r.mask.at(x, y)) nearest_z = std::min<double>(nearest_z, r.depth.at(x, y));
+          double sum[3] = {0, 0, 0}, weight = 0;
+          for (size_t i = 0; i < renders.size(); ++i) {
+            if (!renders[i].mask.at(x, y) || renders[i].depth.at(x, y) > 1.03 * nearest_z) continue;
+            for (int c = 0; c < 3; ++c) sum[c] += loaded[i].weight * renders[i].color.at(x, y, c);
+            weight += loaded[i].weight;
+          }
+          if (!(weight > 0)) continue;
+          for (int c = 0; c < 3; ++c) out.at(x, y, c) = static_cast<uint8_t>(std::lround(sum[c] / weight));
+          out.at(x, y, 3) = 255;
+        }
       }
     }
     const std::string path = out_dir + "/" + fs::path(name).stem().string() + ".png";
     casual3d::io::WritePng(path, out);
-    std::printf("%s: from %zu photos -> %s\n", name.c_str(), renders.size(), path.c_str());
+    std::printf("%s: from %zu photos -> %s\n", name.c_str(), loaded.size(), path.c_str());
   }
   return 0;
 }

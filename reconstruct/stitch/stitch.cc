@@ -257,9 +257,10 @@ int NearestSupported(const FullWarps& warps, int best, int x, int y, const Stitc
   return best;
 }
 
-// Writes pixel (x, y) of `out` from label `best`: its depth and colour, or
-// with blend_depth_tolerance > 0 the mean colour and the geometric mean depth
-// of the warps that agree with it, stretched fragments weighing less.
+// Writes pixel (x, y) of `out` from label `best` (on the front layer, first
+// moved to the nearest supported surface, NearestSupported): its depth and
+// colour, or with blend_depth_tolerance > 0 the mean colour and the geometric
+// mean depth of the warps that agree with it, stretched fragments weighing less.
 void WritePixel(const FullWarps& warps, int best, int x, int y, float front_depth,
                 const StitchOptions& options, std::vector<std::pair<float, int>>* scratch,
                 StitchedLayer* out) {

@@ -63,13 +63,16 @@ struct StitchOptions {
   // relative tolerance of the chosen label's, each weighted by exp(-6 s)
   // against stretched fragments: exposure differences and seams average
   // out, and so does the depth maps' independent noise. The label stays the
-  // chosen photo. 0 keeps the chosen label's colour and depth alone.
+  // chosen photo (or, on the front layer, the one front_support picks). 0
+  // keeps the chosen label's colour and depth alone, and turns front_support
+  // off with it.
   double blend_depth_tolerance = 0.03;
   // Front layer: a pixel whose label's surface lies behind a nearer one that
   // at least this many unstretched warps agree on (within
   // blend_depth_tolerance) takes the nearest such surface: the labelling,
   // solved at a fraction of the resolution, loses thin structures that only
-  // some photos' depth maps hold at a pixel. 0 keeps the label's.
+  // some photos' depth maps hold at a pixel. 0 keeps the label's; 1 (one
+  // depth map's floater would win) is refused. Needs blend_depth_tolerance > 0.
   int front_support = 2;
 
   AlphaExpansionOptions solver;
@@ -95,9 +98,11 @@ struct StitchOptions {
     v.Field("blend_depth_tolerance", o.blend_depth_tolerance, R::ClosedOpen(0, 1),
             "Colour and depth are the means of the warps within this relative depth of the label's; 0: the label's alone");
     v.Field("front_support", o.front_support, R::AtLeast(0),
-            "Front pixels take the nearest surface this many unstretched warps agree on; 0: the label's");
+            "Front pixels take the nearest surface this many unstretched warps agree on (within the blend "
+            "tolerance, so off with it); 0: the label's");
     v.Struct("solver", o.solver);
     v.Require(o.solve_width == 2 * o.solve_height, "solve_width", "must be 2 * solve_height");
+    v.Require(o.front_support != 1, "front_support", "must be 0 (off) or at least 2: one warp alone is a floater");
   }
   Status Check() const { return util::CheckFields(*this); }
 };

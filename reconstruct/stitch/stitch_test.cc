@@ -237,6 +237,10 @@ TEST(StitchTest, OptionsAreChecked) {
   options = StitchOptions();
   options.front_support = -1;
   EXPECT_FALSE(options.Check().ok());
+  options.front_support = 1;
+  EXPECT_FALSE(options.Check().ok());
+  options.front_support = 0;
+  EXPECT_TRUE(options.Check().ok());
 }
 
 }  // namespace
