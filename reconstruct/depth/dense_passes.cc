@@ -3,13 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 #include <opencv2/imgproc.hpp>
 
 #include "reconstruct/depth/cost_cache.h"
 #include "reconstruct/depth/dense_mrf.h"
-#include "reconstruct/depth/dense_report.h"
 #include "reconstruct/depth/depth_metrics.h"
 #include "reconstruct/depth/mrf_trws.h"
 #include "reconstruct/io/color_map.h"
@@ -17,21 +15,12 @@
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/file_util.h"
 #include "reconstruct/io/image_io.h"
-#include "reconstruct/util/log.h"
 
 namespace casual3d::depth {
 namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-size_t PeakRssBytes() {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024;
-  return 0;
-}
 
 int ScaledRadius(int radius_at_reference, double ratio) {
   return std::max(1, static_cast<int>(std::lround(radius_at_reference * ratio)));
@@ -42,47 +31,10 @@ Image8 Colorize(const ImageF& depth, const DepthRange& range) {
   return io::ColorizeDepth(depth, range.near_m, range.far_m);
 }
 
-// Per-pixel verdict against ground truth: red = near floater (d < 0.85 g),
-// yellow = nearer than 3%, green = within 3%, blue = farther than 3%,
-// grey = sky (non-finite ground truth) estimated nearer than the far half of
-// the range, black = sky otherwise.
-Image8 ErrorMap(const ImageF& depth, const ImageF& gt) {
-  const int w = depth.width(), h = depth.height();
-  Image8 rgb(w, h, 3, 0);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const int gx = std::min(gt.width() - 1, static_cast<int>((x + 0.5) * gt.width() / w));
-      const int gy = std::min(gt.height() - 1, static_cast<int>((y + 0.5) * gt.height() / h));
-      const float g = gt.at(gx, gy), d = depth.at(x, y);
-      uint8_t c[3] = {0, 0, 0};
-      if (!(std::isfinite(g) && g > 0)) {
-        if (std::isfinite(d)) c[0] = c[1] = c[2] = 96;
-      } else if (!(d >= 0.85f * g)) {
-        c[0] = 255;
-      } else if (d < 0.97f * g) {
-        c[0] = 255, c[1] = 200;
-      } else if (d <= 1.03f * g) {
-        c[1] = 200;
-      } else {
-        c[2] = 255;
-      }
-      for (int k = 0; k < 3; ++k) rgb.at(x, y, k) = c[k];
-    }
-  return rgb;
-}
-
 ImageF ResizeLinear(const ImageF& image, int width, int height) {
   ImageF out(width, height, image.channels());
   cv::Mat dst = io::ToMat(out);
   cv::resize(io::ToMat(image), dst, cv::Size(width, height), 0, 0, cv::INTER_LINEAR);
-  return out;
-}
-
-// `image` sampled at the pixel nearest each centre of a width x height grid.
-ImageF ResizeNearest(const ImageF& image, int width, int height) {
-  ImageF out(width, height, image.channels());
-  cv::Mat dst = io::ToMat(out);
-  cv::resize(io::ToMat(image), dst, cv::Size(width, height), 0, 0, cv::INTER_NEAREST_EXACT);
   return out;
 }
 
@@ -441,144 +393,6 @@ ImageF DepthPhoto(const DensePlan& plan, int i, const DenseOptions& options, int
     }
   }
   return depth;
-}
-
-namespace {
-
-// The free-space check of the final maps against each other
-// (visibility_filter.h), at full resolution. Every round reads the maps as
-// the previous one left them, so the result does not depend on the order
-// of the photos.
-void CheckFreeSpaceAll(const DensePlan& plan, const DenseOptions& options, int threads,
-                       const std::vector<CostVolume>& shells, std::vector<ImageF>* depth,
-                       std::vector<PhotoReport>* photos) {
-  const LoadedWorkspace& ws = plan.ws;
-  const int n = plan.size();
-  std::vector<PinholeCamera> full_cameras(n);
-  std::vector<const PinholeCamera*> full_camera_ptrs(n);
-  std::vector<const ImageF*> final_ptrs(n), gray_ptrs(n);
-  for (int i = 0; i < n; ++i) {
-    gray_ptrs[i] = &ws.views[i].gray_full;
-    full_cameras[i] = ws.views[i].camera_full.Resized((*depth)[i].width(), (*depth)[i].height());
-    full_camera_ptrs[i] = &full_cameras[i];
-    final_ptrs[i] = &(*depth)[i];
-  }
-  util::Progress check_progress("dense: free-space check", n * options.visibility.rounds);
-  for (int round = 0; round < options.visibility.rounds; ++round) {
-    std::vector<std::vector<DepthReplacement>> moves(n);
-    ForEachPhoto(plan, AllPhotos(n), threads, [&](int i) {
-      const auto t0 = Clock::now();
-      VisibilityStats vs;
-      const LabelGrid grid{shells[i].inv_near, shells[i].inv_far, shells[i].num_labels};
-      moves[i] = CheckFreeSpace(i, full_camera_ptrs, final_ptrs, gray_ptrs, ws.ranked_neighbors[i], grid.InvStep(),
-                                options.visibility, &vs);
-      PhotoReport& pr = (*photos)[i];
-      pr.seen_through += vs.flagged;
-      pr.moved_back += vs.replaced;
-      pr.t_visibility += SecondsSince(t0);
-      check_progress.Advance();
-    });
-    for (int i = 0; i < n; ++i)
-      for (const DepthReplacement& m : moves[i]) (*depth)[i].data()[m.index] = m.depth;
-  }
-  check_progress.Finish();
-}
-
-// Photo i's final map against its ground truth `ground_truth[i]`, over all
-// pixels and over those whose true surface >= 2 swept neighbours see.
-void EvaluateFinalDepth(const DensePlan& plan, int i, const ImageF& depth, const std::vector<ImageF>& ground_truth,
-                        const CostVolume& shell, const std::string& debug_dir, bool debug, PhotoReport* pr) {
-  const DenseView& v = plan.ws.views[i];
-  const ImageF& gt = ground_truth[i];
-  pr->evaluated = true;
-  const LabelGrid grid{shell.inv_near, shell.inv_far, shell.num_labels};
-  if (debug) {
-    const std::string base = (fs::path(debug_dir) / OutputStem(v.name)).string();
-    const Image8 gt_rgb = Colorize(gt, v.range), err_rgb = ErrorMap(depth, gt);
-    io::WritePng(base + "_gt.png", gt_rgb.view());
-    io::WritePng(base + "_error.png", err_rgb.view());
-  }
-  // Which swept neighbours see each pixel's true surface.
-  std::vector<PinholeCamera> nb_cam;
-  std::vector<const ImageF*> gt_ptrs;
-  for (int j : plan.swept[i]) {
-    const ImageF& g = ground_truth[j];
-    if (g.empty()) continue;
-    nb_cam.push_back(plan.ws.views[j].camera.Resized(g.width(), g.height()));
-    gt_ptrs.push_back(&g);
-  }
-  std::vector<const PinholeCamera*> cam_ptrs;
-  for (const PinholeCamera& c : nb_cam) cam_ptrs.push_back(&c);
-  const std::vector<uint8_t> observers =
-      AgreeingViews(v.camera.Resized(gt.width(), gt.height()), gt, cam_ptrs, gt_ptrs, 0.02);
-  const DepthAccuracy acc = EvaluateDepth(depth, gt, 0.5 * v.range.far_m, grid.InvStep(), &observers, 2);
-  pr->pixels = acc.pixels;
-  pr->observed_pixels = acc.observed_pixels;
-  pr->median_rel_error_observed = acc.median_rel_error_observed;
-  pr->within_3pct_observed = acc.within_3pct_observed;
-  pr->near_floaters_observed = acc.near_floaters_observed;
-  pr->median_rel_error = acc.median_rel_error;
-  pr->within_3pct = acc.within_3pct;
-  pr->near_floaters = acc.near_floaters;
-  pr->sky_near = acc.sky_near;
-  pr->within_half_label = acc.within_half_label;
-  pr->within_two_labels = acc.within_two_labels;
-}
-
-}  // namespace
-
-DenseReport FinishDense(const DensePlan& plan, const DenseOptions& options, std::vector<ImageF> depth,
-                        std::vector<PhotoReport> photos, const std::vector<CostVolume>& shells,
-                        const std::vector<ImageF>& ground_truth, const std::string& out_dir,
-                        std::chrono::steady_clock::time_point start, double seconds_load) {
-  const int n = plan.size();
-  const int threads = base::ResolveThreads(options.num_threads);
-  for (int i = 0; i < n; ++i) CheckPixelsLoaded(plan, i);
-  if (options.visibility.enabled) CheckFreeSpaceAll(plan, options, threads, shells, &depth, &photos);
-
-  // Outputs and evaluation of the final maps.
-  const std::string debug_dir = (fs::path(out_dir) / "debug").string();
-  ForEachPhoto(plan, AllPhotos(n), threads, [&](int i) {
-    const DenseView& v = plan.ws.views[i];
-    PhotoReport& pr = photos[i];
-    const std::string stem = OutputStem(v.name);
-    const auto t0 = Clock::now();
-    // ZIP compression: a third smaller.
-    io::WriteExr(StemPath(out_dir, "depth", stem, ".exr"), depth[i], {"Z"});
-    if (options.debug) {
-      const Image8 rgb = Colorize(depth[i], v.range);
-      io::WritePng((fs::path(debug_dir) / (stem + "_depth.png")).string(), rgb.view());
-    }
-    pr.t_upsample += SecondsSince(t0);
-    if (!options.ground_truth_dir.empty() && !ground_truth[i].empty())
-      EvaluateFinalDepth(plan, i, depth[i], ground_truth, shells[i], debug_dir, options.debug, &pr);
-  });
-
-  // Cross-view consistency of the final depth maps, sampled at working
-  // resolution (the pixel nearest each working pixel's centre).
-  {
-    std::vector<const DenseView*> view_ptrs;
-    for (const DenseView& v : plan.ws.views) view_ptrs.push_back(&v);
-    std::vector<ImageF> final_low(n);
-    std::vector<const ImageF*> low_ptrs(n);
-    for (int i = 0; i < n; ++i) {
-      final_low[i] = ResizeNearest(depth[i], plan.ws.views[i].camera.width, plan.ws.views[i].camera.height);
-      low_ptrs[i] = &final_low[i];
-    }
-    base::ParallelFor(0, n, threads, [&](int64_t i) {
-      photos[i].cross_view_consistency =
-          CrossViewConsistency(static_cast<int>(i), view_ptrs, low_ptrs, plan.ws.ranked_neighbors[i]);
-    });
-  }
-
-  DenseReport report;
-  report.photos = std::move(photos);
-  report.seconds_load = seconds_load;
-  SummariseDenseReport(&report);
-  report.seconds_total = SecondsSince(start);
-  report.peak_rss_bytes = PeakRssBytes();
-  WriteDenseJson((fs::path(out_dir) / "dense.json").string(), report, options);
-  return report;
 }
 
 }  // namespace casual3d::depth

@@ -12,7 +12,8 @@
 //              and returns the full-resolution depth map;
 //   3. finish: the free-space check of every map against the others, then
 //              OUT/depth/, the evaluation, the cross-view consistency and
-//              OUT/dense.json.
+//              OUT/dense.json (dense_finish.h); reads the maps and the
+//              full-resolution grey images photo by photo.
 
 #include <chrono>
 #include <mutex>
@@ -45,7 +46,8 @@ struct DensePlan {
 DensePlan PlanDense(const std::string& workspace_dir, const DenseOptions& options, bool load_pixels = true);
 
 // The photos whose pixels passes 1 and 2 read for the photos `photos`: each
-// one and its swept neighbours, sorted. (Pass 3 reads every photo's.)
+// one and its swept neighbours, sorted. (Pass 3 reads grey images on
+// demand: dense_finish.h.)
 std::vector<int> PhotosRead(const DensePlan& plan, const std::vector<int>& photos);
 
 // The photos whose sweeps pass 2 reads for photo i: its own (cost cache and
@@ -75,15 +77,6 @@ ImageF ReadDepthMap(const std::string& dir, const std::string& stem);
 ImageF DepthPhoto(const DensePlan& plan, int i, const DenseOptions& options, int threads,
                   const std::vector<const ImageF*>& wta, const CostVolume& shell, const std::string& cost_path,
                   const ImageF& ground_truth, const std::string& out_dir, BufferPool* pool, PhotoReport* pr);
-
-// Pass 3 over all photos: `depth` (moved in) and `photos` from pass 2,
-// `shells` from pass 1, `ground_truth` per photo (empty ones skipped).
-// Writes OUT/depth/ and OUT/dense.json; returns the report, whose
-// seconds_total runs from `start` and seconds_load is `seconds_load`.
-DenseReport FinishDense(const DensePlan& plan, const DenseOptions& options, std::vector<ImageF> depth,
-                        std::vector<PhotoReport> photos, const std::vector<CostVolume>& shells,
-                        const std::vector<ImageF>& ground_truth, const std::string& out_dir,
-                        std::chrono::steady_clock::time_point start, double seconds_load);
 
 // Creates OUT/ and its depth/, confidence/, envelope/ (and debug/) folders.
 void CreateDenseOutputFolders(const std::string& out_dir, const DenseOptions& options);

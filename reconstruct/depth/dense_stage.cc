@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "reconstruct/depth/dense_finish.h"
 #include "reconstruct/depth/dense_passes.h"
 #include "reconstruct/depth/dense_schedule.h"
 #include "reconstruct/io/file_util.h"
@@ -94,9 +95,9 @@ DenseReport RunDenseStage(const std::string& workspace_dir, const std::string& o
       });
   progress.Finish();
 
-  // Pass 3.
-  return FinishDense(plan, options, std::move(depth), std::move(photos), shells, ground_truth, out_dir, t_start,
-                     seconds_load);
+  // Pass 3, on the maps and images held here.
+  return FinishDense(plan, options, LendFinishInputs(plan, depth, ground_truth), std::move(photos), shells, out_dir,
+                     t_start, seconds_load);
 }
 
 }  // namespace casual3d::depth

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "reconstruct/depth/dense_finish.h"
 #include "reconstruct/depth/dense_passes.h"
 #include "reconstruct/depth/dense_plan_record.h"
 #include "reconstruct/depth/dense_schedule.h"
@@ -193,18 +194,25 @@ void CheckDepthUnitsDone(const DensePlan& plan, const UnitFolder& units) {
 DenseReport FinishUnit(const DensePlan& plan, const DenseOptions& options, const UnitFolder& units,
                        const std::string& out_dir, Clock::time_point start, double seconds_load) {
   const int n = plan.size();
-  std::vector<ImageF> depth(n), ground_truth(n);
   std::vector<PhotoReport> photos(n);
   std::vector<CostVolume> shells(n);
   for (int i = 0; i < n; ++i) {
     const std::string stem = OutputStem(plan.ws.views[i].name);
     shells[i] = ReadSweepRecord(plan, i, units, nullptr);
-    depth[i] = ReadDepthMap(units.Dir("depth"), stem);
     photos[i] = PhotoReportFromJson(nlohmann::json::parse(io::ReadFile(units.Path("depth", stem, ".json"))));
-    if (!options.ground_truth_dir.empty()) ground_truth[i] = ReadDepthMap(options.ground_truth_dir, stem);
   }
-  DenseReport report = FinishDense(plan, options, std::move(depth), std::move(photos), shells, ground_truth,
-                                   out_dir, start, seconds_load);
+  // The maps, the photos and the ground truth are read when pass 3 needs
+  // them, so that the unit needs the memory of the photos in flight and
+  // their neighbours whatever the capture's size.
+  const auto owned = [](ImageF image) { return std::make_shared<const ImageF>(std::move(image)); };
+  FinishInputs inputs;
+  inputs.depth = [&](int i) { return owned(ReadDepthMap(units.Dir("depth"), OutputStem(plan.ws.views[i].name))); };
+  inputs.gray_full = [&](int i) { return owned(ReadViewGrayFull(plan.ws, i)); };
+  inputs.ground_truth = [&](int i) {
+    return owned(ReadDepthMap(options.ground_truth_dir, OutputStem(plan.ws.views[i].name)));
+  };
+  DenseReport report =
+      FinishDense(plan, options, inputs, std::move(photos), shells, out_dir, start, seconds_load);
   // dense.json exists: the stage is complete and its intermediates are
   // spent, as are the temporary files of units killed while writing.
   std::error_code ec;
@@ -307,9 +315,8 @@ DenseUnitResult RunDenseUnit(const std::string& workspace_dir, const std::string
     // Every photo must decode at its camera's size; one at a time, so that
     // the plan of a large capture needs the memory of one photo.
     for (int i = 0; i < n; ++i) CheckViewPhoto(plan.ws, i);
-  } else {
-    ForEachPhoto(plan, pass == DensePass::kFinish ? AllPhotos(n) : PhotosRead(plan, todo), threads,
-                 [&](int i) { LoadViewPixels(&plan.ws, i); });
+  } else if (pass != DensePass::kFinish) {  // The finish unit reads its photos when it needs them.
+    ForEachPhoto(plan, PhotosRead(plan, todo), threads, [&](int i) { LoadViewPixels(&plan.ws, i); });
   }
   const double seconds_load = SecondsSince(start);
 

@@ -13,7 +13,8 @@
 //   depth   per photo: envelope, MRF, upsampling;  needs: the sweeps of the
 //           photo and of its first gc.max_views ranked neighbours
 //   finish  the free-space check, OUT/depth/, OUT/dense.json; needs: every
-//           photo's depth unit; then removes OUT/.dense-units/
+//           photo's depth unit; reads the photos and the depth maps when it
+//           needs them (dense_finish.h); then removes OUT/.dense-units/
 //
 // Intermediate results live in OUT/.dense-units/ (cost caches, WTA maps,
 // unchecked depth maps). Every file is written to a temporary name and

@@ -193,6 +193,14 @@ TEST_F(DenseUnitsTest, UnitsAfterThePlanReadItsRecordNotTheModel) {
   EXPECT_THROW(unit(DensePass::kPlan, {}), std::runtime_error);
 }
 
+TEST_F(DenseUnitsTest, TheFinishUnitReadsTheGreyImagesOfTheOneProcess) {
+  // The finish unit reads each photo's full-resolution grey image on its
+  // own (ReadViewGrayFull); its bytes must be those LoadViewPixels gives.
+  const DensePlan plan = PlanDense(Workspace(), Options());
+  for (int i = 0; i < plan.size(); ++i)
+    EXPECT_EQ(ReadViewGrayFull(plan.ws, i).vector(), plan.ws.views[i].gray_full.vector()) << i;
+}
+
 TEST(ParsePhotoListTest, IndicesAndRanges) {
   EXPECT_EQ(ParsePhotoList("3"), std::vector<int>({3}));
   EXPECT_EQ(ParsePhotoList("5-7,0,6"), std::vector<int>({0, 5, 6, 7}));

@@ -36,6 +36,9 @@ Image8 ReadViewPhoto(const LoadedWorkspace& ws, int i) {
   return rgb;
 }
 
+// View i's photo as RGB float in [0, 1].
+ImageF ReadViewFloat(const LoadedWorkspace& ws, int i) { return ToFloat(ReadViewPhoto(ws, i)); }
+
 }  // namespace
 
 ImageF ReadPhotoFloat(const std::string& path) { return ToFloat(io::ReadImage(path)); }
@@ -69,10 +72,15 @@ std::string OutputStem(const std::string& image_name) {
 
 void CheckViewPhoto(const LoadedWorkspace& ws, int i) { ReadViewPhoto(ws, i); }
 
+// LoadViewPixels and ReadViewGrayFull both make the full-resolution grey
+// image as GrayOf(ReadViewFloat(...)), so that the free-space check, which
+// reads it on demand, sees the bytes the depth pass saw.
+ImageF ReadViewGrayFull(const LoadedWorkspace& ws, int i) { return GrayOf(ReadViewFloat(ws, i)); }
+
 void LoadViewPixels(LoadedWorkspace* ws, int i) {
   DenseView& v = ws->views.at(i);
   if (HasViewPixels(*ws, i)) return;
-  const ImageF full = ToFloat(ReadViewPhoto(*ws, i));
+  const ImageF full = ReadViewFloat(*ws, i);
   // All three or none, so that a failure leaves the view without pixels.
   ImageF gray_full = GrayOf(full);
   ImageF color = ResizeArea(full, v.camera.width, v.camera.height);

@@ -37,6 +37,11 @@ LoadedWorkspace LoadWorkspace(const std::string& workspace_dir, double working_s
 // not its camera's.
 void LoadViewPixels(LoadedWorkspace* ws, int i);
 
+// View `i`'s full-resolution grey image as LoadViewPixels makes it (the same
+// bytes), read from ws.images_dir without keeping anything in `ws`, for the
+// free-space check, which needs it photo by photo. Throws as LoadViewPixels.
+ImageF ReadViewGrayFull(const LoadedWorkspace& ws, int i);
+
 // Decodes view `i`'s photo and checks its size as LoadViewPixels does,
 // keeping nothing (the plan unit's check of every photo).
 void CheckViewPhoto(const LoadedWorkspace& ws, int i);

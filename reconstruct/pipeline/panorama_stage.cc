@@ -156,17 +156,18 @@ PanoramaFrame LoadOrComputeFrame(const std::string& sparse_dir) {
 namespace {
 
 // The photos warped at the panorama's size (`full`) and at the stitch's
-// solve size (`coarse`), with each photo's centre in the panorama frame.
-void WarpPhotos(const std::vector<PanoramaPhoto>& photos, const PanoramaFrame& frame,
+// solve size (`coarse`), by index in `photos`, with each photo's centre in
+// the panorama frame. Each photo's image and depth map are read, its sky
+// given the depth `sky_m`, warped twice and freed, `num_threads` photos at a
+// time: the warps, cropped to the photo, are what stays.
+void WarpPhotos(const std::vector<PanoramaPhoto>& photos, double sky_m, const PanoramaFrame& frame,
                 const PanoramaStageOptions& options, int W, int H, std::vector<warp::WarpedView>* full,
                 std::vector<warp::WarpedView>* coarse, std::vector<stitch::ViewGeometry>* geometry) {
-  std::vector<warp::SourceView> views;
   Eigen::Matrix3d R;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) R(r, c) = frame.rotation[3 * r + c];
   const Eigen::Vector3d centre(frame.centre[0], frame.centre[1], frame.centre[2]);
   for (const PanoramaPhoto& p : photos) {
-    views.push_back({&p.rgb, &p.depth, p.camera, p.pose});
     const Eigen::Vector3d c = R * (p.pose.Center() - centre);
     geometry->push_back({{c.x(), c.y(), c.z()}});
   }
@@ -176,10 +177,21 @@ void WarpPhotos(const std::vector<PanoramaPhoto>& photos, const PanoramaFrame& f
   warp::WarpOptions warp_coarse = warp_full;
   warp_coarse.pano_width = options.stitch.solve_width;
   warp_coarse.pano_height = options.stitch.solve_height;
-  util::Progress progress("panorama: warping", 2);
-  *full = warp::WarpViews(views, frame, warp_full, options.num_threads);
-  progress.Advance();
-  *coarse = warp::WarpViews(views, frame, warp_coarse, options.num_threads);
+  for (const warp::WarpOptions* o : {&warp_full, &warp_coarse})
+    if (const Status st = o->Check(); !st.ok()) throw std::invalid_argument("warp options: " + st.message());
+  const int n = static_cast<int>(photos.size());
+  full->assign(n, {});
+  coarse->assign(n, {});
+  util::Progress progress("panorama: warping", n);
+  ForEachPanoramaPhoto(n, options.num_threads, [&](int i) {
+    PanoramaPixels pixels = ReadPanoramaPixels(photos[i]);
+    FillSky(sky_m, &pixels.depth);
+    const warp::SourceView view{&pixels.rgb, &pixels.depth, photos[i].camera, photos[i].pose};
+    (*full)[i] = warp::WarpView(view, frame, warp_full);
+    (*coarse)[i] = warp::WarpView(view, frame, warp_coarse);
+    progress.Advance();
+  });
+  progress.Finish();
 }
 
 void LogSealed(const fuse::SealStats& seal) {
@@ -230,20 +242,19 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   report.width = W;
   report.height = H;
   const PanoramaFrame frame = LoadOrComputeFrame(sparse_dir);
-  std::vector<PanoramaPhoto> photos = LoadPanoramaPhotos(model, sparse_dir, depth_dir);
+  const std::vector<PanoramaPhoto> photos = LoadPanoramaPhotos(model, sparse_dir, depth_dir);
   std::vector<CoverageView> coverage_views;
   for (const PanoramaPhoto& p : photos) coverage_views.push_back({p.camera, p.pose});
   report.num_photos = static_cast<int>(photos.size());
   // Sky (non-finite depth) gets a finite depth beyond everything else.
-  report.sky_depth_m = FillSkyDepth(options.sky_depth_m, &photos);
+  report.sky_depth_m = SkyDepth(options.sky_depth_m, photos, options.num_threads);
   report.seconds_load = Seconds(t);
 
-  // Warp at the output and at the solve resolution.
+  // Read and warp at the output and at the solve resolution.
   t = Clock::now();
   std::vector<stitch::ViewGeometry> geometry;
   std::vector<warp::WarpedView> full, coarse;
-  WarpPhotos(photos, frame, options, W, H, &full, &coarse, &geometry);
-  photos.clear();  // The warps hold everything needed from here on.
+  WarpPhotos(photos, report.sky_depth_m, frame, options, W, H, &full, &coarse, &geometry);
   const Image8 footprint = FootprintMask(full, W, H);
   report.seconds_warp = Seconds(t);
 

@@ -98,6 +98,8 @@ struct PanoramaStageReport {
   int num_photos = 0;
   int width = 0, height = 0;
   double sky_depth_m = 0.0;
+  // seconds_load covers the model and the sky's depth (every depth map read
+  // once); seconds_warp reading each photo and its depth map, and warping;
   // seconds_fuse includes the field-of-view mask, the gap filling, the depth
   // smoothing and sealing.
   double seconds_load = 0, seconds_warp = 0, seconds_stitch_front = 0, seconds_stitch_back = 0,

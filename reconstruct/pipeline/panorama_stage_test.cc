@@ -7,6 +7,7 @@
 
 #include "encoder/master_file.h"
 #include "reconstruct/io/exr_io.h"
+#include "reconstruct/io/file_util.h"
 #include "reconstruct/pipeline/ground_truth_eval.h"
 #include "reconstruct/synth/synth.h"
 
@@ -122,6 +123,34 @@ TEST(PanoramaStageTest, MissingDepthMapIsAClearError) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("0001.exr: missing depth map"), std::string::npos)
         << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(PanoramaStageTest, OfSeveralUnreadablePhotosTheFirstInModelOrderIsNamed) {
+  const fs::path dir = TempDir("pano_unreadable");
+  synth::SynthOptions synth_options;
+  synth_options.width = 160;
+  synth_options.num_photos = 4;
+  synth_options.panorama_width = 128;
+  synth_options.write_master = false;
+  synth::GenerateCapture(synth_options, dir.string());
+  // Photos are read as they are warped, several at a time; the error must
+  // not depend on which thread failed first.
+  for (const char* name : {"0001.jpg", "0003.jpg"})
+    io::WriteFileAtomic((dir / "images" / name).string(), "not a photo");
+  PanoramaStageOptions options;
+  options.pano_width = 256;
+  options.stitch.solve_width = 128;
+  options.stitch.solve_height = 64;
+  options.num_threads = 4;
+  for (int run = 0; run < 3; ++run) {
+    try {
+      RunPanoramaStage(dir.string(), dir.string(), (dir / "out").string(), options);
+      FAIL() << "expected an error";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("0001.jpg"), std::string::npos) << e.what();
+    }
   }
   fs::remove_all(dir);
 }
