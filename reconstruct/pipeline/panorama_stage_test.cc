@@ -104,19 +104,26 @@ TEST(PanoramaStageTest, SphereCaptureWithGroundTruthDepthMatchesGroundTruthPanor
   CheckAgainstGroundTruth(synth::RigKind::kSphere, 50, 0.95, 0.70, 0.78);
 }
 
-TEST(PanoramaStageTest, MissingDepthMapIsAClearError) {
-  const fs::path dir = TempDir("pano_missing");
+// A 4-photo synthetic capture of 160-pixel photos in `dir`, and stage
+// options for a 256-wide panorama of it.
+PanoramaStageOptions SmallCapture(const fs::path& dir) {
   synth::SynthOptions synth_options;
   synth_options.width = 160;
   synth_options.num_photos = 4;
   synth_options.panorama_width = 128;
   synth_options.write_master = false;
   synth::GenerateCapture(synth_options, dir.string());
-  fs::remove(dir / "depth" / "0001.exr");
   PanoramaStageOptions options;
   options.pano_width = 256;
   options.stitch.solve_width = 128;
   options.stitch.solve_height = 64;
+  return options;
+}
+
+TEST(PanoramaStageTest, MissingDepthMapIsAClearError) {
+  const fs::path dir = TempDir("pano_missing");
+  const PanoramaStageOptions options = SmallCapture(dir);
+  fs::remove(dir / "depth" / "0001.exr");
   try {
     RunPanoramaStage(dir.string(), dir.string(), (dir / "out").string(), options);
     FAIL() << "expected an error";
@@ -129,20 +136,11 @@ TEST(PanoramaStageTest, MissingDepthMapIsAClearError) {
 
 TEST(PanoramaStageTest, OfSeveralUnreadablePhotosTheFirstInModelOrderIsNamed) {
   const fs::path dir = TempDir("pano_unreadable");
-  synth::SynthOptions synth_options;
-  synth_options.width = 160;
-  synth_options.num_photos = 4;
-  synth_options.panorama_width = 128;
-  synth_options.write_master = false;
-  synth::GenerateCapture(synth_options, dir.string());
+  PanoramaStageOptions options = SmallCapture(dir);
   // Photos are read as they are warped, several at a time; the error must
   // not depend on which thread failed first.
   for (const char* name : {"0001.jpg", "0003.jpg"})
     io::WriteFileAtomic((dir / "images" / name).string(), "not a photo");
-  PanoramaStageOptions options;
-  options.pano_width = 256;
-  options.stitch.solve_width = 128;
-  options.stitch.solve_height = 64;
   options.num_threads = 4;
   for (int run = 0; run < 3; ++run) {
     try {
