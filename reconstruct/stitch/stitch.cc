@@ -1,10 +1,10 @@
 #include "reconstruct/stitch/stitch.h"
 
 #include <algorithm>
-#include <utility>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
+#include <utility>
 
 #include "base/parallel_for.h"
 
@@ -233,26 +233,31 @@ constexpr float kMaxSupportStretch = 0.5f;
 // photo shows what lies behind it. `scratch` holds (depth, label) pairs.
 int NearestSupported(const FullWarps& warps, int best, int x, int y, const StitchOptions& options,
                      std::vector<std::pair<float, int>>* scratch) {
-  std::vector<std::pair<float, int>>& found = *scratch;
-  found.clear();
-  for (int l = 0; l < static_cast<int>(warps.full.size()); ++l) {
-    int lx, ly;
-    if (!warps.Usable(l, x, y, 0.0f, &lx, &ly)) continue;
-    const warp::WarpedLayer& w = warps.layer(l);
-    if (w.stretch.at(lx, ly) > kMaxSupportStretch) continue;
-    found.emplace_back(w.depth_m.at(lx, ly), l);
-  }
   int lx, ly;
   warps.layer(best).ToCrop(x, y, warps.width, &lx, &ly);
   const double tol = options.blend_depth_tolerance;
   const float limit = static_cast<float>(warps.layer(best).depth_m.at(lx, ly) * (1.0 - tol));
-  // Nearest first: the first surface with enough support wins.
+  std::vector<std::pair<float, int>>& found = *scratch;
+  found.clear();
+  bool nearer = false;  // Most pixels have no candidate nearer than the label's.
+  for (int l = 0; l < static_cast<int>(warps.full.size()); ++l) {
+    if (!warps.Usable(l, x, y, 0.0f, &lx, &ly)) continue;
+    const warp::WarpedLayer& w = warps.layer(l);
+    if (w.stretch.at(lx, ly) > kMaxSupportStretch) continue;
+    found.emplace_back(w.depth_m.at(lx, ly), l);
+    nearer = nearer || found.back().first < limit;
+  }
+  if (!nearer) return best;
+  // Nearest first: the first surface with enough support wins. Sorted, the
+  // depths within tol of one are the run around it.
   std::sort(found.begin(), found.end());
-  for (const auto& [d, l] : found) {
-    if (!(d < limit)) break;
-    int support = 0;
-    for (const auto& other : found) support += std::abs(other.first - d) <= tol * d;
-    if (support >= options.front_support) return l;
+  const int n = static_cast<int>(found.size());
+  for (int i = 0; i < n && found[i].first < limit; ++i) {
+    const float d = found[i].first;
+    int lo = i, hi = i;
+    while (lo > 0 && std::abs(found[lo - 1].first - d) <= tol * d) --lo;
+    while (hi + 1 < n && std::abs(found[hi + 1].first - d) <= tol * d) ++hi;
+    if (hi - lo + 1 >= options.front_support) return found[i].second;
   }
   return best;
 }
