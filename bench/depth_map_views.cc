@@ -26,14 +26,12 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Core>
-#include <nlohmann/json.hpp>
 
 #include "encoder/master_file.h"
 #include "format/color_atlas.h"
@@ -41,6 +39,7 @@
 #include "format/mesh.h"
 #include "format/mesh_builder.h"
 #include "reconstruct/depth/workspace.h"
+#include "reconstruct/eval/external_renders.h"
 #include "reconstruct/io/exr_io.h"
 #include "reconstruct/io/image_io.h"
 #include "reconstruct/render/mesh_renderer.h"
@@ -59,42 +58,12 @@ struct NamedView {
   Eigen::Vector3d centre;
 };
 
-// The cameras `casual3d evaluate --write-cameras` writes: OpenGL view
-// matrices (column-major, -Z forward, +Y up) in the panorama frame, turned
-// into the renderer's +Z forward, +Y down pinhole views.
+// The views of a cameras file of `casual3d evaluate --write-cameras` by name,
+// with their camera centres.
 std::map<std::string, NamedView> ReadCameras(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read the cameras (write them with `casual3d evaluate --write-cameras`)");
   std::map<std::string, NamedView> out;
-  try {
-  const nlohmann::json j = nlohmann::json::parse(in);
-  for (const auto& c : j.at("cameras")) {
-    const auto& m = c.at("view_matrix");
-    Eigen::Matrix3d r;
-    Eigen::Vector3d t;
-    for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 3; ++col) r(row, col) = m.at(col * 4 + row).get<double>();
-      t[row] = m.at(12 + row).get<double>();
-    }
-    const Eigen::Matrix3d flip = Eigen::Vector3d(1, -1, -1).asDiagonal();
-    NamedView v;
-    v.view.rotation = flip * r;
-    v.view.translation = flip * t;
-    v.view.width = c.at("width");
-    v.view.height = c.at("height");
-    v.view.fx = c.at("fx");
-    v.view.fy = c.at("fy");
-    v.view.cx = c.at("cx");
-    v.view.cy = c.at("cy");
-    v.centre = -v.view.rotation.transpose() * v.view.translation;
-    const std::string name = c.at("name").get<std::string>();
-    if (const casual3d::Status st = v.view.Check(); !st.ok()) throw std::runtime_error(name + ": " + st.message());
-    out[name] = v;
-  }
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": not a cameras file of `casual3d evaluate --write-cameras`: " + e.what());
-  }
-  if (out.empty()) throw std::runtime_error(path + ": no cameras");
+  for (casual3d::eval::NamedView& nv : casual3d::eval::ReadRephotoCameras(path))
+    out[nv.name] = {nv.view, -nv.view.rotation.transpose() * nv.view.translation};
   return out;
 }
 
@@ -276,7 +245,7 @@ int Run(int argc, char** argv) {
         }
       }
     }
-    const std::string path = out_dir + "/" + fs::path(name).stem().string() + ".png";
+    const std::string path = (fs::path(out_dir) / casual3d::eval::ExternalRenderName(name)).string();
     casual3d::io::WritePng(path, out);
     std::printf("%s: from %zu photos -> %s\n", name.c_str(), loaded.size(), path.c_str());
   }

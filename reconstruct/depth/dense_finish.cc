@@ -30,11 +30,6 @@ size_t PeakRssBytes() {
   return 0;
 }
 
-// Inverse depth over the photo's range (near = warm); invalid pixels black.
-Image8 Colorize(const ImageF& depth, const DepthRange& range) {
-  return io::ColorizeDepth(depth, range.near_m, range.far_m);
-}
-
 // Per-pixel verdict against ground truth: red = near floater (d < 0.85 g),
 // yellow = nearer than 3%, green = within 3%, blue = farther than 3%,
 // grey = sky (non-finite ground truth) estimated nearer than the far half of
@@ -88,7 +83,7 @@ void EvaluateFinalDepth(const DensePlan& plan, int i, const ImageF& depth, const
   const LabelGrid grid{shell.inv_near, shell.inv_far, shell.num_labels};
   if (debug) {
     const std::string base = (fs::path(debug_dir) / OutputStem(v.name)).string();
-    const Image8 gt_rgb = Colorize(gt, v.range), err_rgb = ErrorMap(depth, gt);
+    const Image8 gt_rgb = io::ColorizeDepth(gt, v.range.near_m, v.range.far_m), err_rgb = ErrorMap(depth, gt);
     io::WritePng(base + "_gt.png", gt_rgb.view());
     io::WritePng(base + "_error.png", err_rgb.view());
   }
@@ -169,7 +164,7 @@ DenseReport FinishDense(const DensePlan& plan, const DenseOptions& options, cons
     // ZIP compression: a third smaller.
     io::WriteExr((fs::path(out_dir) / "depth" / (stem + ".exr")).string(), *depth, {"Z"});
     if (options.debug) {
-      const Image8 rgb = Colorize(*depth, v.range);
+      const Image8 rgb = io::ColorizeDepth(*depth, v.range.near_m, v.range.far_m);
       io::WritePng((fs::path(debug_dir) / (stem + "_depth.png")).string(), rgb.view());
     }
     pr.t_upsample += SecondsSince(t0);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
@@ -67,6 +68,39 @@ std::string RephotoCamerasJson(const std::vector<NamedView>& views, double near,
                               {"far", far},
                               {"cameras", cameras}};
   return doc.dump(1) + "\n";
+}
+
+std::vector<NamedView> ReadRephotoCameras(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read the cameras (write them with `casual3d evaluate --write-cameras`)");
+  std::vector<NamedView> views;
+  try {
+    const nlohmann::json doc = nlohmann::json::parse(in);
+    if (doc.value("format", "") != "casual3d-rephoto-cameras") throw std::runtime_error("format is not casual3d-rephoto-cameras");
+    for (const auto& c : doc.at("cameras")) {
+      NamedView nv;
+      nv.name = c.at("name").get<std::string>();
+      const auto& m = c.at("view_matrix");
+      // GlMatrices' eye frame back to the camera frame: rows 1 and 2 negated.
+      for (int r = 0; r < 3; ++r) {
+        const double sign = r == 0 ? 1.0 : -1.0;
+        for (int col = 0; col < 3; ++col) nv.view.rotation(r, col) = sign * m.at(4 * col + r).get<double>();
+        nv.view.translation(r) = sign * m.at(12 + r).get<double>();
+      }
+      nv.view.width = c.at("width");
+      nv.view.height = c.at("height");
+      nv.view.fx = c.at("fx");
+      nv.view.fy = c.at("fy");
+      nv.view.cx = c.at("cx");
+      nv.view.cy = c.at("cy");
+      if (Status s = nv.view.Check(); !s.ok()) throw std::runtime_error("camera of " + nv.name + ": " + s.message());
+      views.push_back(std::move(nv));
+    }
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": not a cameras file of `casual3d evaluate --write-cameras`: " + e.what());
+  }
+  if (views.empty()) throw std::runtime_error(path + ": no cameras");
+  return views;
 }
 
 ExternalRender ReadExternalRender(const std::string& dir, const std::string& name, int width,

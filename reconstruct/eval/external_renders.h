@@ -48,6 +48,12 @@ void GlMatrices(const render::PinholeView& view, double near, double far, double
 // not 0 < near < far or a view fails PinholeView::Check.
 std::string RephotoCamerasJson(const std::vector<NamedView>& views, double near, double far);
 
+// The views of a cameras document (RephotoCamerasJson's inverse, for tools
+// that render from it), in its order. Throws std::runtime_error naming
+// `path` when it cannot be read, is not such a document, or a view fails
+// PinholeView::Check.
+std::vector<NamedView> ReadRephotoCameras(const std::string& path);
+
 struct ExternalRender {
   Image8 color;  // width x height x 3.
   Image8 mask;   // width x height x 1: 255 where covered.

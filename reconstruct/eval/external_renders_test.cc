@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "reconstruct/io/image_io.h"
@@ -53,6 +54,41 @@ TEST(RephotoCamerasJsonTest, NamesImagesAndRefusesBadClipPlanes) {
   EXPECT_EQ(j["cameras"][0]["image"], "dir_IMG_1.png");
   EXPECT_EQ(j["cameras"][0]["view_matrix"].size(), 16u);
   EXPECT_THROW(RephotoCamerasJson({{"a.jpg", TestView()}}, 1, 1), std::invalid_argument);
+}
+
+TEST(ReadRephotoCamerasTest, ReadsBackWhatRephotoCamerasJsonWrote) {
+  const auto dir = std::filesystem::temp_directory_path() / "casual3d_read_rephoto_cameras_test";
+  std::filesystem::create_directories(dir);
+  render::PinholeView other = TestView();
+  other.width = 64;
+  other.cx = 30;
+  other.translation = Eigen::Vector3d(0.5, -1, 2);
+  const std::string path = (dir / "cams.json").string();
+  std::ofstream(path) << RephotoCamerasJson({{"b.jpg", TestView()}, {"a.jpg", other}}, 0.05, 10);
+  const std::vector<NamedView> read = ReadRephotoCameras(path);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[0].name, "b.jpg");
+  EXPECT_EQ(read[1].name, "a.jpg");
+  for (int k = 0; k < 2; ++k) {
+    const render::PinholeView& want = k == 0 ? TestView() : other;
+    const render::PinholeView& got = read[k].view;
+    EXPECT_EQ(got.width, want.width);
+    EXPECT_EQ(got.height, want.height);
+    EXPECT_DOUBLE_EQ(got.fx, want.fx);
+    EXPECT_DOUBLE_EQ(got.cx, want.cx);
+    EXPECT_LT((got.rotation - want.rotation).norm(), 1e-12);
+    EXPECT_LT((got.translation - want.translation).norm(), 1e-12);
+  }
+  // Not such a document: the file is named.
+  std::ofstream(path) << "{\"cameras\": [";
+  try {
+    ReadRephotoCameras(path);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ReadRephotoCameras((dir / "missing.json").string()), std::runtime_error);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ReadExternalRenderTest, AlphaIsCoverageAndSizeIsChecked) {
