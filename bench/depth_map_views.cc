@@ -3,7 +3,8 @@
 // each drawn as a mesh of its depth map (one vertex per pixel, cut where
 // neighbouring depths differ by more than --cut), the nearest surface kept
 // and the colours of the photos within 3% of it averaged, weighted by the
-// inverse distance of their cameras. The PNGs (RGBA, alpha 0 where no photo
+// inverse distance of their cameras (--weights uniform: equally, one colour
+// per point whatever the eye, as a 3D photo has). The PNGs (RGBA, alpha 0 where no photo
 // reaches) are scored by `casual3d evaluate --rendered`; the gap between
 // that figure and the 3D photo's own is what the panorama stage loses
 // (docs/DECISIONS.md, "Stitch: the nearest surface two photos agree on").
@@ -18,6 +19,7 @@
 //       --write-cameras sources.json        # W: the depth maps' width
 //   depth_map_views eval.json sources.json OUT/work/dense/depth \
 //       OUT/work/train/images DIR [--k 8] [--cut 1.05] [--surface OUT/master.exr]
+//       [--weights nearest|uniform]
 //   casual3d evaluate CAPTURE OUT --width 1008 --rendered DIR
 
 #include <algorithm>
@@ -123,9 +125,9 @@ struct Source {
 };
 
 Source LoadSource(const std::string& name, const NamedView& camera, const std::string& depth_dir,
-                  const std::string& image_dir, double distance) {
+                  const std::string& image_dir, double weight) {
   Source s{&camera, casual3d::io::ReadExrChannels(depth_dir + "/" + casual3d::depth::OutputStem(name) + ".exr", {"Z"}),
-           casual3d::io::ReadImage(image_dir + "/" + name), 1.0 / (distance + 1e-3)};
+           casual3d::io::ReadImage(image_dir + "/" + name), weight};
   if (s.depth.width() != camera.view.width || s.depth.height() != camera.view.height ||
       s.rgb.width() != s.depth.width() || s.rgb.height() != s.depth.height())
     throw std::runtime_error(name + ": the photo, its depth map and its camera differ in size (write the "
@@ -164,19 +166,23 @@ int Run(int argc, char** argv) {
   if (argc < 6) {
     std::fprintf(stderr,
                  "usage: depth_map_views EVAL_CAMERAS SOURCE_CAMERAS DEPTH_DIR IMAGE_DIR OUT_DIR [--k N] [--cut R] "
-                 "[--surface MASTER.exr]\n");
+                 "[--surface MASTER.exr] [--weights nearest|uniform]\n");
     return 2;
   }
   double k = 8;
   double cut = 1.05;
   std::string surface;
+  bool uniform = false;
   for (int a = 6; a < argc; a += 2) {
     const std::string flag = argv[a];
     if (a + 1 >= argc) throw std::runtime_error(flag + ": needs a value");
     if (flag == "--k") k = ParseNumber(flag, argv[a + 1]);
     else if (flag == "--cut") cut = ParseNumber(flag, argv[a + 1]);
     else if (flag == "--surface") surface = argv[a + 1];
-    else throw std::runtime_error(flag + ": unknown option (--k N, --cut R, --surface MASTER.exr)");
+    else if (flag == "--weights" && (std::string(argv[a + 1]) == "nearest" || std::string(argv[a + 1]) == "uniform"))
+      uniform = std::string(argv[a + 1]) == "uniform";
+    else if (flag == "--weights") throw std::runtime_error("--weights: give nearest or uniform");
+    else throw std::runtime_error(flag + ": unknown option (--k N, --cut R, --surface MASTER.exr, --weights W)");
   }
   if (!(k >= 1 && k == std::floor(k))) throw std::runtime_error("--k: give a whole number of photos, at least 1");
   if (!(cut > 1)) throw std::runtime_error("--cut: give a depth ratio above 1 (e.g. 1.05)");
@@ -207,7 +213,8 @@ int Run(int argc, char** argv) {
     nearest.resize(std::min<size_t>(nearest.size(), static_cast<size_t>(k)));
     std::vector<Source> loaded;
     for (const auto& [distance, source_name] : nearest)
-      loaded.push_back(LoadSource(source_name, sources.at(source_name), depth_dir, image_dir, distance));
+      loaded.push_back(LoadSource(source_name, sources.at(source_name), depth_dir, image_dir,
+                                  uniform ? 1.0 : 1.0 / (distance + 1e-3)));
     const int w = target.view.width, h = target.view.height;
     Image8 out(w, h, 4, 0);
     if (!surface.empty()) {
