@@ -222,8 +222,10 @@ int UpsampleLabel(const FullWarps& warps, const StitchedLayer& out, const Image8
 }
 
 // Fragments more stretched than this (triangles across a photo's depth edge,
-// warp.h) neither propose nor support a front surface.
-constexpr float kMaxSupportStretch = 0.5f;
+// warp.h) neither propose nor support a front surface. 0.5 let two depth
+// maps' fattened edges against the sky (stretch about 0.4) hold up a floater
+// in sceaux's sky; fern's leaflets are held by unstretched fragments.
+constexpr float kMaxSupportStretch = 0.2f;
 
 // The front layer's label at (x, y): `best`, unless a surface nearer than
 // best's by more than blend_depth_tolerance has the support of at least

@@ -223,6 +223,42 @@ TEST(StitchTest, FrontKeepsANearSurfaceTwoPhotosAgreeOn) {
   EXPECT_LT(labelled_near, checked);
 }
 
+TEST(StitchTest, StretchedFragmentsDoNotSupportANearSurface) {
+  // As above, but photo 1's warp of the square is made of moderately
+  // stretched fragments (stretch 0.35, as along a depth map's fattened edge
+  // against the sky): photo 0 alone then holds the square unstretched, which
+  // is not enough, and the front is the labelling's.
+  const wt::SquareScene scene;
+  Capture cap = MakeCapture(scene);
+  wt::SquareScene no_square = scene;
+  no_square.half_size = 0;
+  for (int i = 2; i < 4; ++i)
+    wt::RenderSquareScene(no_square, cap.views[i].camera, cap.views[i].pose, &cap.depth[i], &cap.rgb[i]);
+  const int W = 1024;
+  auto full = Warp(cap, W);
+  auto coarse = Warp(cap, SmallSolve().solve_width);
+  int stretched = 0;
+  for (auto* warps : {&full, &coarse}) {
+    warp::WarpedLayer& layer = (*warps)[1].front;
+    for (int y = 0; y < layer.depth_m.height(); ++y)
+      for (int x = 0; x < layer.depth_m.width(); ++x)
+        if (layer.depth_m.at(x, y) > 0 && layer.depth_m.at(x, y) < 2.0f) {
+          layer.stretch.at(x, y) = std::max(layer.stretch.at(x, y), 0.35f);
+          ++stretched;
+        }
+  }
+  ASSERT_GT(stretched, 2000);
+  auto front_with_support = [&](int support) {
+    StitchOptions options = SmallSolve();
+    options.front_support = support;
+    return StitchFront(full, coarse, cap.geometry, W, options);
+  };
+  const StitchedLayer ruled = front_with_support(2);
+  const StitchedLayer labelled = front_with_support(0);
+  EXPECT_EQ(ruled.depth_m.vector(), labelled.depth_m.vector());
+  EXPECT_EQ(ruled.label.vector(), labelled.label.vector());
+}
+
 TEST(StitchTest, OptionsAreChecked) {
   StitchOptions options;
   EXPECT_TRUE(options.Check().ok());
