@@ -172,26 +172,34 @@ TEST(StitchTest, BlendingAveragesTheWarpsThatAgreeInDepth) {
       if (blended.depth_m.at(x, y) > 3.0f) ASSERT_LT(blended.rgb.at(x, y, 0), 60) << x << "," << y;
 }
 
-TEST(StitchTest, FrontKeepsANearSurfaceTwoPhotosAgreeOn) {
-  // Photos 2 and 3 miss the square (their depth maps and colours show the
-  // plane behind it), as real depth maps miss a thin structure that others
-  // hold; photos 0 and 1 see it.
-  const wt::SquareScene scene;
+// Photos 2 and 3 miss the square (their depth maps and colours show the
+// plane behind it), as real depth maps miss a thin structure that others
+// hold; photos 0 and 1 see it.
+Capture SquareMissedByTwo(const wt::SquareScene& scene) {
   Capture cap = MakeCapture(scene);
   wt::SquareScene no_square = scene;
   no_square.half_size = 0;
   for (int i = 2; i < 4; ++i)
     wt::RenderSquareScene(no_square, cap.views[i].camera, cap.views[i].pose, &cap.depth[i], &cap.rgb[i]);
+  return cap;
+}
+
+// The front stitched with the SmallSolve options and front_support `support`.
+StitchedLayer FrontWithSupport(const Capture& cap, const std::vector<warp::WarpedView>& full,
+                               const std::vector<warp::WarpedView>& coarse, int W, int support) {
+  StitchOptions options = SmallSolve();
+  options.front_support = support;
+  return StitchFront(full, coarse, cap.geometry, W, options);
+}
+
+TEST(StitchTest, FrontKeepsANearSurfaceTwoPhotosAgreeOn) {
+  const wt::SquareScene scene;
+  const Capture cap = SquareMissedByTwo(scene);
   const int W = 1024;
   const auto full = Warp(cap, W);
   const auto coarse = Warp(cap, SmallSolve().solve_width);
-  auto front_with_support = [&](int support) {
-    StitchOptions options = SmallSolve();
-    options.front_support = support;
-    return StitchFront(full, coarse, cap.geometry, W, options);
-  };
-  const StitchedLayer kept = front_with_support(2);
-  const StitchedLayer labelled = front_with_support(0);
+  const StitchedLayer kept = FrontWithSupport(cap, full, coarse, W, 2);
+  const StitchedLayer labelled = FrontWithSupport(cap, full, coarse, W, 0);
 
   // Where the square's interior is seen by both photos 0 and 1 (unstretched),
   // the front holds it; the labelling alone shows the plane at some of them.
@@ -228,12 +236,7 @@ TEST(StitchTest, StretchedFragmentsDoNotSupportANearSurface) {
   // stretched fragments (stretch 0.35, as along a depth map's fattened edge
   // against the sky): photo 0 alone then holds the square unstretched, which
   // is not enough, and the front is the labelling's.
-  const wt::SquareScene scene;
-  Capture cap = MakeCapture(scene);
-  wt::SquareScene no_square = scene;
-  no_square.half_size = 0;
-  for (int i = 2; i < 4; ++i)
-    wt::RenderSquareScene(no_square, cap.views[i].camera, cap.views[i].pose, &cap.depth[i], &cap.rgb[i]);
+  const Capture cap = SquareMissedByTwo(wt::SquareScene());
   const int W = 1024;
   auto full = Warp(cap, W);
   auto coarse = Warp(cap, SmallSolve().solve_width);
@@ -248,13 +251,8 @@ TEST(StitchTest, StretchedFragmentsDoNotSupportANearSurface) {
         }
   }
   ASSERT_GT(stretched, 2000);
-  auto front_with_support = [&](int support) {
-    StitchOptions options = SmallSolve();
-    options.front_support = support;
-    return StitchFront(full, coarse, cap.geometry, W, options);
-  };
-  const StitchedLayer ruled = front_with_support(2);
-  const StitchedLayer labelled = front_with_support(0);
+  const StitchedLayer ruled = FrontWithSupport(cap, full, coarse, W, 2);
+  const StitchedLayer labelled = FrontWithSupport(cap, full, coarse, W, 0);
   EXPECT_EQ(ruled.depth_m.vector(), labelled.depth_m.vector());
   EXPECT_EQ(ruled.label.vector(), labelled.label.vector());
 }
