@@ -3,8 +3,9 @@
 // each drawn as a mesh of its depth map (one vertex per pixel, cut where
 // neighbouring depths differ by more than --cut), the nearest surface kept
 // and the colours of the photos within 3% of it averaged, weighted by the
-// inverse distance of their cameras (--weights uniform: equally, one colour
-// per point whatever the eye, as a 3D photo has). The PNGs (RGBA, alpha 0 where no photo
+// inverse distance of their cameras (--weights uniform: equally; with --k
+// at least the number of source photos, one colour per point whatever the
+// eye, as a 3D photo has). The PNGs (RGBA, alpha 0 where no photo
 // reaches) are scored by `casual3d evaluate --rendered`; the gap between
 // that figure and the 3D photo's own is what the panorama stage loses
 // (docs/DECISIONS.md, "Stitch: the nearest surface two photos agree on").

@@ -37,6 +37,8 @@ using Clock = std::chrono::steady_clock;
 // normal of their block, the manifest is compact. encode-4: 9-bit depth.
 // encode-5: package 2.0 (no 2048-wide level, links stored once).
 // sparse-5: COLMAP's steps on one thread (the same photos, the same model).
+// panorama-9: the nearest front surface two warps agree on (spec version 8);
+// panorama-10: only fragments stretched at most 0.2 support it (version 9).
 constexpr const char* kStageVersions[kNumStages] = {"sparse-5", "dense-5", "panorama-10",
                                                     "encode-5"};
 

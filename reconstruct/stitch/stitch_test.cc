@@ -253,6 +253,18 @@ TEST(StitchTest, StretchedFragmentsDoNotSupportANearSurface) {
   ASSERT_GT(stretched, 2000);
   const StitchedLayer ruled = FrontWithSupport(cap, full, coarse, W, 2);
   const StitchedLayer labelled = FrontWithSupport(cap, full, coarse, W, 0);
+  // The rule has something to change: the labelling shows the plane behind
+  // the square where photo 0 holds the square unstretched.
+  int plane_behind = 0;
+  for (int y = 0; y < W / 2; ++y) {
+    for (int x = 0; x < W; ++x) {
+      int cx, cy;
+      plane_behind += full[0].front.ToCrop(x, y, W, &cx, &cy) && full[0].front.depth_m.at(cx, cy) > 0 &&
+                      full[0].front.depth_m.at(cx, cy) < 2.0f && full[0].front.stretch.at(cx, cy) < 0.1f &&
+                      labelled.depth_m.at(x, y) > 2.0f;
+    }
+  }
+  ASSERT_GT(plane_behind, 100);
   EXPECT_EQ(ruled.depth_m.vector(), labelled.depth_m.vector());
   EXPECT_EQ(ruled.label.vector(), labelled.label.vector());
 }
