@@ -180,10 +180,11 @@ int Run(int argc, char** argv) {
     if (flag == "--k") k = ParseNumber(flag, argv[a + 1]);
     else if (flag == "--cut") cut = ParseNumber(flag, argv[a + 1]);
     else if (flag == "--surface") surface = argv[a + 1];
-    else if (flag == "--weights" && (std::string(argv[a + 1]) == "nearest" || std::string(argv[a + 1]) == "uniform"))
-      uniform = std::string(argv[a + 1]) == "uniform";
-    else if (flag == "--weights") throw std::runtime_error("--weights: give nearest or uniform");
-    else throw std::runtime_error(flag + ": unknown option (--k N, --cut R, --surface MASTER.exr, --weights W)");
+    else if (flag == "--weights") {
+      const std::string value = argv[a + 1];
+      if (value != "nearest" && value != "uniform") throw std::runtime_error("--weights: give nearest or uniform");
+      uniform = value == "uniform";
+    } else throw std::runtime_error(flag + ": unknown option (--k N, --cut R, --surface MASTER.exr, --weights W)");
   }
   if (!(k >= 1 && k == std::floor(k))) throw std::runtime_error("--k: give a whole number of photos, at least 1");
   if (!(cut > 1)) throw std::runtime_error("--cut: give a depth ratio above 1 (e.g. 1.05)");

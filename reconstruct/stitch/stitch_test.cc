@@ -42,7 +42,9 @@ std::vector<warp::WarpedView> Warp(const Capture& cap, int width) {
   warp::WarpOptions options;
   options.pano_width = width;
   options.pano_height = width / 2;
-  return warp::WarpViews(cap.views, PanoramaFrame(), options, 2);
+  std::vector<warp::WarpedView> warps;
+  for (const warp::SourceView& view : cap.views) warps.push_back(warp::WarpView(view, PanoramaFrame(), options));
+  return warps;
 }
 
 // The labelling solved at 256x128 for the tests' 1024x512 panoramas.

@@ -7,7 +7,6 @@
 
 #include <Eigen/Core>
 
-#include "base/parallel_for.h"
 
 namespace casual3d::warp {
 namespace {
@@ -286,16 +285,6 @@ WarpedView WarpView(const SourceView& view, const PanoramaFrame& frame,
     }
   }
   return raster.Take();
-}
-
-std::vector<WarpedView> WarpViews(const std::vector<SourceView>& views, const PanoramaFrame& frame,
-                                  const WarpOptions& options, int num_threads) {
-  if (const Status st = options.Check(); !st.ok())
-    throw std::invalid_argument("warp options: " + st.message());
-  std::vector<WarpedView> out(views.size());
-  base::ParallelFor(0, static_cast<int64_t>(views.size()), base::ResolveThreads(num_threads),
-                    [&](int64_t i) { out[i] = WarpView(views[i], frame, options); });
-  return out;
 }
 
 }  // namespace casual3d::warp

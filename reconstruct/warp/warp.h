@@ -100,9 +100,4 @@ struct WarpedView {
 // Warps one view. Throws std::invalid_argument on invalid options or inputs.
 WarpedView WarpView(const SourceView& view, const PanoramaFrame& frame, const WarpOptions& options);
 
-// Warps all views on `num_threads` threads (0: all cores). The first view
-// that throws stops the others, and its exception is rethrown.
-std::vector<WarpedView> WarpViews(const std::vector<SourceView>& views, const PanoramaFrame& frame,
-                                  const WarpOptions& options, int num_threads = 0);
-
 }  // namespace casual3d::warp
