@@ -187,7 +187,8 @@ struct Spawner {
 // Step 3: grows the back layer one ring at a time, `rings` rings: a pixel with
 // a front node and no back node takes the mean depth and colour of the
 // unlinked nodes beside it that lie clearly behind its front node, and keeps
-// it only if it links to a neighbour.
+// it only if it links to a neighbour and lies within rings * (1 - df / db) + 1
+// rings of the captured nodes (df its front node's depth, db its own).
 void GrowBackLayer(int rings, float tau, Graph* graph, TwoLayerPanorama* pano, FuseStats* stats) {
   const int W = pano->width();
   LayerData& F = pano->layer(kFront);
@@ -236,6 +237,13 @@ void GrowBackLayer(int rings, float tau, Graph* graph, TwoLayerPanorama* pano, F
         sum_rgb[3 * q + c] = 0.0f;
       }
       if (!(F.depth_m[q] < depth && DepthRatio(F.depth_m[q], depth) <= tau)) continue;
+      // Only as far as the viewing volume can open behind q's front node: a
+      // moving eye opens a gap between two surfaces in proportion to
+      // 1 - df / db, and `rings` is the gap in front of a far background. A
+      // surface just behind the front one (the noisy far side of a trunk)
+      // grows a ring or two and leaves the pixels behind the foreground to
+      // the background, which a moving eye does see there.
+      if (ring + 1 > rings * (1.0 - F.depth_m[q] / depth) + 1.0) continue;
       B.present[q] = 1;
       B.depth_m[q] = depth;
       for (int c = 0; c < 3; ++c) B.rgb[3 * q + c] = rgb[c];

@@ -15,8 +15,10 @@
 //   3. Grow the back layer ring by ring: a node without a link towards a
 //      neighbour spawns a candidate there with the mean depth and colour of its
 //      spawners; the candidate is kept where the neighbour has a front node
-//      clearly in front of it (ratio <= tau) and no back node, and only if it
-//      links to a spawner. Kept nodes are hallucinated, labelled B.
+//      clearly in front of it (ratio <= tau) and no back node, only if it
+//      links to a spawner, and only within the rings a moving eye can open
+//      behind that front node (rings * (1 - df / db) + 1). Kept nodes are
+//      hallucinated, labelled B.
 //   4. Remove colour fringes: the B label spreads from B nodes along links onto
 //      front nodes for a few rings; those front nodes take the back stitch's
 //      colour where the back stitch saw the same surface (the redundant back

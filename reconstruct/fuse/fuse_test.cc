@@ -7,8 +7,9 @@
 namespace casual3d::fuse {
 namespace {
 
-// A 256x128 panorama: background at 4 m everywhere, a foreground square at
-// 1 m over columns [100, 140) and rows [50, 80). The back stitch saw the
+// A 256x128 panorama: background at `background` m (4 by default)
+// everywhere, a foreground square at 1 m over columns [100, 140) and rows
+// [50, 80). The back stitch saw the
 // background behind the square's first and last `seen` columns and repeats the
 // front elsewhere. The front's background pixels right next to the square
 // carry the square's colour (a fringe).
@@ -19,13 +20,13 @@ struct Scene {
 
   static bool InSquare(int x, int y) { return x >= 100 && x < 140 && y >= 50 && y < 80; }
 
-  explicit Scene(int seen) {
+  explicit Scene(int seen, float background = 4.0f) {
     for (int y = 0; y < H; ++y) {
       for (int x = 0; x < W; ++x) {
         const bool sq = InSquare(x, y);
-        front_depth.at(x, y) = sq ? 1.0f : 4.0f;
+        front_depth.at(x, y) = sq ? 1.0f : background;
         front_rgb.at(x, y, 0) = sq ? 250 : 20;
-        back_depth.at(x, y) = 4.0f;  // Redundant where the front is the background.
+        back_depth.at(x, y) = background;  // Redundant where the front is the background.
         back_rgb.at(x, y, 0) = 20;
         const bool seen_behind = sq && (x < 100 + seen || x >= 140 - seen);
         if (sq && !seen_behind) back_depth.at(x, y) = 0.0f;
@@ -76,10 +77,12 @@ TEST(FuseTest, GrowsTheBackLayerBehindTheForeground) {
   FuseStats stats;
   const TwoLayerPanorama pano = Fuse(scene.Input(), options, &stats);
   ASSERT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
-  // Back nodes now reach 3 + 10 columns in from each side of the square, at
-  // the background's depth, and never outside the square.
+  // Back nodes now reach 3 + 8 columns in from each side of the square, at
+  // the background's depth, and never outside the square: the 10 rings hold
+  // for a background far behind, and a moving eye opens 1 - 1/4 of that gap
+  // between the square at 1 m and the background at 4 m (8.5 rings).
   for (int x = 100; x < 140; ++x) {
-    const bool expect_back = x < 113 || x >= 127;
+    const bool expect_back = x < 111 || x >= 129;
     EXPECT_EQ(pano.present(kBack, x, 65), expect_back) << "column " << x;
     if (expect_back) {
       EXPECT_FLOAT_EQ(pano.layer(kBack).depth_m[pano.index(x, 65)], 4.0f);
@@ -92,7 +95,23 @@ TEST(FuseTest, GrowsTheBackLayerBehindTheForeground) {
   }
   // Rows above and below the square grow too (vertical edges of the square).
   EXPECT_TRUE(pano.present(kBack, 120, 50));
-  EXPECT_GT(stats.back_nodes_hallucinated, 2 * 10 * 30);
+  EXPECT_GT(stats.back_nodes_hallucinated, 2 * 8 * 30);
+}
+
+TEST(FuseTest, GrowsASurfaceJustBehindTheForegroundOnlyARing) {
+  // A background 10% behind the square (the noisy far side of a trunk, say):
+  // the eye opens 1 - 1/1.1 of the far-background gap there, 1.9 rings of 10.
+  Scene scene(3, 1.1f);
+  FuseOptions options;
+  options.expansion_fraction = 10.0 / Scene::W;
+  options.fringe_fraction = 0;
+  FuseStats stats;
+  const TwoLayerPanorama pano = Fuse(scene.Input(), options, &stats);
+  ASSERT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
+  for (int x = 100; x < 140; ++x) {
+    const bool expect_back = x < 104 || x >= 136;  // 3 seen + 1 grown each side.
+    EXPECT_EQ(pano.present(kBack, x, 65), expect_back) << "column " << x;
+  }
 }
 
 TEST(FuseTest, RemovesColorFringes) {

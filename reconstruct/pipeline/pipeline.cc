@@ -39,7 +39,9 @@ using Clock = std::chrono::steady_clock;
 // sparse-5: COLMAP's steps on one thread (the same photos, the same model).
 // panorama-9: the nearest front surface two warps agree on (spec version 8);
 // panorama-10: only fragments stretched at most 0.2 support it (version 9).
-constexpr const char* kStageVersions[kNumStages] = {"sparse-5", "dense-5", "panorama-10",
+// panorama-11: the back layer grows only as far as a moving eye can open the
+// gap behind each front node (version 10).
+constexpr const char* kStageVersions[kNumStages] = {"sparse-5", "dense-5", "panorama-11",
                                                     "encode-5"};
 
 std::string HashHex(const std::string& text) {
