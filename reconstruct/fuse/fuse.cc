@@ -241,8 +241,8 @@ void GrowBackLayer(int rings, float tau, Graph* graph, TwoLayerPanorama* pano, F
       // moving eye opens a gap between two surfaces in proportion to
       // 1 - df / db, and `rings` is the gap in front of a far background. A
       // surface just behind the front one (the noisy far side of a trunk)
-      // grows a ring or two and leaves the pixels behind the foreground to
-      // the background, which a moving eye does see there.
+      // grows about three rings at 4096 and leaves the pixels behind the
+      // foreground to the background, which a moving eye does see there.
       if (ring + 1 > rings * (1.0 - F.depth_m[q] / depth) + 1.0) continue;
       B.present[q] = 1;
       B.depth_m[q] = depth;
