@@ -41,7 +41,9 @@ using Clock = std::chrono::steady_clock;
 // panorama-10: only fragments stretched at most 0.2 support it (version 9).
 // panorama-11: the back layer grows only as far as a moving eye can open the
 // gap behind each front node (version 10).
-constexpr const char* kStageVersions[kNumStages] = {"sparse-5", "dense-5", "panorama-11",
+// sparse-6: a photo's near depth also bounded by other photos' points inside
+// its view (spec/stage-sparse.md, depth_ranges.json).
+constexpr const char* kStageVersions[kNumStages] = {"sparse-6", "dense-5", "panorama-11",
                                                     "encode-5"};
 
 std::string HashHex(const std::string& text) {

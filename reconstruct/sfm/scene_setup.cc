@@ -43,6 +43,29 @@ Eigen::Vector3d CentreOf(const geometry::Pose& pose) {
 Eigen::Vector3d ViewOf(const geometry::Pose& pose) { return pose.R().row(2).transpose(); }
 Eigen::Vector3d UpOf(const geometry::Pose& pose) { return -pose.R().row(1).transpose(); }
 
+// Camera-frame depths of the model points observed by at least `min_track`
+// photos that lie in front of `image` and project inside its pinhole view.
+std::vector<double> FrustumDepths(const geometry::SparseModel& model, const geometry::ModelImage& image,
+                                  size_t min_track) {
+  std::vector<double> depths;
+  const auto cam_it = model.cameras.find(image.camera_id);
+  if (cam_it == model.cameras.end() || cam_it->second.width <= 0) return depths;
+  const geometry::Camera& cam = cam_it->second;
+  const double fx = cam.FocalX(), fy = cam.FocalY();
+  const double cx = cam.PrincipalX(), cy = cam.PrincipalY();
+  const Eigen::Matrix3d R = image.pose.R();
+  const Eigen::Vector3d& t = image.pose.translation;
+  for (const auto& [id, point] : model.points) {
+    if (point.track.size() < min_track) continue;
+    const Eigen::Vector3d p = R * point.xyz + t;
+    if (!(p.z() > 0)) continue;
+    const double u = fx * p.x() / p.z() + cx;
+    const double v = fy * p.y() / p.z() + cy;
+    if (u >= 0 && u <= cam.width && v >= 0 && v <= cam.height) depths.push_back(p.z());
+  }
+  return depths;
+}
+
 DepthRange RangeFromDepths(std::vector<double> depths, const DepthRangeOptions& options) {
   std::sort(depths.begin(), depths.end());
   DepthRange r;
@@ -120,20 +143,7 @@ std::map<int, DepthRange> ComputeDepthRanges(const geometry::SparseModel& model,
     if (static_cast<int>(depths.size()) < options.min_points) {
       // Too few observations (a weakly registered photo): fall back to every
       // model point that projects inside its pinhole view.
-      depths.clear();
-      const auto cam_it = model.cameras.find(image.camera_id);
-      if (cam_it != model.cameras.end() && cam_it->second.width > 0) {
-        const geometry::Camera& cam = cam_it->second;
-        const double fx = cam.FocalX(), fy = cam.FocalY();
-        const double cx = cam.PrincipalX(), cy = cam.PrincipalY();
-        for (const auto& [id, point] : model.points) {
-          const Eigen::Vector3d p = R * point.xyz + t;
-          if (!(p.z() > 0)) continue;
-          const double u = fx * p.x() / p.z() + cx;
-          const double v = fy * p.y() / p.z() + cy;
-          if (u >= 0 && u <= cam.width && v >= 0 && v <= cam.height) depths.push_back(p.z());
-        }
-      }
+      depths = FrustumDepths(model, image, /*min_track=*/0);
       source = "frustum";
     }
     if (static_cast<int>(depths.size()) < options.min_points) {
@@ -141,6 +151,15 @@ std::map<int, DepthRange> ComputeDepthRanges(const geometry::SparseModel& model,
       continue;
     }
     DepthRange r = RangeFromDepths(std::move(depths), options);
+    const size_t k = static_cast<size_t>(options.frustum_near_points);
+    if (k > 0 && source == "observed") {
+      std::vector<double> frustum = FrustumDepths(model, image, /*min_track=*/3);
+      if (frustum.size() >= k) {
+        std::nth_element(frustum.begin(), frustum.begin() + (k - 1), frustum.end());
+        const double near_m = std::max(frustum[k - 1] * options.near_margin, r.far_m * options.min_near_over_far);
+        r.near_m = std::min(r.near_m, near_m);
+      }
+    }
     r.name = image.name;
     r.source = source;
     ranges[image_id] = r;

@@ -42,6 +42,12 @@ struct DepthRangeOptions {
   // Near bounds are clamped to at least this fraction of the far bound, which
   // keeps the inverse-depth sweep finite when a point lies at the lens.
   double min_near_over_far = 1e-3;  // Range (0, 1).
+  // A photo's near bound is also at most near_margin times the depth of the
+  // k-th nearest model point that at least 3 photos observe and that projects
+  // inside the photo (k this many): a near object that other photos'
+  // matches found and this photo's missed (at the edge of its view, say)
+  // stays inside its sweep. 0 disables.
+  int frustum_near_points = 5;  // Range [0, 1000].
 
   // Names the first field out of range.
   template <typename Self, typename Visitor>
@@ -53,6 +59,8 @@ struct DepthRangeOptions {
     v.Field("far_margin", o.far_margin, R::Closed(1, 100), "Far bound factor");
     v.Field("min_points", o.min_points, R::Closed(1, 1e6), "Observed points a photo needs for its own range");
     v.Field("min_near_over_far", o.min_near_over_far, R::Open(0, 1), "Near bounds are at least this fraction of the far bound");
+    v.Field("frustum_near_points", o.frustum_near_points, R::Closed(0, 1000),
+            "Near bound at most near_margin times the depth of this many-th nearest point of 3+ photos inside the view; 0: off");
   }
   Status Check() const { return util::CheckFields(*this); }
 };

@@ -263,6 +263,47 @@ TEST(DepthRangeTest, FallbacksForPhotosWithFewObservations) {
   EXPECT_LT(ranges.at(3).far_m, 5.2);
 }
 
+// Adds a point at local (x, y, z) observed by the photos `seen_by`.
+void AddPoint(const World& w, uint64_t id, double x, double y, double z, const std::vector<int>& seen_by,
+              SparseModel* model) {
+  geometry::Point3D p;
+  p.point3d_id = id;
+  p.xyz = w.P(x, y, z);
+  for (int image_id : seen_by) {
+    geometry::ModelImage& image = model->images.at(image_id);
+    geometry::Observation2D obs;
+    obs.point3d_id = id;
+    p.track.push_back({image_id, static_cast<int>(image.points2d.size())});
+    image.points2d.push_back(obs);
+  }
+  model->points[id] = p;
+}
+
+TEST(DepthRangeTest, NearObjectThatOtherPhotosSawBoundsTheNearDepth) {
+  const World w;
+  SparseModel model = PartialCapture(w);
+  // A box 0.8 m in front of the rig: photos 1-8 matched 6 of its points, photo
+  // 9 none, though it sees them. A stray point 0.3 m away that only two
+  // photos matched does not count.
+  for (int i = 0; i < 6; ++i) AddPoint(w, 2000 + i, 0.02 * i - 0.05, 0.01 * i, -0.8, {1, 2, 3, 4, 5, 6, 7, 8}, &model);
+  AddPoint(w, 3000, 0.0, 0.0, -0.3, {1, 2}, &model);
+  auto camera_depth = [&](int image_id, uint64_t point_id) {
+    const geometry::Pose& pose = model.images.at(image_id).pose;
+    return (pose.R() * model.points.at(point_id).xyz + pose.translation).z();
+  };
+  std::vector<double> box;
+  for (int i = 0; i < 6; ++i) box.push_back(camera_depth(9, 2000 + i));
+  std::sort(box.begin(), box.end());
+  const auto ranges = ComputeDepthRanges(model, {});
+  EXPECT_EQ(ranges.at(9).source, "observed");
+  EXPECT_EQ(ranges.at(9).num_points, 100);
+  EXPECT_NEAR(ranges.at(9).near_m, 0.8 * box[4], 1e-9);  // The 5th nearest, times 0.8.
+  // Off: photo 9 keeps the range of its own points, behind the box.
+  DepthRangeOptions off;
+  off.frustum_near_points = 0;
+  EXPECT_GT(ComputeDepthRanges(model, off).at(9).near_m, 1.4);
+}
+
 TEST(DepthRangeTest, RejectsBadOptionsAndEmptyModels) {
   DepthRangeOptions options;
   options.near_percentile = 0.7;
