@@ -2,7 +2,8 @@
 
 // Scene set-up from a sparse reconstruction (Sec. 4.1 of the paper):
 //  - the per-photo depth range that bounds the dense stage's plane sweep, from
-//    the sparse points each photo observes (robust percentiles with margins);
+//    the sparse points each photo observes (robust percentiles with margins),
+//    its near end also bounded by other photos' points inside its view;
 //  - the 3D photo's frame (format/equirect.h's PanoramaFrame): the centre of the
 //    central panorama, its up direction and, for partial captures, its forward
 //    direction;
@@ -42,7 +43,7 @@ struct DepthRangeOptions {
   // Near bounds are clamped to at least this fraction of the far bound, which
   // keeps the inverse-depth sweep finite when a point lies at the lens.
   double min_near_over_far = 1e-3;  // Range (0, 1).
-  // A photo's near bound is also at most near_margin times the depth of the
+  // A photo's near bound (of an "observed" range) is also at most near_margin times the depth of the
   // k-th nearest model point that at least 3 photos observe and that projects
   // inside the photo (k this many): a near object that other photos'
   // matches found and this photo's missed (at the edge of its view, say)

@@ -299,7 +299,9 @@ Json OptionsJson(const SparseStageOptions& o) {
             {"far_percentile", o.depth_ranges.far_percentile},
             {"near_margin", o.depth_ranges.near_margin},
             {"far_margin", o.depth_ranges.far_margin},
-            {"min_points", o.depth_ranges.min_points}}},
+            {"min_points", o.depth_ranges.min_points},
+            {"min_near_over_far", o.depth_ranges.min_near_over_far},
+            {"frustum_near_points", o.depth_ranges.frustum_near_points}}},
           {"frame",
            {{"robust_centre", o.frame.robust_centre},
             {"min_partial_resultant", o.frame.min_partial_resultant}}}};
