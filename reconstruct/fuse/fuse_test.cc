@@ -114,6 +114,44 @@ TEST(FuseTest, GrowsASurfaceJustBehindTheForegroundOnlyARing) {
   }
 }
 
+TEST(FuseTest, TheBackgroundTakesThePixelsASurfaceJustBehindCannotFill) {
+  // The square's far side, 10% behind it, shows as a strip of front nodes at
+  // 1.1 m over columns [96, 100) (a trunk's noisy silhouette); nothing was
+  // seen behind the square. The strip grows one ring behind the square (with
+  // every ring it covered columns 100-109); the background at 4 m grows in
+  // over the square's top and bottom rows and from its right.
+  Scene scene(0);
+  for (int y = 50; y < 80; ++y) {
+    for (int x = 96; x < 100; ++x) {
+      scene.front_depth.at(x, y) = 1.1f;
+      scene.back_depth.at(x, y) = 0.0f;
+    }
+  }
+  FuseOptions options;
+  options.expansion_fraction = 10.0 / Scene::W;
+  options.fringe_fraction = 0;
+  const TwoLayerPanorama pano = Fuse(scene.Input(), options);
+  ASSERT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
+  const LayerData& B = pano.layer(kBack);
+  int strip_behind = 0, background_behind = 0;
+  for (int y = 50; y < 80; ++y) {
+    for (int x = 100; x < 140; ++x) {
+      const size_t i = pano.index(x, y);
+      if (!B.present[i]) continue;
+      strip_behind += B.depth_m[i] < 1.2f;
+      background_behind += B.depth_m[i] > 3.5f;
+      // Beyond the strip's one ring, nothing of its depth.
+      if (x > 100) {
+        EXPECT_GT(B.depth_m[i], 1.2f) << x << "," << y;
+      }
+    }
+  }
+  EXPECT_LE(strip_behind, 30);  // Column 100 at most.
+  // The background's rings from above reach row 51 behind columns 102-109.
+  for (int x = 102; x < 110; ++x) EXPECT_GT(B.depth_m[pano.index(x, 51)], 3.0f) << "column " << x;
+  EXPECT_GT(background_behind, 8 * 30);
+}
+
 TEST(FuseTest, RemovesColorFringes) {
   Scene scene(3);
   FuseOptions options;

@@ -43,25 +43,29 @@ Eigen::Vector3d CentreOf(const geometry::Pose& pose) {
 Eigen::Vector3d ViewOf(const geometry::Pose& pose) { return pose.R().row(2).transpose(); }
 Eigen::Vector3d UpOf(const geometry::Pose& pose) { return -pose.R().row(1).transpose(); }
 
-// Camera-frame depths of the model points observed by at least `min_track`
-// photos that lie in front of `image` and project inside its pinhole view.
-std::vector<double> FrustumDepths(const geometry::SparseModel& model, const geometry::ModelImage& image,
-                                  size_t min_track) {
+// The positions of the model points that at least `min_track` photos observe.
+std::vector<Eigen::Vector3d> PointsSeenBy(const geometry::SparseModel& model, size_t min_track) {
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& [id, point] : model.points)
+    if (point.track.size() >= min_track) points.push_back(point.xyz);
+  return points;
+}
+
+// Camera-frame depths of those of `points` that lie in front of `image` and
+// project inside its pinhole view.
+std::vector<double> FrustumDepths(const std::vector<Eigen::Vector3d>& points, const geometry::SparseModel& model,
+                                  const geometry::ModelImage& image) {
   std::vector<double> depths;
   const auto cam_it = model.cameras.find(image.camera_id);
   if (cam_it == model.cameras.end() || cam_it->second.width <= 0) return depths;
-  const geometry::Camera& cam = cam_it->second;
-  const double fx = cam.FocalX(), fy = cam.FocalY();
-  const double cx = cam.PrincipalX(), cy = cam.PrincipalY();
+  const geometry::Camera pinhole = cam_it->second.PinholePart();
   const Eigen::Matrix3d R = image.pose.R();
   const Eigen::Vector3d& t = image.pose.translation;
-  for (const auto& [id, point] : model.points) {
-    if (point.track.size() < min_track) continue;
-    const Eigen::Vector3d p = R * point.xyz + t;
+  for (const Eigen::Vector3d& xyz : points) {
+    const Eigen::Vector3d p = R * xyz + t;
     if (!(p.z() > 0)) continue;
-    const double u = fx * p.x() / p.z() + cx;
-    const double v = fy * p.y() / p.z() + cy;
-    if (u >= 0 && u <= cam.width && v >= 0 && v <= cam.height) depths.push_back(p.z());
+    const Eigen::Vector2d uv = pinhole.Project(p);
+    if (uv.x() >= 0 && uv.x() <= pinhole.width && uv.y() >= 0 && uv.y() <= pinhole.height) depths.push_back(p.z());
   }
   return depths;
 }
@@ -128,6 +132,12 @@ std::map<int, DepthRange> ComputeDepthRanges(const geometry::SparseModel& model,
 
   std::map<int, DepthRange> ranges;
   std::vector<int> unresolved;
+  // Every point, for photos that observe too few (read when one needs them),
+  // and the points of three or more photos, for the near bound.
+  std::vector<Eigen::Vector3d> all_points;
+  const size_t k = static_cast<size_t>(options.frustum_near_points);
+  const std::vector<Eigen::Vector3d> multi_view_points =
+      k > 0 ? PointsSeenBy(model, 3) : std::vector<Eigen::Vector3d>();
   for (const auto& [image_id, image] : model.images) {
     const Eigen::Matrix3d R = image.pose.R();
     const Eigen::Vector3d& t = image.pose.translation;
@@ -143,7 +153,8 @@ std::map<int, DepthRange> ComputeDepthRanges(const geometry::SparseModel& model,
     if (static_cast<int>(depths.size()) < options.min_points) {
       // Too few observations (a weakly registered photo): fall back to every
       // model point that projects inside its pinhole view.
-      depths = FrustumDepths(model, image, /*min_track=*/0);
+      if (all_points.empty()) all_points = PointsSeenBy(model, 0);
+      depths = FrustumDepths(all_points, model, image);
       source = "frustum";
     }
     if (static_cast<int>(depths.size()) < options.min_points) {
@@ -151,9 +162,8 @@ std::map<int, DepthRange> ComputeDepthRanges(const geometry::SparseModel& model,
       continue;
     }
     DepthRange r = RangeFromDepths(std::move(depths), options);
-    const size_t k = static_cast<size_t>(options.frustum_near_points);
     if (k > 0 && source == "observed") {
-      std::vector<double> frustum = FrustumDepths(model, image, /*min_track=*/3);
+      std::vector<double> frustum = FrustumDepths(multi_view_points, model, image);
       if (frustum.size() >= k) {
         std::nth_element(frustum.begin(), frustum.begin() + (k - 1), frustum.end());
         const double near_m = std::max(frustum[k - 1] * options.near_margin, r.far_m * options.min_near_over_far);

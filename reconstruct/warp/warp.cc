@@ -7,7 +7,6 @@
 
 #include <Eigen/Core>
 
-
 namespace casual3d::warp {
 namespace {
 
