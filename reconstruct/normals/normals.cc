@@ -15,30 +15,58 @@ namespace {
 
 using Vec3 = Eigen::Vector3f;
 
-// Runs fn(node) for every node of `count` on all cores, a thread for every
-// 4096 nodes at most.
-template <typename Fn>
-void ParallelNodes(size_t count, Fn fn) {
-  constexpr int64_t kGrain = 4096;
-  const int threads =
-      static_cast<int>(std::min<int64_t>(count / kGrain + 1, base::ResolveThreads(0)));
-  base::ParallelFor(0, static_cast<int64_t>(count), threads,
-                    [&](int64_t node) { fn(static_cast<size_t>(node)); }, kGrain);
-}
-
-// The nodes of both layers, numbered layer * n + pixel, with their links as
-// node numbers (-1: none).
+// The nodes of both layers, numbered layer * n + pixel. A node's neighbours
+// are found from its packed links and its column, not stored: at 8192x4096
+// every byte per node is 67 MB. The positions serve the raw normals only,
+// and are freed once those are computed.
 struct NodeGraph {
   int width = 0, height = 0;
   size_t n = 0;  // Pixels.
   std::vector<uint8_t> present;        // 2n.
-  std::vector<int64_t> neighbour;      // 2n * 4, by Direction.
+  std::vector<uint8_t> links;          // 2n: the layer's packed links; 0 at an absent node.
   std::vector<Vec3> position;          // 2n.
-  std::vector<Vec3> ray;               // n: unit direction of the pixel centre.
   std::vector<float> luminance;        // 2n, in [0, 1].
 
-  int64_t next(size_t node, int dir) const { return neighbour[4 * node + dir]; }
+  // The node `node` (at column x) links to in direction `dir`; -1: none.
+  int64_t next(size_t node, int x, int dir) const {
+    const Link link = GetLink(links[node], static_cast<Direction>(dir));
+    if (link == Link::kNone) return -1;
+    const size_t pixel = node >= n ? node - n : node;
+    const size_t w = static_cast<size_t>(width);
+    size_t target = 0;
+    switch (dir) {
+      case kRight: target = x + 1 == width ? pixel - x : pixel + 1; break;
+      case kLeft: target = x == 0 ? pixel + w - 1 : pixel - 1; break;
+      case kDown:
+        if (pixel + w >= n) return -1;
+        target = pixel + w;
+        break;
+      default:  // kUp
+        if (pixel < w) return -1;
+        target = pixel - w;
+        break;
+    }
+    return static_cast<int64_t>((link == Link::kFront ? 0 : n) + target);
+  }
+  // Unit direction of pixel `pixel`'s centre.
+  Vec3 ray(size_t pixel) const {
+    const Vec3d d = EquirectPixelToDirection(static_cast<double>(pixel % width) + 0.5,
+                                             static_cast<double>(pixel / width) + 0.5, width, height);
+    return Vec3(static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z));
+  }
 };
+
+// Runs fn(node, x) for every node of both layers, a row at a time on all
+// cores.
+template <typename Fn>
+void ParallelNodes(const NodeGraph& g, Fn fn) {
+  const int64_t rows = 2 * static_cast<int64_t>(g.height);
+  const int threads = static_cast<int>(std::min<int64_t>(rows, base::ResolveThreads(0)));
+  base::ParallelFor(0, rows, threads, [&](int64_t row) {
+    const size_t first = static_cast<size_t>(row) * g.width;
+    for (int x = 0; x < g.width; ++x) fn(first + x, x);
+  });
+}
 
 NodeGraph BuildGraph(const TwoLayerPanorama& pano) {
   NodeGraph g;
@@ -46,17 +74,9 @@ NodeGraph BuildGraph(const TwoLayerPanorama& pano) {
   g.height = pano.height();
   g.n = static_cast<size_t>(g.width) * g.height;
   g.present.assign(2 * g.n, 0);
-  g.neighbour.assign(8 * g.n, -1);
+  g.links.assign(2 * g.n, 0);
   g.position.assign(2 * g.n, Vec3::Zero());
   g.luminance.assign(2 * g.n, 0.0f);
-  g.ray.resize(g.n);
-  for (int y = 0; y < g.height; ++y) {
-    for (int x = 0; x < g.width; ++x) {
-      const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, g.width, g.height);
-      g.ray[pano.index(x, y)] = Vec3(static_cast<float>(d.x), static_cast<float>(d.y),
-                                     static_cast<float>(d.z));
-    }
-  }
   for (int l = 0; l < kNumLayers; ++l) {
     const LayerData& layer = pano.layer(l);
     for (int y = 0; y < g.height; ++y) {
@@ -65,17 +85,10 @@ NodeGraph BuildGraph(const TwoLayerPanorama& pano) {
         if (!layer.present[i]) continue;
         const size_t node = l * g.n + i;
         g.present[node] = 1;
-        g.position[node] = g.ray[i] * layer.depth_m[i];
+        g.position[node] = g.ray(i) * layer.depth_m[i];
         const uint8_t* c = &layer.rgb[3 * i];
         g.luminance[node] = (0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]) / 255.0f;
-        for (int d = 0; d < kNumDirections; ++d) {
-          const Link link = GetLink(layer.links[i], static_cast<Direction>(d));
-          if (link == Link::kNone) continue;
-          int nx, ny;
-          if (!pano.Neighbour(x, y, static_cast<Direction>(d), &nx, &ny)) continue;
-          const int nl = link == Link::kFront ? kFront : kBack;
-          g.neighbour[4 * node + d] = static_cast<int64_t>(nl * g.n + pano.index(nx, ny));
-        }
+        g.links[node] = layer.links[i];
       }
     }
   }
@@ -84,8 +97,8 @@ NodeGraph BuildGraph(const TwoLayerPanorama& pano) {
 
 // Tangent of the surface along one grid axis from the linked neighbours
 // (central difference where both exist, else one-sided); false if none.
-bool Tangent(const NodeGraph& g, size_t node, int forward, int backward, Vec3* t) {
-  const int64_t f = g.next(node, forward), b = g.next(node, backward);
+bool Tangent(const NodeGraph& g, size_t node, int x, int forward, int backward, Vec3* t) {
+  const int64_t f = g.next(node, x, forward), b = g.next(node, x, backward);
   if (f >= 0 && b >= 0) {
     *t = g.position[f] - g.position[b];
   } else if (f >= 0) {
@@ -105,33 +118,36 @@ Eigen::Matrix3f MinimalRotation(const Vec3& a, const Vec3& b) {
 
 // 1. Forward-difference normals, oriented towards the centre, then smoothed
 // over the link graph (Eq. 5, binary weights):
-// x_i = (w_i x'_i + s sum_j x_j) / (w_i + s deg_i).
-std::vector<Vec3> SmoothBaseNormals(const NodeGraph& g, const NormalOptions& options) {
+// x_i = (w_i x'_i + s sum_j x_j) / (w_i + s deg_i), where w_i is 1 for a node
+// with a raw normal (a unit vector) and 0 for one without (left at zero).
+// Frees the graph's positions.
+std::vector<Vec3> SmoothBaseNormals(NodeGraph* graph, const NormalOptions& options) {
+  const NodeGraph& g = *graph;
   const size_t num_nodes = 2 * g.n;
   std::vector<Vec3> raw(num_nodes, Vec3::Zero());
-  std::vector<float> weight(num_nodes, 0.0f);
-  ParallelNodes(num_nodes, [&](size_t node) {
+  ParallelNodes(g, [&](size_t node, int x) {
     if (!g.present[node]) return;
     Vec3 tu, tv;
-    if (!Tangent(g, node, kRight, kLeft, &tu) || !Tangent(g, node, kDown, kUp, &tv)) return;
+    if (!Tangent(g, node, x, kRight, kLeft, &tu) || !Tangent(g, node, x, kDown, kUp, &tv)) return;
     Vec3 nrm = tu.cross(tv);
     const float len = nrm.norm();
     if (!(len > 0)) return;
     nrm /= len;
     if (nrm.dot(g.position[node]) > 0) nrm = -nrm;
     raw[node] = nrm;
-    weight[node] = 1.0f;
   });
+  graph->position = std::vector<Vec3>();
 
   const float s = static_cast<float>(options.smoothness);
   std::vector<Vec3> base = raw, next(num_nodes, Vec3::Zero());
   for (int it = 0; it < options.iterations; ++it) {
-    ParallelNodes(num_nodes, [&](size_t node) {
+    ParallelNodes(g, [&](size_t node, int x) {
       if (!g.present[node]) return;
-      Vec3 sum = weight[node] * raw[node];
-      float total = weight[node];
+      const float weight = raw[node].isZero() ? 0.0f : 1.0f;
+      Vec3 sum = weight * raw[node];
+      float total = weight;
       for (int d = 0; d < kNumDirections; ++d) {
-        const int64_t j = g.next(node, d);
+        const int64_t j = g.next(node, x, d);
         if (j < 0) continue;
         sum += s * base[j];
         total += s;
@@ -149,12 +165,12 @@ std::vector<float> LowPassLuminance(const NodeGraph& g, int detail_radius) {
   const size_t num_nodes = 2 * g.n;
   std::vector<float> low = g.luminance, low_next(num_nodes, 0.0f);
   for (int it = 0; it < detail_radius; ++it) {
-    ParallelNodes(num_nodes, [&](size_t node) {
+    ParallelNodes(g, [&](size_t node, int x) {
       if (!g.present[node]) return;
       float sum = low[node];
       int count = 1;
       for (int d = 0; d < kNumDirections; ++d) {
-        const int64_t j = g.next(node, d);
+        const int64_t j = g.next(node, x, d);
         if (j >= 0) {
           sum += low[j];
           ++count;
@@ -168,24 +184,23 @@ std::vector<float> LowPassLuminance(const NodeGraph& g, int detail_radius) {
 }
 
 // 3. Combine (Eq. 14 to 16): each node's base normal tilted by the gradient of
-// the luminance detail along the links.
-std::vector<Vec3> CombineWithDetail(const NodeGraph& g, const std::vector<Vec3>& base,
-                                    const std::vector<float>& low, const NormalOptions& options) {
-  const size_t num_nodes = 2 * g.n;
+// the luminance detail along the links, written to the layers' normals.
+void CombineWithDetail(const NodeGraph& g, const std::vector<Vec3>& base,
+                       const std::vector<float>& low, const NormalOptions& options,
+                       TwoLayerPanorama* pano) {
   auto detail = [&](int64_t node) { return g.luminance[node] - low[node]; };
-  auto derivative = [&](size_t node, int forward, int backward) {
-    const int64_t f = g.next(node, forward), b = g.next(node, backward);
+  auto derivative = [&](size_t node, int x, int forward, int backward) {
+    const int64_t f = g.next(node, x, forward), b = g.next(node, x, backward);
     if (f >= 0 && b >= 0) return 0.5f * (detail(f) - detail(b));
     if (f >= 0) return detail(f) - detail(node);
     if (b >= 0) return detail(node) - detail(b);
     return 0.0f;
   };
   const float k = static_cast<float>(options.detail_strength);
-  std::vector<Vec3> result(num_nodes, Vec3::Zero());
-  ParallelNodes(num_nodes, [&](size_t node) {
+  ParallelNodes(g, [&](size_t node, int x) {
     if (!g.present[node]) return;
     const size_t pixel = node % g.n;
-    const Vec3& r = g.ray[pixel];
+    const Vec3 r = g.ray(pixel);
     Vec3 nf = base[node];
     if (!(nf.norm() > 1e-6f)) nf = -r;  // No geometry around: face the centre.
     nf.normalize();
@@ -197,8 +212,8 @@ std::vector<Vec3> CombineWithDetail(const NodeGraph& g, const std::vector<Vec3>&
       const Vec3 east(std::cos(lon), 0.0f, std::sin(lon));
       const Vec3 south(std::sin(lat) * std::sin(lon), -std::cos(lat),
                        -std::sin(lat) * std::cos(lon));
-      const float hx = derivative(node, kRight, kLeft);
-      const float hy = derivative(node, kDown, kUp);
+      const float hx = derivative(node, x, kRight, kLeft);
+      const float hy = derivative(node, x, kDown, kUp);
       // Detail normal in the radial frame R_s: facing the centre, tilted by
       // the height gradient (brighter is nearer).
       const Vec3 ni = (-r - k * hx * east - k * hy * south).normalized();
@@ -206,9 +221,9 @@ std::vector<Vec3> CombineWithDetail(const NodeGraph& g, const std::vector<Vec3>&
       // the base normal, by the minimal rotation (defined for floors too).
       n = (MinimalRotation(-r, nf) * ni).normalized();
     }
-    result[node] = n;
+    float* out = &pano->layer(static_cast<int>(node / g.n)).normal[3 * pixel];
+    for (int c = 0; c < 3; ++c) out[c] = n[c];
   });
-  return result;
 }
 
 // Sky candidates: front nodes beyond `far` whose luminance spread over the
@@ -219,11 +234,12 @@ std::vector<uint8_t> SkyCandidates(const NodeGraph& g, const LayerData& front, f
   std::vector<uint8_t> candidate(g.n, 0);
   for (size_t i = 0; i < g.n; ++i) {
     if (!front.present[i] || front.depth_m[i] < far) continue;
+    const int x = static_cast<int>(i % g.width);
     // Texture: luminance spread over the pixel and its linked neighbours.
     float sum = g.luminance[i], sum2 = sum * sum;
     int count = 1;
     for (int d = 0; d < kNumDirections; ++d) {
-      const int64_t j = g.next(i, d);
+      const int64_t j = g.next(i, x, d);
       if (j < 0) continue;
       sum += g.luminance[j];
       sum2 += g.luminance[j] * g.luminance[j];
@@ -285,23 +301,24 @@ std::vector<uint8_t> DetectSky(const NodeGraph& g, const TwoLayerPanorama& pano,
 NormalStats ComputeNormals(TwoLayerPanorama* pano, const NormalOptions& options) {
   if (const Status st = options.Check(); !st.ok())
     throw std::invalid_argument("normal options: " + st.message());
-  const NodeGraph g = BuildGraph(*pano);
-  const std::vector<Vec3> base = SmoothBaseNormals(g, options);
-  const std::vector<float> low = LowPassLuminance(g, options.detail_radius);
-  const std::vector<Vec3> result = CombineWithDetail(g, base, low, options);
+  NodeGraph g = BuildGraph(*pano);
+  {
+    const std::vector<Vec3> base = SmoothBaseNormals(&g, options);
+    const std::vector<float> low = LowPassLuminance(g, options.detail_radius);
+    CombineWithDetail(g, base, low, options, pano);
+  }
   const std::vector<uint8_t> sky = DetectSky(g, *pano, options);
 
-  // Write the normals; sky nodes are unlit (0, 0, 0).
+  // Sky nodes are unlit (0, 0, 0).
   NormalStats stats;
   for (int l = 0; l < kNumLayers; ++l) {
     LayerData& layer = pano->layer(l);
     for (size_t i = 0; i < g.n; ++i) {
       if (!layer.present[i]) continue;
       ++stats.nodes;
-      const bool unlit = l == kFront && sky[i];
-      stats.sky_nodes += unlit;
-      const Vec3 n = unlit ? Vec3::Zero() : result[l * g.n + i];
-      for (int c = 0; c < 3; ++c) layer.normal[3 * i + c] = n[c];
+      if (l != kFront || !sky[i]) continue;
+      ++stats.sky_nodes;
+      for (int c = 0; c < 3; ++c) layer.normal[3 * i + c] = 0.0f;
     }
   }
   return stats;

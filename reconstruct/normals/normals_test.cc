@@ -1,5 +1,6 @@
 #include "reconstruct/normals/normals.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -140,6 +141,64 @@ TEST(NormalsTest, SkyIsUnlitAndDetailTiltsNormals) {
   ASSERT_GT(tilt_count, 100);
   EXPECT_GT(tilt_sum / tilt_count, 2.0);
   EXPECT_LT(tilt_sum / tilt_count, 30.0);
+}
+
+// A node's neighbours come from its links and its column: across the +-180
+// degree seam and into the back layer too.
+TEST(NormalsTest, NeighboursAcrossTheSeamAndInTheBackLayer) {
+  Room room(false);
+  // The back layer: the room behind the plate.
+  ImageF back_depth(W, H, 1, 0.0f);
+  Image8 back_rgb(W, H, 3, 0);
+  int back_wall = 0;
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, W, H);
+      if (Room::PlateHit(d) < 0) continue;
+      const double tz = 4.0 / std::abs(d.z), tx = 4.0 / std::max(std::abs(d.x), 1e-9);
+      const double ty = d.y < 0 ? 1.5 / -d.y : 1e9;
+      back_depth.at(x, y) = static_cast<float>(std::min({tx, tz, ty}));
+      for (int k = 0; k < 3; ++k) back_rgb.at(x, y, k) = room.rgb.at(0, H / 2, k);
+      back_wall += tz < std::min(tx, ty);
+    }
+  }
+  ASSERT_GT(back_wall, 500);
+  fuse::FuseOptions fuse_options;
+  fuse_options.expansion_fraction = 0;
+  TwoLayerPanorama pano =
+      fuse::Fuse({&room.rgb, &room.depth, &back_rgb, &back_depth, {}}, fuse_options);
+  NormalOptions options;
+  options.detail_strength = 0;
+  ComputeNormals(&pano, options);
+  ASSERT_TRUE(pano.Validate().ok()) << pano.Validate().ToString();
+  // The wall behind the plate, in the back layer, faces +z like the front
+  // wall around it.
+  const LayerData& B = pano.layer(kBack);
+  int back = 0;
+  double worst_back = 0;
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const size_t i = pano.index(x, y);
+      if (!B.present[i]) continue;
+      const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, W, H);
+      const double tz = 4.0 / std::abs(d.z), tx = 4.0 / std::max(std::abs(d.x), 1e-9);
+      const double ty = d.y < 0 ? 1.5 / -d.y : 1e9;
+      // Away from the creases with the floor and the side walls (smoothed,
+      // by design).
+      if (!(tz < 0.95 * tx) || std::abs(std::asin(d.y)) > 10 * kPi / 180) continue;
+      worst_back = std::max(worst_back, AngleDeg(&B.normal[3 * i], 0, 0, 1));
+      ++back;
+    }
+  }
+  ASSERT_GT(back, 300);
+  EXPECT_LT(worst_back, 0.5);
+  // The wall behind the centre, at the seam's columns, faces -z.
+  const LayerData& F = pano.layer(kFront);
+  double worst_seam = 0;
+  for (int y = H / 2 - 14; y < H / 2 + 14; ++y)
+    for (int x : {0, 1, W - 2, W - 1})
+      worst_seam = std::max(worst_seam, AngleDeg(&F.normal[3 * pano.index(x, y)], 0, 0, -1));
+  EXPECT_LT(worst_seam, 0.5);
 }
 
 TEST(NormalsTest, RejectsBadOptions) {

@@ -296,6 +296,10 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
   if (!options.back_layer) fuse_options.expansion_fraction = 0;
   TwoLayerPanorama pano = fuse::Fuse({&front.rgb, &front.depth_m, &back.rgb, &back.depth_m, frame},
                                      fuse_options, &report.fuse);
+  // The stitched layers are in the panorama now; their memory goes to the
+  // normals (at 8192x4096, 600 MB).
+  front = stitch::StitchedLayer();
+  back = stitch::StitchedLayer();
   if (options.seal_tears) {
     report.seal = fuse::SealTears(&pano, options.seal);
     LogSealed(report.seal);
