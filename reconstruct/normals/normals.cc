@@ -116,7 +116,7 @@ Eigen::Matrix3f MinimalRotation(const Vec3& a, const Vec3& b) {
   return Eigen::Quaternionf::FromTwoVectors(a, b).toRotationMatrix();
 }
 
-// 1. Forward-difference normals, oriented towards the centre, then smoothed
+// 1. Normals from the tangents of Tangent(), oriented towards the centre, then smoothed
 // over the link graph (Eq. 5, binary weights):
 // x_i = (w_i x'_i + s sum_j x_j) / (w_i + s deg_i), where w_i is 1 for a node
 // with a raw normal (a unit vector) and 0 for one without (left at zero).
@@ -131,7 +131,9 @@ std::vector<Vec3> SmoothBaseNormals(NodeGraph* graph, const NormalOptions& optio
     if (!Tangent(g, node, x, kRight, kLeft, &tu) || !Tangent(g, node, x, kDown, kUp, &tv)) return;
     Vec3 nrm = tu.cross(tv);
     const float len = nrm.norm();
-    if (!(len > 0)) return;
+    // A raw normal is a unit vector or left zero: the smoothing's weight
+    // below tells them apart by that.
+    if (!(len > 0) || !std::isfinite(len)) return;
     nrm /= len;
     if (nrm.dot(g.position[node]) > 0) nrm = -nrm;
     raw[node] = nrm;

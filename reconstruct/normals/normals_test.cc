@@ -69,6 +69,8 @@ struct Room {
   }
 };
 
+double Length(const float* n) { return std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]); }
+
 double AngleDeg(const float* n, double x, double y, double z) {
   const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   const double c = (n[0] * x + n[1] * y + n[2] * z) / len;
@@ -143,9 +145,9 @@ TEST(NormalsTest, SkyIsUnlitAndDetailTiltsNormals) {
   EXPECT_LT(tilt_sum / tilt_count, 30.0);
 }
 
-// A node's neighbours come from its links and its column: across the +-180
-// degree seam and into the back layer too.
-TEST(NormalsTest, NeighboursAcrossTheSeamAndInTheBackLayer) {
+// Back nodes are linked to back nodes: the wall behind a plate, held in the
+// back layer, gets the wall's normal, not the plate's.
+TEST(NormalsTest, TheBackLayerHasItsOwnSurfaces) {
   Room room(false);
   // The back layer: the room behind the plate.
   ImageF back_depth(W, H, 1, 0.0f);
@@ -186,19 +188,46 @@ TEST(NormalsTest, NeighboursAcrossTheSeamAndInTheBackLayer) {
       // Away from the creases with the floor and the side walls (smoothed,
       // by design).
       if (!(tz < 0.95 * tx) || std::abs(std::asin(d.y)) > 10 * kPi / 180) continue;
+      ASSERT_NEAR(Length(&B.normal[3 * i]), 1.0, 1e-4) << "back node " << x << "," << y;
       worst_back = std::max(worst_back, AngleDeg(&B.normal[3 * i], 0, 0, 1));
       ++back;
     }
   }
   ASSERT_GT(back, 300);
   EXPECT_LT(worst_back, 0.5);
-  // The wall behind the centre, at the seam's columns, faces -z.
+}
+
+// Turning the scene half a turn moves the striped front wall onto the +-180
+// degree seam: its normals, detail included, turn with it, so neighbours
+// across the seam are the ones beside it.
+TEST(NormalsTest, NormalsTurnWithTheSceneAcrossTheSeam) {
+  Room room(true);
+  Room turned(true);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const int from = (x + W / 2) % W;
+      turned.depth.at(x, y) = room.depth.at(from, y);
+      for (int k = 0; k < 3; ++k) turned.rgb.at(x, y, k) = room.rgb.at(from, y, k);
+    }
+  TwoLayerPanorama pano = room.Fused(), pano_turned = turned.Fused();
+  ComputeNormals(&pano, NormalOptions());
+  ComputeNormals(&pano_turned, NormalOptions());
   const LayerData& F = pano.layer(kFront);
-  double worst_seam = 0;
-  for (int y = H / 2 - 14; y < H / 2 + 14; ++y)
-    for (int x : {0, 1, W - 2, W - 1})
-      worst_seam = std::max(worst_seam, AngleDeg(&F.normal[3 * pano.index(x, y)], 0, 0, -1));
-  EXPECT_LT(worst_seam, 0.5);
+  const LayerData& T = pano_turned.layer(kFront);
+  double worst = 0;
+  int seam = 0;
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const int tx = (x + W / 2) % W;  // Where pixel x of `room` is in `turned`.
+      const float* n = &F.normal[3 * pano.index(x, y)];
+      const float* t = &T.normal[3 * pano_turned.index(tx, y)];
+      // Half a turn about the vertical: (x, y, z) -> (-x, y, -z).
+      for (const double e : {-n[0] - t[0], n[1] - t[1], -n[2] - t[2]}) worst = std::max(worst, std::abs(e));
+      seam += (tx == 0 || tx == W - 1) && std::abs(std::asin(EquirectPixelToDirection(x + 0.5, y + 0.5, W, H).y)) < 0.3;
+    }
+  }
+  ASSERT_GT(seam, 80);
+  EXPECT_LT(worst, 1e-3);
 }
 
 TEST(NormalsTest, RejectsBadOptions) {
