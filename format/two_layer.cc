@@ -185,30 +185,6 @@ bool TwoLayerPanorama::NodeDepthRange(double* near_m, double* far_m) const {
   return true;
 }
 
-bool TwoLayerPanorama::Neighbour(int x, int y, Direction d, int* nx, int* ny) const {
-  switch (d) {
-    case kRight:
-      *nx = x + 1 == width_ ? 0 : x + 1;
-      *ny = y;
-      return true;
-    case kLeft:
-      *nx = x == 0 ? width_ - 1 : x - 1;
-      *ny = y;
-      return true;
-    case kDown:
-      if (y + 1 >= height_) return false;
-      *nx = x;
-      *ny = y + 1;
-      return true;
-    case kUp:
-      if (y <= 0) return false;
-      *nx = x;
-      *ny = y - 1;
-      return true;
-  }
-  return false;
-}
-
 template <bool kCheckNodes>
 bool TwoLayerPanorama::ScanIsValid(int num_threads) const {
   const LayerData& front = layers_[kFront];

@@ -108,7 +108,30 @@ class TwoLayerPanorama {
   bool present(int l, int x, int y) const { return layers_[l].present[index(x, y)] != 0; }
 
   // The pixel next to (x, y) in direction d; false past the top or bottom row.
-  bool Neighbour(int x, int y, Direction d, int* nx, int* ny) const;
+  // Inline: the per-node loops of fusion and normals call it for every link.
+  bool Neighbour(int x, int y, Direction d, int* nx, int* ny) const {
+    switch (d) {
+      case kRight:
+        *nx = x + 1 == width_ ? 0 : x + 1;
+        *ny = y;
+        return true;
+      case kLeft:
+        *nx = x == 0 ? width_ - 1 : x - 1;
+        *ny = y;
+        return true;
+      case kDown:
+        if (y + 1 >= height_) return false;
+        *nx = x;
+        *ny = y + 1;
+        return true;
+      case kUp:
+        if (y <= 0) return false;
+        *nx = x;
+        *ny = y - 1;
+        return true;
+    }
+    return false;
+  }
 
   // Smallest and largest depth of the present nodes of both layers (finite
   // ones only); false, leaving both untouched, when there is no such node.

@@ -16,37 +16,25 @@ namespace {
 using Vec3 = Eigen::Vector3f;
 
 // The nodes of both layers, numbered layer * n + pixel. A node's neighbours
-// are found from its packed links and its column, not stored: at 8192x4096
+// are read from the panorama's links when needed, not stored: at 8192x4096
 // every byte per node is 67 MB. The positions serve the raw normals only,
 // and are freed once those are computed.
 struct NodeGraph {
+  const TwoLayerPanorama* pano = nullptr;  // Its links; its normals are the output.
   int width = 0, height = 0;
   size_t n = 0;  // Pixels.
   std::vector<uint8_t> present;        // 2n.
-  std::vector<uint8_t> links;          // 2n: the layer's packed links; 0 at an absent node.
   std::vector<Vec3> position;          // 2n.
   std::vector<float> luminance;        // 2n, in [0, 1].
 
-  // The node `node` (at column x) links to in direction `dir`; -1: none.
-  int64_t next(size_t node, int x, int dir) const {
-    const Link link = GetLink(links[node], static_cast<Direction>(dir));
+  // The node `node`, at pixel (x, y), links to in direction `dir`; -1: none.
+  int64_t next(size_t node, int x, int y, int dir) const {
+    const int layer = node >= n ? kBack : kFront;
+    const Link link = GetLink(pano->layer(layer).links[node - layer * n], static_cast<Direction>(dir));
     if (link == Link::kNone) return -1;
-    const size_t pixel = node >= n ? node - n : node;
-    const size_t w = static_cast<size_t>(width);
-    size_t target = 0;
-    switch (dir) {
-      case kRight: target = x + 1 == width ? pixel - x : pixel + 1; break;
-      case kLeft: target = x == 0 ? pixel + w - 1 : pixel - 1; break;
-      case kDown:
-        if (pixel + w >= n) return -1;
-        target = pixel + w;
-        break;
-      default:  // kUp
-        if (pixel < w) return -1;
-        target = pixel - w;
-        break;
-    }
-    return static_cast<int64_t>((link == Link::kFront ? 0 : n) + target);
+    int nx, ny;
+    if (!pano->Neighbour(x, y, static_cast<Direction>(dir), &nx, &ny)) return -1;
+    return static_cast<int64_t>((link == Link::kFront ? 0 : n) + pano->index(nx, ny));
   }
   // Unit direction of pixel `pixel`'s centre.
   Vec3 ray(size_t pixel) const {
@@ -56,7 +44,7 @@ struct NodeGraph {
   }
 };
 
-// Runs fn(node, x) for every node of both layers, a row at a time on all
+// Runs fn(node, x, y) for every node of both layers, a row at a time on all
 // cores.
 template <typename Fn>
 void ParallelNodes(const NodeGraph& g, Fn fn) {
@@ -64,17 +52,18 @@ void ParallelNodes(const NodeGraph& g, Fn fn) {
   const int threads = static_cast<int>(std::min<int64_t>(rows, base::ResolveThreads(0)));
   base::ParallelFor(0, rows, threads, [&](int64_t row) {
     const size_t first = static_cast<size_t>(row) * g.width;
-    for (int x = 0; x < g.width; ++x) fn(first + x, x);
+    const int y = static_cast<int>(row % g.height);
+    for (int x = 0; x < g.width; ++x) fn(first + x, x, y);
   });
 }
 
 NodeGraph BuildGraph(const TwoLayerPanorama& pano) {
   NodeGraph g;
+  g.pano = &pano;
   g.width = pano.width();
   g.height = pano.height();
   g.n = static_cast<size_t>(g.width) * g.height;
   g.present.assign(2 * g.n, 0);
-  g.links.assign(2 * g.n, 0);
   g.position.assign(2 * g.n, Vec3::Zero());
   g.luminance.assign(2 * g.n, 0.0f);
   for (int l = 0; l < kNumLayers; ++l) {
@@ -88,7 +77,6 @@ NodeGraph BuildGraph(const TwoLayerPanorama& pano) {
         g.position[node] = g.ray(i) * layer.depth_m[i];
         const uint8_t* c = &layer.rgb[3 * i];
         g.luminance[node] = (0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]) / 255.0f;
-        g.links[node] = layer.links[i];
       }
     }
   }
@@ -97,8 +85,8 @@ NodeGraph BuildGraph(const TwoLayerPanorama& pano) {
 
 // Tangent of the surface along one grid axis from the linked neighbours
 // (central difference where both exist, else one-sided); false if none.
-bool Tangent(const NodeGraph& g, size_t node, int x, int forward, int backward, Vec3* t) {
-  const int64_t f = g.next(node, x, forward), b = g.next(node, x, backward);
+bool Tangent(const NodeGraph& g, size_t node, int x, int y, int forward, int backward, Vec3* t) {
+  const int64_t f = g.next(node, x, y, forward), b = g.next(node, x, y, backward);
   if (f >= 0 && b >= 0) {
     *t = g.position[f] - g.position[b];
   } else if (f >= 0) {
@@ -116,8 +104,8 @@ Eigen::Matrix3f MinimalRotation(const Vec3& a, const Vec3& b) {
   return Eigen::Quaternionf::FromTwoVectors(a, b).toRotationMatrix();
 }
 
-// 1. Normals from the tangents of Tangent(), oriented towards the centre, then smoothed
-// over the link graph (Eq. 5, binary weights):
+// 1. Normals from the tangents of Tangent(), oriented towards the centre,
+// then smoothed over the link graph (Eq. 5, binary weights):
 // x_i = (w_i x'_i + s sum_j x_j) / (w_i + s deg_i), where w_i is 1 for a node
 // with a raw normal (a unit vector) and 0 for one without (left at zero).
 // Frees the graph's positions.
@@ -125,10 +113,10 @@ std::vector<Vec3> SmoothBaseNormals(NodeGraph* graph, const NormalOptions& optio
   const NodeGraph& g = *graph;
   const size_t num_nodes = 2 * g.n;
   std::vector<Vec3> raw(num_nodes, Vec3::Zero());
-  ParallelNodes(g, [&](size_t node, int x) {
+  ParallelNodes(g, [&](size_t node, int x, int y) {
     if (!g.present[node]) return;
     Vec3 tu, tv;
-    if (!Tangent(g, node, x, kRight, kLeft, &tu) || !Tangent(g, node, x, kDown, kUp, &tv)) return;
+    if (!Tangent(g, node, x, y, kRight, kLeft, &tu) || !Tangent(g, node, x, y, kDown, kUp, &tv)) return;
     Vec3 nrm = tu.cross(tv);
     const float len = nrm.norm();
     // A raw normal is a unit vector or left zero: the smoothing's weight
@@ -143,13 +131,13 @@ std::vector<Vec3> SmoothBaseNormals(NodeGraph* graph, const NormalOptions& optio
   const float s = static_cast<float>(options.smoothness);
   std::vector<Vec3> base = raw, next(num_nodes, Vec3::Zero());
   for (int it = 0; it < options.iterations; ++it) {
-    ParallelNodes(g, [&](size_t node, int x) {
+    ParallelNodes(g, [&](size_t node, int x, int y) {
       if (!g.present[node]) return;
-      const float weight = raw[node].isZero() ? 0.0f : 1.0f;
+      const float weight = raw[node] == Vec3::Zero() ? 0.0f : 1.0f;
       Vec3 sum = weight * raw[node];
       float total = weight;
       for (int d = 0; d < kNumDirections; ++d) {
-        const int64_t j = g.next(node, x, d);
+        const int64_t j = g.next(node, x, y, d);
         if (j < 0) continue;
         sum += s * base[j];
         total += s;
@@ -167,12 +155,12 @@ std::vector<float> LowPassLuminance(const NodeGraph& g, int detail_radius) {
   const size_t num_nodes = 2 * g.n;
   std::vector<float> low = g.luminance, low_next(num_nodes, 0.0f);
   for (int it = 0; it < detail_radius; ++it) {
-    ParallelNodes(g, [&](size_t node, int x) {
+    ParallelNodes(g, [&](size_t node, int x, int y) {
       if (!g.present[node]) return;
       float sum = low[node];
       int count = 1;
       for (int d = 0; d < kNumDirections; ++d) {
-        const int64_t j = g.next(node, x, d);
+        const int64_t j = g.next(node, x, y, d);
         if (j >= 0) {
           sum += low[j];
           ++count;
@@ -191,15 +179,15 @@ void CombineWithDetail(const NodeGraph& g, const std::vector<Vec3>& base,
                        const std::vector<float>& low, const NormalOptions& options,
                        TwoLayerPanorama* pano) {
   auto detail = [&](int64_t node) { return g.luminance[node] - low[node]; };
-  auto derivative = [&](size_t node, int x, int forward, int backward) {
-    const int64_t f = g.next(node, x, forward), b = g.next(node, x, backward);
+  auto derivative = [&](size_t node, int x, int y, int forward, int backward) {
+    const int64_t f = g.next(node, x, y, forward), b = g.next(node, x, y, backward);
     if (f >= 0 && b >= 0) return 0.5f * (detail(f) - detail(b));
     if (f >= 0) return detail(f) - detail(node);
     if (b >= 0) return detail(node) - detail(b);
     return 0.0f;
   };
   const float k = static_cast<float>(options.detail_strength);
-  ParallelNodes(g, [&](size_t node, int x) {
+  ParallelNodes(g, [&](size_t node, int x, int y) {
     if (!g.present[node]) return;
     const size_t pixel = node % g.n;
     const Vec3 r = g.ray(pixel);
@@ -214,8 +202,8 @@ void CombineWithDetail(const NodeGraph& g, const std::vector<Vec3>& base,
       const Vec3 east(std::cos(lon), 0.0f, std::sin(lon));
       const Vec3 south(std::sin(lat) * std::sin(lon), -std::cos(lat),
                        -std::sin(lat) * std::cos(lon));
-      const float hx = derivative(node, x, kRight, kLeft);
-      const float hy = derivative(node, x, kDown, kUp);
+      const float hx = derivative(node, x, y, kRight, kLeft);
+      const float hy = derivative(node, x, y, kDown, kUp);
       // Detail normal in the radial frame R_s: facing the centre, tilted by
       // the height gradient (brighter is nearer).
       const Vec3 ni = (-r - k * hx * east - k * hy * south).normalized();
@@ -236,12 +224,12 @@ std::vector<uint8_t> SkyCandidates(const NodeGraph& g, const LayerData& front, f
   std::vector<uint8_t> candidate(g.n, 0);
   for (size_t i = 0; i < g.n; ++i) {
     if (!front.present[i] || front.depth_m[i] < far) continue;
-    const int x = static_cast<int>(i % g.width);
+    const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
     // Texture: luminance spread over the pixel and its linked neighbours.
     float sum = g.luminance[i], sum2 = sum * sum;
     int count = 1;
     for (int d = 0; d < kNumDirections; ++d) {
-      const int64_t j = g.next(i, x, d);
+      const int64_t j = g.next(i, x, y, d);
       if (j < 0) continue;
       sum += g.luminance[j];
       sum2 += g.luminance[j] * g.luminance[j];

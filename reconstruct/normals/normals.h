@@ -3,9 +3,10 @@
 // Normal maps for lighting effects (paper Sec. 5, Fig. 11): plausible rather
 // than exact normals, computed on the fused two-layer graph.
 //   1. Base normals: central differences of the nodes' 3D positions along
-//      links only (one-sided where a link is missing), then smoothed by the linear system of Eq. 5 with data
-//      constraints everywhere and binary smoothness weights (1 across a link,
-//      0 across a depth discontinuity), solved by Jacobi iterations.
+//      links only (one-sided where a link is missing), then smoothed by the
+//      linear system of Eq. 5 with data constraints everywhere and binary
+//      smoothness weights (1 across a link, 0 across a depth discontinuity),
+//      solved by Jacobi iterations.
 //   2. Detail normals hallucinated from luminance (Khan et al. 2006: brighter
 //      is nearer): the high-pass luminance is a height field whose gradient
 //      tilts a normal facing the centre.

@@ -184,7 +184,6 @@ TEST(NormalsTest, TheBackLayerHasItsOwnSurfaces) {
       if (!B.present[i]) continue;
       const Vec3d d = EquirectPixelToDirection(x + 0.5, y + 0.5, W, H);
       const double tz = 4.0 / std::abs(d.z), tx = 4.0 / std::max(std::abs(d.x), 1e-9);
-      const double ty = d.y < 0 ? 1.5 / -d.y : 1e9;
       // Away from the creases with the floor and the side walls (smoothed,
       // by design).
       if (!(tz < 0.95 * tx) || std::abs(std::asin(d.y)) > 10 * kPi / 180) continue;

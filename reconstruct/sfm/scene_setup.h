@@ -43,11 +43,11 @@ struct DepthRangeOptions {
   // Near bounds are clamped to at least this fraction of the far bound, which
   // keeps the inverse-depth sweep finite when a point lies at the lens.
   double min_near_over_far = 1e-3;  // Range (0, 1).
-  // A photo's near bound (of an "observed" range) is also at most near_margin times the depth of the
-  // k-th nearest model point that at least 3 photos observe and that projects
-  // inside the photo (k this many): a near object that other photos'
-  // matches found and this photo's missed (at the edge of its view, say)
-  // stays inside its sweep. 0 disables.
+  // A photo's near bound (of an "observed" range) is also at most
+  // near_margin times the depth of the k-th nearest model point that at
+  // least 3 photos observe and that projects inside the photo (k this many):
+  // a near object that other photos' matches found and this photo's missed
+  // (at the edge of its view, say) stays inside its sweep. 0 disables.
   int frustum_near_points = 5;  // Range [0, 1000].
 
   // Names the first field out of range.
