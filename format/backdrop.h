@@ -21,12 +21,15 @@
 // every node it covers: seen from the centre it is hidden wherever the mesh
 // has a surface, and it only shows through the mesh's openings.
 //
-// Colour (Mesh::colors, interpolated across each triangle): a vertex takes the
-// colour of the cell its depth came from, the mean colour of that cell's
-// nodes within 5% of its largest depth: the background's colour, continued
-// behind the foreground as far as its depth is (a blurred fill, as an
-// inpainting would give, never the foreground's texture at the background's
-// depth). Vertex uvs point into the back half of the colour atlas at the
+// Colour (Mesh::colors, interpolated across each triangle): each cell's
+// colour is the mean colour of its nodes within 5% of its largest depth; a
+// vertex takes the mean of those colours over the cells within
+// max(1, r / 4) of its own cell, each weighted by the fourth power of its
+// largest depth, clipped to 1.5 times the mean largest depth of the other
+// cells within that distance of it: a blurred fill in the colour of the
+// farther surfaces around the vertex, as an inpainting would give, which a
+// few far outliers of a noisy capture do not take over.
+// Vertex uvs point into the back half of the colour atlas at the
 // vertex's pixel (for readers that can only texture; format/color_atlas.h).
 // Normals are (0, 0, 0): the backdrop is unlit.
 //

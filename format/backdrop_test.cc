@@ -118,9 +118,46 @@ TEST(BackdropTest, LiesBehindEveryNodeItCoversAndIsWoundLikeTheMesh) {
   }
 }
 
+// A wall (depth 4, red) with one cell of far outliers (depth 40, blue), as a
+// real capture's noisy depth leaves them: the backdrop lies behind the
+// outliers (depth, as every node it covers), but their colour no longer
+// paints every vertex within reach; the wall's colour stays.
+TEST(BackdropTest, AFewFarOutliersDoNotColourTheirWindow) {
+  TwoLayerPanorama p(128, 64);
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 128; ++x) {
+      const bool outlier = x >= 60 && x < 64 && y >= 28 && y < 32;
+      const size_t i = p.index(x, y);
+      p.layer(kFront).present[i] = 1;
+      p.layer(kFront).depth_m[i] = outlier ? 40.0f : 4.0f;
+      p.layer(kFront).rgb[3 * i + (outlier ? 2 : 0)] = 200;
+    }
+  }
+  BackdropOptions o;
+  o.cell_px = 4;
+  o.spread_px = 32;  // Reach: 1 + 8 cells; colour from 2 cells around.
+  auto m = BuildBackdrop(p, o);
+  ASSERT_TRUE(m.ok());
+  int within_reach = 0;
+  for (size_t v = 0; v < m->num_vertices(); ++v) {
+    const int x = static_cast<int>(std::lround(m->uvs[2 * v] * 128 - 0.5));
+    const int y = static_cast<int>(std::lround((m->uvs[2 * v + 1] * 2 - 1) * 64 - 0.5));
+    if (std::abs(x - 60) > 12 || std::abs(y - 28) > 12) continue;
+    ++within_reach;
+    EXPECT_NEAR(Norm(&m->positions[3 * v]), 40.0 * 1.02, 1e-3) << x << ", " << y;
+    // The outlier's cell weighs at most 1.5^4 times a wall cell: less than
+    // a fifth of the 25 cells' weight where it is in a vertex's window.
+    EXPECT_GE(m->colors[3 * v], 150) << x << ", " << y;
+    EXPECT_LE(m->colors[3 * v + 2], 50) << x << ", " << y;
+  }
+  EXPECT_EQ(within_reach, 49);
+}
+
 // A near square (depth 1, green) in front of a far wall (depth 4, red): the
-// backdrop takes the wall's depth and colour behind the square's rim, as far
-// as the spread reaches, and the square's own further inside.
+// backdrop takes the wall's depth behind the square's rim, as far as the
+// spread reaches, and the square's own further inside. Its colour is the
+// wall's at the rim, and inside the square the square's: the surface it shows
+// through there, where a sheet of the square is left out.
 TEST(BackdropTest, TheBackgroundSpreadsBehindTheForeground) {
   TwoLayerPanorama p(128, 64);
   for (int y = 0; y < 64; ++y) {
@@ -134,7 +171,7 @@ TEST(BackdropTest, TheBackgroundSpreadsBehindTheForeground) {
   }
   BackdropOptions o;
   o.cell_px = 4;
-  o.spread_px = 8;  // Reach: 1 + 2 cells.
+  o.spread_px = 8;  // Reach: 1 + 2 cells; colour from 1 cell around.
   auto m = BuildBackdrop(p, o);
   ASSERT_TRUE(m.ok());
   auto vertex_at = [&](int x, int y) -> size_t {
@@ -145,11 +182,18 @@ TEST(BackdropTest, TheBackgroundSpreadsBehindTheForeground) {
     ADD_FAILURE() << "no vertex at " << x << ", " << y;
     return 0;
   };
-  // Inside the square by 8 pixels (2 cells, within reach): the wall.
-  size_t v = vertex_at(40, 32);
+  // On the square's edge: the wall's depth, and its colour with at most a
+  // twentieth of the square's (a wall cell weighs (4 / 1)^4 times more).
+  size_t v = vertex_at(32, 32);
   EXPECT_NEAR(Norm(&m->positions[3 * v]), 4.0 * 1.02, 1e-4);
-  EXPECT_EQ(m->colors[3 * v], 200);
-  EXPECT_EQ(m->colors[3 * v + 1], 0);
+  EXPECT_GE(m->colors[3 * v], 190);
+  EXPECT_LE(m->colors[3 * v + 1], 10);
+  // Inside the square by 8 pixels (2 cells, within reach): the wall's depth,
+  // the square's colour.
+  v = vertex_at(40, 32);
+  EXPECT_NEAR(Norm(&m->positions[3 * v]), 4.0 * 1.02, 1e-4);
+  EXPECT_EQ(m->colors[3 * v], 0);
+  EXPECT_EQ(m->colors[3 * v + 1], 200);
   // 16 pixels inside (4 cells, beyond reach): the square itself.
   v = vertex_at(48, 32);
   EXPECT_NEAR(Norm(&m->positions[3 * v]), 1.0 * 1.02, 1e-5);

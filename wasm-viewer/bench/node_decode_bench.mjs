@@ -22,7 +22,7 @@ import path from 'node:path';
 
 import { loadFormatModule, runTool } from '../test/node-support.mjs';
 import { readPackageLevel } from '../test/node-package.mjs';
-import { simplifyMaxError } from '../js/mesh-error.js';
+import { backdropCell, simplifyMaxError } from '../js/mesh-error.js';
 
 const repeats = Number(process.argv[3] ?? 3);
 const level = Number(process.argv[4] ?? 0);
@@ -64,7 +64,7 @@ try {
   };
   // As the viewer's worker: the simplifier's error beyond the depth code's step.
   const simplifyError = simplifyMaxError(JSON.parse(fs.readFileSync(path.join(pkg, 'manifest.json'), 'utf8')).depth_encoding);
-  let full = 0, simplified = 0, bound = 0;
+  let full = 0, simplified = 0, bound = 0, backdrop = 0;
   for (let r = 0; r < repeats; ++r) {
     const { pano, timing, cpu } = await readPackageLevel(format, pkg, level);
     for (const k of Object.keys(timing)) keep(k, timing[k], cpu[k]);
@@ -76,6 +76,11 @@ try {
     mesh = null;
     [, wall, c] = measure(() => pano.atlas());
     keep('atlasMs', wall, c);
+    // As the viewer's worker: the backdrop's cell from the level's size and the budget.
+    [mesh, wall, c] = measure(() => format.buildBackdrop(pano, { cellPx: backdropCell(pano.width, pano.height, MAX_TRIANGLES) }));
+    keep('backdropMs', wall, c);
+    backdrop = mesh.indices.length / 3;
+    mesh = null;
     [mesh, wall, c] = measure(() => format.buildMesh(pano));
     keep('meshFullMs', wall, c);
     full = mesh.indices.length / 3;
@@ -92,8 +97,9 @@ try {
     ['assemble: FinishDecodedPanorama + Validate (wasm)', ['finishMs']],
     [`simplified mesh, ${MAX_TRIANGLES / 1e6} M budget, copied out (${simplified} triangles)`, ['meshSimplifiedMs']],
     ['colour atlas, copied out', ['atlasMs']],
+    [`backdrop, copied out (${backdrop} triangles)`, ['backdropMs']],
     [`full mesh, copied out (${full} triangles)`, ['meshFullMs']],
-    ['viewer path: check + decode + unpack + assemble + simplified mesh + atlas', ['checkMs', 'decodeMs', 'addMs', 'finishMs', 'meshSimplifiedMs', 'atlasMs']],
+    ['viewer path: check + decode + unpack + assemble + simplified mesh + atlas + backdrop', ['checkMs', 'decodeMs', 'addMs', 'finishMs', 'meshSimplifiedMs', 'atlasMs', 'backdropMs']],
     ['wasm format library only: check + unpack + assemble + simplified mesh', ['checkMs', 'addMs', 'finishMs', 'meshSimplifiedMs']],
     ['wasm format library only, full mesh: check + unpack + assemble + full mesh', ['checkMs', 'addMs', 'finishMs', 'meshFullMs']],
   ];
@@ -112,7 +118,7 @@ try {
     threads: format.numThreads,
     ms: Object.fromEntries(Object.entries(best).map(([k, v]) => [k, { wall: Math.round(v.wall), cpu: Math.round(v.cpu) }])),
     firstRunMs: Object.fromEntries(Object.entries(first).map(([k, v]) => [k, { wall: Math.round(v.wall), cpu: Math.round(v.cpu) }])),
-    triangles: { full, simplified, relativeErrorBound: bound },
+    triangles: { full, simplified, backdrop, relativeErrorBound: bound },
     repeats,
   }));
 } finally {

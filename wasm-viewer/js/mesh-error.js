@@ -1,5 +1,6 @@
-// How far the viewer's simplified mesh may stray from a package's decoded
-// depth (format/mesh_simplify.h, max_relative_error).
+// How the viewer bounds its meshes: how far the simplified mesh may stray
+// from a package's decoded depth (format/mesh_simplify.h, max_relative_error),
+// and how coarse the backdrop's cells are (format/backdrop.h).
 
 /** Relative depth error the viewer allows the simplifier beyond the depth code's own step. */
 export const SIMPLIFY_ERROR = 0.01;
@@ -29,4 +30,18 @@ export function depthCodeStep(depthEncoding) {
  */
 export function simplifyMaxError(depthEncoding) {
   return Math.min(0.5, SIMPLIFY_ERROR + depthCodeStep(depthEncoding));
+}
+
+/**
+ * The backdrop's cell side for a level: the library's default (0) unless a
+ * backdrop over the whole sphere would then exceed a quarter of the triangle
+ * budget, in which case the smallest cell that keeps it within.
+ */
+export function backdropCell(width, height, maxTriangles) {
+  const defaultCell = Math.max(1, Math.round(width / 1024));
+  const fullSphere = (cell) => 2 * Math.ceil(width / cell) * Math.ceil(height / cell);
+  if (!(maxTriangles > 0) || fullSphere(defaultCell) <= maxTriangles / 4) return 0;
+  let cell = defaultCell;
+  while (fullSphere(cell) > maxTriangles / 4 && cell < 256) ++cell;
+  return cell;
 }

@@ -28,7 +28,7 @@
 import { FormatModule } from './format-module.js';
 import { Casual3dPackage } from './format.js';
 import { openUrl } from './package-source.js';
-import { simplifyMaxError } from './mesh-error.js';
+import { backdropCell, simplifyMaxError } from './mesh-error.js';
 import { decodeImage } from './tile-decoder.js';
 import { buildEnvironment } from './environment.js';
 import { deriveViewHints, narrowContent, parseViewHints, presenceFromMesh } from './view-hints.js';
@@ -202,20 +202,6 @@ async function load({ id, url, maxLevelWidth, maxTriangles, backdrop: withBackdr
   } finally {
     pkg.close();
   }
-}
-
-/**
- * The backdrop's cell side for a level: the library's default (0) unless a
- * backdrop over the whole sphere would then exceed a quarter of the triangle
- * budget, in which case the smallest cell that keeps it within.
- */
-function backdropCell(width, height, maxTriangles) {
-  const defaultCell = Math.max(1, Math.round(width / 1024));
-  const fullSphere = (cell) => 2 * Math.ceil(width / cell) * Math.ceil(height / cell);
-  if (!(maxTriangles > 0) || fullSphere(defaultCell) <= maxTriangles / 4) return 0;
-  let cell = defaultCell;
-  while (fullSphere(cell) > maxTriangles / 4 && cell < 256) ++cell;
-  return cell;
 }
 
 /**
