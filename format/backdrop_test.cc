@@ -118,21 +118,28 @@ TEST(BackdropTest, LiesBehindEveryNodeItCoversAndIsWoundLikeTheMesh) {
   }
 }
 
+// A 128x64 front layer: a wall at depth 4 in red (200, 0, 0), with the patch
+// [x0, x1) x [y0, y1) at `depth` in 200 of colour channel `channel`.
+TwoLayerPanorama WallWithPatch(int x0, int x1, int y0, int y1, float depth, int channel) {
+  TwoLayerPanorama p(128, 64);
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 128; ++x) {
+      const bool patch = x >= x0 && x < x1 && y >= y0 && y < y1;
+      const size_t i = p.index(x, y);
+      p.layer(kFront).present[i] = 1;
+      p.layer(kFront).depth_m[i] = patch ? depth : 4.0f;
+      p.layer(kFront).rgb[3 * i + (patch ? channel : 0)] = 200;
+    }
+  }
+  return p;
+}
+
 // A wall (depth 4, red) with one cell of far outliers (depth 40, blue), as a
 // real capture's noisy depth leaves them: the backdrop lies behind the
 // outliers (depth, as every node it covers), but their colour no longer
 // paints every vertex within reach; the wall's colour stays.
 TEST(BackdropTest, AFewFarOutliersDoNotColourTheirWindow) {
-  TwoLayerPanorama p(128, 64);
-  for (int y = 0; y < 64; ++y) {
-    for (int x = 0; x < 128; ++x) {
-      const bool outlier = x >= 60 && x < 64 && y >= 28 && y < 32;
-      const size_t i = p.index(x, y);
-      p.layer(kFront).present[i] = 1;
-      p.layer(kFront).depth_m[i] = outlier ? 40.0f : 4.0f;
-      p.layer(kFront).rgb[3 * i + (outlier ? 2 : 0)] = 200;
-    }
-  }
+  const TwoLayerPanorama p = WallWithPatch(60, 64, 28, 32, 40.0f, 2);
   BackdropOptions o;
   o.cell_px = 4;
   o.spread_px = 32;  // Reach: 1 + 8 cells; colour from 2 cells around.
@@ -159,16 +166,7 @@ TEST(BackdropTest, AFewFarOutliersDoNotColourTheirWindow) {
 // wall's at the rim, and inside the square the square's: the surface it shows
 // through there, where a sheet of the square is left out.
 TEST(BackdropTest, TheBackgroundSpreadsBehindTheForeground) {
-  TwoLayerPanorama p(128, 64);
-  for (int y = 0; y < 64; ++y) {
-    for (int x = 0; x < 128; ++x) {
-      const bool near = x >= 32 && x < 96 && y >= 8 && y < 56;
-      const size_t i = p.index(x, y);
-      p.layer(kFront).present[i] = 1;
-      p.layer(kFront).depth_m[i] = near ? 1.0f : 4.0f;
-      p.layer(kFront).rgb[3 * i + (near ? 1 : 0)] = 200;
-    }
-  }
+  const TwoLayerPanorama p = WallWithPatch(32, 96, 8, 56, 1.0f, 1);
   BackdropOptions o;
   o.cell_px = 4;
   o.spread_px = 8;  // Reach: 1 + 2 cells; colour from 1 cell around.
