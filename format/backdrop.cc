@@ -106,93 +106,81 @@ std::vector<size_t> SpreadFar(const Cells& cells, int r) {
 
 // Replaces `values` (`channels` interleaved per cell) by their sums over the
 // square window of `r` cells around each cell (columns wrap, rows stop at the
-// edges), by two separable running sums in a fixed order: exact for integers,
-// and the same doubles in the Emscripten build.
-template <typename T>
-void BoxSums(int nx, int ny, int channels, int r, std::vector<T>* values) {
+// edges), by two separable passes that add each window's values in the same
+// order: the same doubles in the Emscripten build, and no cancellation where a
+// large value leaves a window of small ones (as running sums would have).
+// O(r) per cell and channel.
+void BoxSums(int nx, int ny, int channels, int r, std::vector<double>* values) {
   const size_t ch = static_cast<size_t>(channels);
   const size_t row_len = static_cast<size_t>(nx) * ch;
   const int left = std::min(r, nx / 2), right = std::min(r, (nx - 1) / 2);
-  auto wrap = [nx](int x) { return static_cast<size_t>((x % nx + nx) % nx); };
-  std::vector<T> rows(values->size());
-  std::vector<T> in(row_len);
-  T sum[4];
+  std::vector<double> rows(values->size(), 0.0);
   for (int y = 0; y < ny; ++y) {
-    std::copy_n(values->begin() + static_cast<ptrdiff_t>(y * row_len), row_len, in.begin());
-    T* out = &rows[static_cast<size_t>(y) * row_len];
-    for (size_t k = 0; k < ch; ++k) sum[k] = T{0};
-    for (int d = -left; d <= right; ++d) {
-      for (size_t k = 0; k < ch; ++k) sum[k] += in[wrap(d) * ch + k];
-    }
+    const double* in = &(*values)[static_cast<size_t>(y) * row_len];
+    double* out = &rows[static_cast<size_t>(y) * row_len];
     for (int x = 0; x < nx; ++x) {
-      for (size_t k = 0; k < ch; ++k) out[x * ch + k] = sum[k];
-      const size_t add = wrap(x + right + 1) * ch, drop = wrap(x - left) * ch;
-      for (size_t k = 0; k < ch; ++k) sum[k] += in[add + k] - in[drop + k];
+      for (int d = -left; d <= right; ++d) {
+        const size_t from = static_cast<size_t>(((x + d) % nx + nx) % nx) * ch;
+        for (size_t k = 0; k < ch; ++k) out[x * ch + k] += in[from + k];
+      }
     }
-  }
-  std::vector<T>& column = in;
-  std::fill(column.begin(), column.end(), T{0});
-  for (int k = 0; k <= std::min(r, ny - 1); ++k) {
-    const T* add = &rows[static_cast<size_t>(k) * row_len];
-    for (size_t i = 0; i < row_len; ++i) column[i] += add[i];
   }
   for (int y = 0; y < ny; ++y) {
-    std::copy(column.begin(), column.end(), values->begin() + static_cast<ptrdiff_t>(y * row_len));
-    if (y + r + 1 < ny) {
-      const T* add = &rows[static_cast<size_t>(y + r + 1) * row_len];
-      for (size_t i = 0; i < row_len; ++i) column[i] += add[i];
-    }
-    if (y - r >= 0) {
-      const T* drop = &rows[static_cast<size_t>(y - r) * row_len];
-      for (size_t i = 0; i < row_len; ++i) column[i] -= drop[i];
+    double* out = &(*values)[static_cast<size_t>(y) * row_len];
+    std::fill(out, out + row_len, 0.0);
+    for (int k = std::max(0, y - r); k <= std::min(ny - 1, y + r); ++k) {
+      const double* in = &rows[static_cast<size_t>(k) * row_len];
+      for (size_t i = 0; i < row_len; ++i) out[i] += in[i];
     }
   }
 }
 
-// The backdrop's colour around each cell: the mean colour of the cells
-// within `r`, each weighted by the fourth power of its far depth, that depth
-// first clipped to 1.5 times the mean far depth of the other cells within `r`
-// of it. Farther surfaces outweigh nearer ones (twice as far, 16 times the
-// weight), so the colour is the background's where the window holds some;
-// one cell of far outliers (the noisy depth of a real capture) weighs at most
-// 1.5^4 = 5 times a cell of the surface around it. A blurred fill that
-// follows the surface it shows through, as an inpainting would give. Weights
-// are integers (2^24 for the farthest clipped depth, at least 1), so the sums
-// are exact and the same in every build.
+// The backdrop's colour around each cell: the mean colour of the cells with
+// nodes within `r`, each weighted by (f / F)^4, where f is its far depth
+// clipped to 1.5 times the mean far depth of the other cells with nodes
+// within `r` of it (unclipped without such cells) and F the largest f. Farther
+// surfaces outweigh nearer ones (twice as far, 16 times the weight), so the
+// colour is the background's where the window holds some; one cell of far
+// outliers (the noisy depth of a real capture) weighs at most 1.5^4 = 5
+// times a cell of the surface around it. A blurred fill that follows the
+// surface it shows through, as an inpainting would give. Cells whose far
+// depth is not finite take no part.
 std::vector<uint8_t> BlurredFarColors(const Cells& cells, int r) {
   const int nx = cells.nx, ny = cells.ny;
   const size_t n = cells.far.size();
   constexpr double kClip = 1.5;
-  constexpr double kUnit = 16777216.0;  // 2^24: 2^24 * 255 * (2 * 4097)^2 < 2^63.
-  std::vector<double> mean(n);
-  std::vector<int32_t> count(n);
+  auto measured = [&](size_t c) { return cells.far[c] > 0.0f && std::isfinite(cells.far[c]); };
+  std::vector<double> local(2 * n, 0.0);  // Far depth and count, then their window sums.
   for (size_t c = 0; c < n; ++c) {
-    mean[c] = cells.far[c];
-    count[c] = cells.far[c] > 0.0f ? 1 : 0;
+    if (!measured(c)) continue;
+    local[2 * c] = cells.far[c];
+    local[2 * c + 1] = 1.0;
   }
-  BoxSums(nx, ny, 1, r, &mean);
-  BoxSums(nx, ny, 1, r, &count);
+  BoxSums(nx, ny, 2, r, &local);
+  std::vector<double> clipped(n, 0.0);
   double farthest = 0.0;
   for (size_t c = 0; c < n; ++c) {
-    // mean[c] becomes the cell's clipped far depth (0 without nodes).
-    const double far = cells.far[c];
-    mean[c] = far <= 0.0 ? 0.0 : count[c] > 1 ? std::min(far, kClip * (mean[c] - far) / (count[c] - 1)) : far;
-    farthest = std::max(farthest, mean[c]);
+    if (!measured(c)) continue;
+    const double far = cells.far[c], others = local[2 * c + 1] - 1.0;
+    clipped[c] = others > 0.0 ? std::min(far, kClip * (local[2 * c] - far) / others) : far;
+    farthest = std::max(farthest, clipped[c]);
   }
-  std::vector<int64_t> weighted(4 * n, 0);
+  std::vector<double> weighted(4 * n, 0.0);
   for (size_t c = 0; c < n; ++c) {
-    if (mean[c] <= 0.0) continue;
-    const double f = mean[c] / farthest;
-    const int64_t w = std::max<int64_t>(1, static_cast<int64_t>(f * f * f * f * kUnit));
+    if (!measured(c)) continue;
+    const double f = clipped[c] / farthest;
+    const double w = (f * f) * (f * f);
     for (int k = 0; k < 3; ++k) weighted[4 * c + k] = w * cells.rgb[3 * c + k];
     weighted[4 * c + 3] = w;
   }
   BoxSums(nx, ny, 4, r, &weighted);
   std::vector<uint8_t> rgb(3 * n, 0);
   for (size_t c = 0; c < n; ++c) {
-    const int64_t w = weighted[4 * c + 3];
-    if (w <= 0) continue;
-    for (int k = 0; k < 3; ++k) rgb[3 * c + k] = static_cast<uint8_t>((weighted[4 * c + k] + w / 2) / w);
+    const double w = weighted[4 * c + 3];
+    if (!(w > 0.0)) continue;
+    for (int k = 0; k < 3; ++k) {
+      rgb[3 * c + k] = static_cast<uint8_t>(std::clamp(std::floor(weighted[4 * c + k] / w + 0.5), 0.0, 255.0));
+    }
   }
   return rgb;
 }
@@ -236,9 +224,10 @@ StatusOr<Mesh> BuildBackdrop(const TwoLayerPanorama& pano, const BackdropOptions
   const std::vector<float>& far = cells.far;
   const int reach = 1 + (BackdropSpreadPixels(options, w) + cell - 1) / cell;
   const std::vector<size_t> source = SpreadFar(cells, reach);
-  // Colour from a quarter of the reach: the surface around the vertex, which
-  // the backdrop shows through where a sheet between its nodes is left out.
-  const std::vector<uint8_t> colors = BlurredFarColors(cells, std::max(1, reach / 4));
+  // Colour from a quarter of the reach (at most 16 cells): the surface around
+  // the vertex, which the backdrop shows through where a sheet between its
+  // nodes is left out.
+  const std::vector<uint8_t> colors = BlurredFarColors(cells, std::clamp(reach / 4, 1, 16));
 
   // Vertex grid: columns 0..cells_x (column cells_x is the seam copy of
   // column 0, at pixel x = w), rows 0..rows-1 at pixel y = j * cell.

@@ -23,12 +23,12 @@
 //
 // Colour (Mesh::colors, interpolated across each triangle): each cell's
 // colour is the mean colour of its nodes within 5% of its largest depth; a
-// vertex takes the mean of those colours over the cells within
-// max(1, r / 4) of its own cell, each weighted by the fourth power of its
-// largest depth, clipped to 1.5 times the mean largest depth of the other
-// cells within that distance of it: a blurred fill in the colour of the
-// farther surfaces around the vertex, as an inpainting would give, which a
-// few far outliers of a noisy capture do not take over.
+// vertex takes the mean of those colours over the cells with nodes within
+// q = min(16, max(1, r / 4)) of its own cell, each weighted by (f / F)^4: f
+// the cell's largest depth, clipped to 1.5 times the mean largest depth of
+// the other cells with nodes within q of it, F the largest f. A blurred fill
+// in the colour of the farther surfaces around the vertex, as an inpainting
+// would give, which a few far outliers of a noisy capture do not take over.
 // Vertex uvs point into the back half of the colour atlas at the
 // vertex's pixel (for readers that can only texture; format/color_atlas.h).
 // Normals are (0, 0, 0): the backdrop is unlit.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "format/mesh_builder.h"
 #include "format/testing/test_panoramas.h"
@@ -54,7 +55,7 @@ TEST(BackdropTest, RefusesBadOptionsAndTooSmallPanoramas) {
 
 // Every quad lies behind every node of the pixels it covers, by the depth
 // factor, and is wound like the mesh; its uvs point into the atlas's back
-// half, and its colours are the back half's.
+// half.
 TEST(BackdropTest, LiesBehindEveryNodeItCoversAndIsWoundLikeTheMesh) {
   TwoLayerPanorama p = MakeRoomPanorama(64, 32);
   // A few back nodes farther than the front, and some pixels left empty.
@@ -197,6 +198,32 @@ TEST(BackdropTest, TheBackgroundSpreadsBehindTheForeground) {
   EXPECT_NEAR(Norm(&m->positions[3 * v]), 1.0 * 1.02, 1e-5);
   EXPECT_EQ(m->colors[3 * v], 0);
   EXPECT_EQ(m->colors[3 * v + 1], 200);
+}
+
+// The same square and wall with the sky elsewhere: a block of nodes 1000
+// times farther (the depth sky pixels get) and one node at +infinity (an
+// invalid depth, which takes no part in the colour). The weights stay
+// relative: the wall's colour still wins at the square's rim.
+TEST(BackdropTest, FarSkyElsewhereLeavesTheRimTheWallsColour) {
+  TwoLayerPanorama p = WallWithPatch(32, 96, 8, 56, 1.0f, 1);
+  for (int y = 56; y < 64; ++y) {
+    for (int x = 104; x < 112; ++x) p.layer(kFront).depth_m[p.index(x, y)] = 4000.0f;
+  }
+  p.layer(kFront).depth_m[p.index(4, 4)] = std::numeric_limits<float>::infinity();
+  BackdropOptions o;
+  o.cell_px = 4;
+  o.spread_px = 8;
+  auto m = BuildBackdrop(p, o);
+  ASSERT_TRUE(m.ok());
+  bool found = false;
+  for (size_t v = 0; v < m->num_vertices(); ++v) {
+    if (std::lround(m->uvs[2 * v] * 128 - 0.5) != 32 || std::lround((m->uvs[2 * v + 1] * 2 - 1) * 64 - 0.5) != 32)
+      continue;
+    found = true;
+    EXPECT_GE(m->colors[3 * v], 190);
+    EXPECT_LE(m->colors[3 * v + 1], 10);
+  }
+  EXPECT_TRUE(found);
 }
 
 TEST(BackdropTest, AFullSphereIsClosedAcrossTheSeam) {

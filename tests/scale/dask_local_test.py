@@ -113,11 +113,16 @@ def main():
 
     start([scheduler_cmd, "--host", "127.0.0.1", "--port", "0", "--no-dashboard", "--scheduler-file", sched_file],
           "scheduler.log")
-    for _ in range(200):
-        if sched_file.exists():
+    # The scheduler writes its file in place: wait until it parses, not only exists.
+    address = None
+    for _ in range(300):
+        try:
+            address = json.loads(sched_file.read_text())["address"]
             break
-        time.sleep(0.1)
-    address = json.loads(sched_file.read_text())["address"]
+        except (OSError, ValueError, KeyError):
+            time.sleep(0.1)
+    if address is None:
+        fail("the scheduler wrote no address to %s within 30 s (see scheduler.log)" % sched_file)
     if not address.startswith("tcp://127.0.0.1:"):
         fail("scheduler address %s is not TCP on 127.0.0.1" % address)
 
