@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "format/mesh_builder.h"
 #include "format/testing/test_panoramas.h"
@@ -135,21 +136,43 @@ TwoLayerPanorama WallWithPatch(int x0, int x1, int y0, int y1, float depth, int 
   return p;
 }
 
+// The backdrop of a 128x64 panorama `p` with cells of 4 pixels and a spread
+// of `spread_px` (reach 1 + spread_px / 4 cells).
+Mesh Backdrop(const TwoLayerPanorama& p, int spread_px) {
+  BackdropOptions o;
+  o.cell_px = 4;
+  o.spread_px = spread_px;
+  StatusOr<Mesh> m = BuildBackdrop(p, o);
+  EXPECT_TRUE(m.ok()) << m.status().ToString();
+  return m.ok() ? std::move(*m) : Mesh();
+}
+
+// The panorama pixel (x, y) of backdrop vertex v of a 128x64 panorama.
+std::pair<int, int> PixelOf(const Mesh& m, size_t v) {
+  return {static_cast<int>(std::lround(m.uvs[2 * v] * 128 - 0.5)),
+          static_cast<int>(std::lround((m.uvs[2 * v + 1] * 2 - 1) * 64 - 0.5))};
+}
+
+// The index of the backdrop vertex at pixel (x, y) of a 128x64 panorama.
+size_t VertexAt(const Mesh& m, int x, int y) {
+  for (size_t v = 0; v < m.num_vertices(); ++v) {
+    if (PixelOf(m, v) == std::pair{x, y}) return v;
+  }
+  ADD_FAILURE() << "no vertex at " << x << ", " << y;
+  return 0;
+}
+
 // A wall (depth 4, red) with one cell of far outliers (depth 40, blue), as a
 // real capture's noisy depth leaves them: the backdrop lies behind the
 // outliers (depth, as every node it covers), but their colour no longer
 // paints every vertex within reach; the wall's colour stays.
 TEST(BackdropTest, AFewFarOutliersDoNotColourTheirWindow) {
-  const TwoLayerPanorama p = WallWithPatch(60, 64, 28, 32, 40.0f, 2);
-  BackdropOptions o;
-  o.cell_px = 4;
-  o.spread_px = 32;  // Reach: 1 + 8 cells; colour from 2 cells around.
-  auto m = BuildBackdrop(p, o);
-  ASSERT_TRUE(m.ok());
+  // Reach: 1 + 8 cells; colour from 2 cells around.
+  const Mesh mesh = Backdrop(WallWithPatch(60, 64, 28, 32, 40.0f, 2), 32);
+  const Mesh* m = &mesh;
   int within_reach = 0;
   for (size_t v = 0; v < m->num_vertices(); ++v) {
-    const int x = static_cast<int>(std::lround(m->uvs[2 * v] * 128 - 0.5));
-    const int y = static_cast<int>(std::lround((m->uvs[2 * v + 1] * 2 - 1) * 64 - 0.5));
+    const auto [x, y] = PixelOf(*m, v);
     if (std::abs(x - 60) > 12 || std::abs(y - 28) > 12) continue;
     ++within_reach;
     EXPECT_NEAR(Norm(&m->positions[3 * v]), 40.0 * 1.02, 1e-3) << x << ", " << y;
@@ -167,20 +190,10 @@ TEST(BackdropTest, AFewFarOutliersDoNotColourTheirWindow) {
 // wall's at the rim, and inside the square the square's: the surface it shows
 // through there, where a sheet of the square is left out.
 TEST(BackdropTest, TheBackgroundSpreadsBehindTheForeground) {
-  const TwoLayerPanorama p = WallWithPatch(32, 96, 8, 56, 1.0f, 1);
-  BackdropOptions o;
-  o.cell_px = 4;
-  o.spread_px = 8;  // Reach: 1 + 2 cells; colour from 1 cell around.
-  auto m = BuildBackdrop(p, o);
-  ASSERT_TRUE(m.ok());
-  auto vertex_at = [&](int x, int y) -> size_t {
-    for (size_t v = 0; v < m->num_vertices(); ++v) {
-      if (std::lround(m->uvs[2 * v] * 128 - 0.5) == x && std::lround((m->uvs[2 * v + 1] * 2 - 1) * 64 - 0.5) == y)
-        return v;
-    }
-    ADD_FAILURE() << "no vertex at " << x << ", " << y;
-    return 0;
-  };
+  // Reach: 1 + 2 cells; colour from 1 cell around.
+  const Mesh mesh = Backdrop(WallWithPatch(32, 96, 8, 56, 1.0f, 1), 8);
+  const Mesh* m = &mesh;
+  auto vertex_at = [&](int x, int y) { return VertexAt(mesh, x, y); };
   // On the square's edge: the wall's depth, and its colour with at most a
   // twentieth of the square's (a wall cell weighs (4 / 1)^4 times more).
   size_t v = vertex_at(32, 32);
@@ -210,20 +223,10 @@ TEST(BackdropTest, FarSkyElsewhereLeavesTheRimTheWallsColour) {
     for (int x = 104; x < 112; ++x) p.layer(kFront).depth_m[p.index(x, y)] = 4000.0f;
   }
   p.layer(kFront).depth_m[p.index(4, 4)] = std::numeric_limits<float>::infinity();
-  BackdropOptions o;
-  o.cell_px = 4;
-  o.spread_px = 8;
-  auto m = BuildBackdrop(p, o);
-  ASSERT_TRUE(m.ok());
-  bool found = false;
-  for (size_t v = 0; v < m->num_vertices(); ++v) {
-    if (std::lround(m->uvs[2 * v] * 128 - 0.5) != 32 || std::lround((m->uvs[2 * v + 1] * 2 - 1) * 64 - 0.5) != 32)
-      continue;
-    found = true;
-    EXPECT_GE(m->colors[3 * v], 190);
-    EXPECT_LE(m->colors[3 * v + 1], 10);
-  }
-  EXPECT_TRUE(found);
+  const Mesh m = Backdrop(p, 8);
+  const size_t v = VertexAt(m, 32, 32);
+  EXPECT_GE(m.colors[3 * v], 190);
+  EXPECT_LE(m.colors[3 * v + 1], 10);
 }
 
 TEST(BackdropTest, AFullSphereIsClosedAcrossTheSeam) {
