@@ -119,8 +119,10 @@ void BoxSums(int nx, int ny, int channels, int r, std::vector<double>* values) {
     const double* in = &(*values)[static_cast<size_t>(y) * row_len];
     double* out = &rows[static_cast<size_t>(y) * row_len];
     for (int x = 0; x < nx; ++x) {
+      const bool inside = x - left >= 0 && x + right < nx;  // No wrap: no modulo.
       for (int d = -left; d <= right; ++d) {
-        const size_t from = static_cast<size_t>(((x + d) % nx + nx) % nx) * ch;
+        const int column = inside ? x + d : ((x + d) % nx + nx) % nx;
+        const size_t from = static_cast<size_t>(column) * ch;
         for (size_t k = 0; k < ch; ++k) out[x * ch + k] += in[from + k];
       }
     }
@@ -279,7 +281,7 @@ StatusOr<Mesh> BuildBackdrop(const TwoLayerPanorama& pano, const BackdropOptions
       float* uv = &mesh.uvs[2 * static_cast<size_t>(v)];
       uv[0] = static_cast<float>((x + 0.5) / w);
       uv[1] = static_cast<float>((y + 0.5 + h) / (2.0 * h));
-      const size_t own = static_cast<size_t>(std::min(j, cells_y - 1)) * cells_x + i % cells_x;
+      const size_t own = static_cast<size_t>(j) * cells_x + i % cells_x;  // rows == cells_y.
       for (int c = 0; c < 3; ++c) mesh.colors[3 * static_cast<size_t>(v) + c] = colors[3 * own + c];
     }
   }

@@ -168,18 +168,17 @@ size_t VertexAt(const Mesh& m, int x, int y) {
 // paints every vertex within reach; the wall's colour stays.
 TEST(BackdropTest, AFewFarOutliersDoNotColourTheirWindow) {
   // Reach: 1 + 8 cells; colour from 2 cells around.
-  const Mesh mesh = Backdrop(WallWithPatch(60, 64, 28, 32, 40.0f, 2), 32);
-  const Mesh* m = &mesh;
+  const Mesh m = Backdrop(WallWithPatch(60, 64, 28, 32, 40.0f, 2), 32);
   int within_reach = 0;
-  for (size_t v = 0; v < m->num_vertices(); ++v) {
-    const auto [x, y] = PixelOf(*m, v);
+  for (size_t v = 0; v < m.num_vertices(); ++v) {
+    const auto [x, y] = PixelOf(m, v);
     if (std::abs(x - 60) > 12 || std::abs(y - 28) > 12) continue;
     ++within_reach;
-    EXPECT_NEAR(Norm(&m->positions[3 * v]), 40.0 * 1.02, 1e-3) << x << ", " << y;
+    EXPECT_NEAR(Norm(&m.positions[3 * v]), 40.0 * 1.02, 1e-3) << x << ", " << y;
     // The outlier's cell weighs at most 1.5^4 times a wall cell: less than
     // a fifth of the 25 cells' weight where it is in a vertex's window.
-    EXPECT_GE(m->colors[3 * v], 150) << x << ", " << y;
-    EXPECT_LE(m->colors[3 * v + 2], 50) << x << ", " << y;
+    EXPECT_GE(m.colors[3 * v], 150) << x << ", " << y;
+    EXPECT_LE(m.colors[3 * v + 2], 50) << x << ", " << y;
   }
   EXPECT_EQ(within_reach, 49);
 }
@@ -191,26 +190,25 @@ TEST(BackdropTest, AFewFarOutliersDoNotColourTheirWindow) {
 // through there, where a sheet of the square is left out.
 TEST(BackdropTest, TheBackgroundSpreadsBehindTheForeground) {
   // Reach: 1 + 2 cells; colour from 1 cell around.
-  const Mesh mesh = Backdrop(WallWithPatch(32, 96, 8, 56, 1.0f, 1), 8);
-  const Mesh* m = &mesh;
-  auto vertex_at = [&](int x, int y) { return VertexAt(mesh, x, y); };
+  const Mesh m = Backdrop(WallWithPatch(32, 96, 8, 56, 1.0f, 1), 8);
+  auto vertex_at = [&](int x, int y) { return VertexAt(m, x, y); };
   // On the square's edge: the wall's depth, and its colour with at most a
   // twentieth of the square's (a wall cell weighs (4 / 1)^4 times more).
   size_t v = vertex_at(32, 32);
-  EXPECT_NEAR(Norm(&m->positions[3 * v]), 4.0 * 1.02, 1e-4);
-  EXPECT_GE(m->colors[3 * v], 190);
-  EXPECT_LE(m->colors[3 * v + 1], 10);
+  EXPECT_NEAR(Norm(&m.positions[3 * v]), 4.0 * 1.02, 1e-4);
+  EXPECT_GE(m.colors[3 * v], 190);
+  EXPECT_LE(m.colors[3 * v + 1], 10);
   // Inside the square by 8 pixels (2 cells, within reach): the wall's depth,
   // the square's colour.
   v = vertex_at(40, 32);
-  EXPECT_NEAR(Norm(&m->positions[3 * v]), 4.0 * 1.02, 1e-4);
-  EXPECT_EQ(m->colors[3 * v], 0);
-  EXPECT_EQ(m->colors[3 * v + 1], 200);
+  EXPECT_NEAR(Norm(&m.positions[3 * v]), 4.0 * 1.02, 1e-4);
+  EXPECT_EQ(m.colors[3 * v], 0);
+  EXPECT_EQ(m.colors[3 * v + 1], 200);
   // 16 pixels inside (4 cells, beyond reach): the square itself.
   v = vertex_at(48, 32);
-  EXPECT_NEAR(Norm(&m->positions[3 * v]), 1.0 * 1.02, 1e-5);
-  EXPECT_EQ(m->colors[3 * v], 0);
-  EXPECT_EQ(m->colors[3 * v + 1], 200);
+  EXPECT_NEAR(Norm(&m.positions[3 * v]), 1.0 * 1.02, 1e-5);
+  EXPECT_EQ(m.colors[3 * v], 0);
+  EXPECT_EQ(m.colors[3 * v + 1], 200);
 }
 
 // The same square and wall with the sky elsewhere: a block of nodes 1000
