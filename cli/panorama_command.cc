@@ -38,6 +38,7 @@ void AddPanoramaCommand(CLI::App& app) {
   AddDescribedOption(cmd, "--solve-width", args->options, args->options.stitch.solve_width);
   AddDescribedOption(cmd, "--blend-depth-tolerance", args->options, args->options.stitch.blend_depth_tolerance);
   AddDescribedOption(cmd, "--front-support", args->options, args->options.stitch.front_support);
+  AddDescribedOption(cmd, "--seam-blend-length", args->options, args->options.stitch.seam_blend_length);
   AddDescribedOption(cmd, "--depth-smooth-radius", args->options, args->options.depth_smooth.radius);
   AddDescribedOption(cmd, "--depth-smooth-iterations", args->options, args->options.depth_smooth.iterations);
   cmd->add_flag("--no-gap-fill", "Leave the front layer's gaps inside the photos' field of view empty")

@@ -43,7 +43,8 @@ using Clock = std::chrono::steady_clock;
 // gap behind each front node (version 10).
 // sparse-6: a photo's near depth also bounded by other photos' points inside
 // its view (spec/stage-sparse.md, depth_ranges.json).
-constexpr const char* kStageVersions[kNumStages] = {"sparse-6", "dense-5", "panorama-11",
+// panorama-12: the seams between sets of blended photos evened out (version 11).
+constexpr const char* kStageVersions[kNumStages] = {"sparse-6", "dense-5", "panorama-12",
                                                     "encode-5"};
 
 std::string HashHex(const std::string& text) {

@@ -7,14 +7,13 @@
 #include <utility>
 
 #include "base/parallel_for.h"
+#include "reconstruct/stitch/full_warps.h"
+#include "reconstruct/stitch/seam_blend.h"
 
 namespace casual3d::stitch {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / kPi;
-// How strongly label upsampling avoids stretched fragments: a fully stretched
-// one (s = 1) weighs exp(-6), about 0.25%, of an unstretched one.
-constexpr double kUpsampleStretchWeight = 6.0;
 
 // The per-label data of one layer at the solve resolution, densely stored.
 struct CoarseStack {
@@ -130,26 +129,6 @@ float SeamCost(const CoarseStack& stack, const StitchOptions& options, float inv
          static_cast<float>(options.lambda_seam_depth) * std::min(1.0f, 0.5f * depth * inv_scale);
 }
 
-// One layer's full-resolution warps, as the label upsampling and the blending
-// read them.
-struct FullWarps {
-  bool back;
-  const std::vector<warp::WarpedView>& full;
-  int width;  // Of the panorama.
-  double back_tolerance;
-
-  const warp::WarpedLayer& layer(int l) const { return back ? full[l].back : full[l].front; }
-  // Whether label l's warp has a depth at pixel (x, y) (its crop coordinates
-  // in lx, ly) that this layer may take: for the back layer, not nearer than
-  // the front.
-  bool Usable(int l, int x, int y, float front_depth, int* lx, int* ly) const {
-    const warp::WarpedLayer& w = layer(l);
-    if (!w.ToCrop(x, y, width, lx, ly)) return false;
-    const float d = w.depth_m.at(*lx, *ly);
-    if (!(d > 0)) return false;
-    return !(back && front_depth > 0 && d < front_depth * (1.0 - back_tolerance));
-  }
-};
 
 // Edge-aware label upsampling of pixel (x, y): among the labels of the nearby
 // solve-resolution pixels, the one whose full-resolution warp best matches
@@ -221,11 +200,6 @@ int UpsampleLabel(const FullWarps& warps, const StitchedLayer& out, const Image8
   return best;
 }
 
-// Fragments more stretched than this (triangles across a photo's depth edge,
-// warp.h) neither propose nor support a front surface. 0.5 let two depth
-// maps' fattened edges against the sky (stretch about 0.4) hold up a floater
-// in sceaux's sky; fern's leaflets are held by unstretched fragments.
-constexpr float kMaxSupportStretch = 0.2f;
 
 // The front layer's label at (x, y): `best`, unless a surface nearer than
 // best's by more than blend_depth_tolerance has the support of at least
@@ -267,34 +241,29 @@ int NearestSupported(const FullWarps& warps, int best, int x, int y, const Stitc
 // Writes pixel (x, y) of `out` from label `best` (on the front layer, first
 // moved to the nearest supported surface, NearestSupported): its depth and
 // colour, or with blend_depth_tolerance > 0 the mean colour and the geometric
-// mean depth of the warps that agree with it, stretched fragments weighing less.
+// mean depth of the warps that agree with it (BlendMembers).
 void WritePixel(const FullWarps& warps, int best, int x, int y, float front_depth,
                 const StitchOptions& options, std::vector<std::pair<float, int>>* scratch,
-                StitchedLayer* out) {
+                std::vector<std::pair<int, double>>* members, StitchedLayer* out) {
   if (!warps.back && options.front_support > 0 && options.blend_depth_tolerance > 0)
     best = NearestSupported(warps, best, x, y, options, scratch);
   const warp::WarpedLayer& layer = warps.layer(best);
   int lx, ly;
   layer.ToCrop(x, y, warps.width, &lx, &ly);
   out->label.at(x, y) = static_cast<int16_t>(best);
-  const float depth = layer.depth_m.at(lx, ly);
-  out->depth_m.at(x, y) = depth;
+  out->depth_m.at(x, y) = layer.depth_m.at(lx, ly);
   if (!(options.blend_depth_tolerance > 0)) {
     for (int c = 0; c < 3; ++c) out->rgb.at(x, y, c) = layer.rgb.at(lx, ly, c);
     return;
   }
+  BlendMembers(warps, best, x, y, front_depth, options, members);
   double sum[3] = {0, 0, 0}, weight = 0, dsum = 0;
-  for (int l = 0; l < static_cast<int>(warps.full.size()); ++l) {
+  for (const auto& [l, w] : *members) {
     const warp::WarpedLayer& other = warps.layer(l);
     int ox, oy;
-    // The same tests the chosen photo passed (on the back layer, not in
-    // front of the front), then the depth agreement.
-    if (!warps.Usable(l, x, y, front_depth, &ox, &oy)) continue;
-    const float d = other.depth_m.at(ox, oy);
-    if (std::abs(d - depth) > options.blend_depth_tolerance * depth) continue;
-    const double w = std::exp(-kUpsampleStretchWeight * other.stretch.at(ox, oy));
+    other.ToCrop(x, y, warps.width, &ox, &oy);
     for (int c = 0; c < 3; ++c) sum[c] += w * other.rgb.at(ox, oy, c);
-    dsum += w * std::log(d);
+    dsum += w * std::log(other.depth_m.at(ox, oy));
     weight += w;
   }
   out->depth_m.at(x, y) = static_cast<float>(std::exp(dsum / weight));
@@ -355,12 +324,16 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
     std::vector<int> candidates;
     std::vector<double> scores;
     std::vector<std::pair<float, int>> scratch;
+    std::vector<std::pair<int, double>> members;
     for (int x = 0; x < W; ++x) {
       const float front_depth = front ? front->depth_m.at(x, y) : 0.0f;
       const int best = UpsampleLabel(warps, out, solve_rgb, x, y, front_depth, options, &candidates, &scores);
-      if (best >= 0) WritePixel(warps, best, x, y, front_depth, options, &scratch, &out);
+      if (best >= 0) WritePixel(warps, best, x, y, front_depth, options, &scratch, &members, &out);
     }
   });
+
+  // 3. Seams between the sets of blended photos evened out (BlendSeams).
+  if (options.seam_blend_length > 0) BlendSeams(warps, front, options, &out);
   return out;
 }
 

@@ -74,6 +74,13 @@ struct StitchOptions {
   // some photos' depth maps hold at a pixel. 0 keeps the label's; 1 (one
   // depth map's floater would win) is refused. Needs blend_depth_tolerance > 0.
   int front_support = 2;
+  // Seams: where the set of blended warps changes from one pixel to the next
+  // (a label's border, or a warp's depth leaving the tolerance), the colour
+  // may jump by the photos' exposure difference. The jumps are evened out by
+  // a correction that keeps every other colour difference and stays near the
+  // blended colours (a screened Poisson problem, seam_blend.h); a jump fades
+  // over about this fraction of the panorama width on both sides. 0: off.
+  double seam_blend_length = 1.0 / 32;
 
   AlphaExpansionOptions solver;
 
@@ -100,6 +107,8 @@ struct StitchOptions {
     v.Field("front_support", o.front_support, R::AtLeast(0),
             "Front pixels take the nearest surface this many unstretched warps agree on (within the blend "
             "tolerance, so off with it); 0: the label's");
+    v.Field("seam_blend_length", o.seam_blend_length, R::Closed(0, 1),
+            "Colour jumps between the sets of blended photos fade over this fraction of the width; 0: off");
     v.Struct("solver", o.solver);
     v.Require(o.solve_width == 2 * o.solve_height, "solve_width", "must be 2 * solve_height");
     v.Require(o.front_support != 1, "front_support", "must be 0 (off) or at least 2: one warp alone is a floater");

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -269,6 +270,62 @@ TEST(StitchTest, StretchedFragmentsDoNotSupportANearSurface) {
   ASSERT_GT(plane_behind, 100);
   EXPECT_EQ(ruled.depth_m.vector(), labelled.depth_m.vector());
   EXPECT_EQ(ruled.label.vector(), labelled.label.vector());
+}
+
+// A plain wall seen by four photos of different exposures: where the set of
+// blended photos changes (at the border of a photo's field of view), the
+// blend jumps by the exposure difference; the seam blend evens the jumps out
+// and keeps the colours within the photos' range.
+TEST(StitchTest, SeamsBetweenPhotosOfDifferentExposureFade) {
+  wt::SquareScene scene;
+  scene.half_size = 0;  // The plane alone.
+  Capture cap = MakeCapture(scene);
+  for (int i = 0; i < 4; ++i) {
+    for (int y = 0; y < 240; ++y) {
+      for (int x = 0; x < 320; ++x) {
+        cap.rgb[i].at(x, y, 0) = static_cast<uint8_t>(80 + 25 * i);
+        cap.rgb[i].at(x, y, 1) = 100;
+        cap.rgb[i].at(x, y, 2) = static_cast<uint8_t>(150 - 10 * i);
+      }
+    }
+  }
+  StitchOptions options = SmallSolve();
+  const int W = 1024;
+  const auto full = Warp(cap, W);
+  const auto coarse = Warp(cap, options.solve_width);
+  options.seam_blend_length = 0;
+  const StitchedLayer plain = StitchFront(full, coarse, cap.geometry, W, options);
+  options.seam_blend_length = StitchOptions().seam_blend_length;
+  const StitchedLayer blended = StitchFront(full, coarse, cap.geometry, W, options);
+
+  // Steps of more than 2 levels between labelled neighbours, in any channel.
+  auto jumps = [&](const StitchedLayer& layer) {
+    int n = 0;
+    for (int y = 0; y + 1 < W / 2; ++y) {
+      for (int x = 0; x + 1 < W; ++x) {
+        if (layer.label.at(x, y) < 0) continue;
+        for (const auto& [qx, qy] : {std::pair{x + 1, y}, std::pair{x, y + 1}}) {
+          if (layer.label.at(qx, qy) < 0) continue;
+          bool jump = false;
+          for (int c = 0; c < 3; ++c) jump |= std::abs(layer.rgb.at(qx, qy, c) - layer.rgb.at(x, y, c)) > 2;
+          n += jump;
+        }
+      }
+    }
+    return n;
+  };
+  const int before = jumps(plain), after = jumps(blended);
+  EXPECT_GT(before, 200);
+  EXPECT_LT(after, before / 20) << before;
+  for (int y = 0; y < W / 2; ++y) {
+    for (int x = 0; x < W; ++x) {
+      if (blended.label.at(x, y) < 0) continue;
+      ASSERT_EQ(blended.label.at(x, y), plain.label.at(x, y));
+      ASSERT_EQ(blended.depth_m.at(x, y), plain.depth_m.at(x, y));
+      ASSERT_GE(blended.rgb.at(x, y, 0), 78);
+      ASSERT_LE(blended.rgb.at(x, y, 0), 157);
+    }
+  }
 }
 
 TEST(StitchTest, OptionsAreChecked) {

@@ -1,0 +1,30 @@
+#include "reconstruct/stitch/full_warps.h"
+
+#include <cmath>
+
+namespace casual3d::stitch {
+
+// The warps blended into a pixel whose label is `best` (at crop coordinates
+// of best's warp): every warp usable there (for the back layer, not in front
+// of the front) whose depth lies within blend_depth_tolerance of best's, with
+// its weight exp(-6 s) against stretched fragments; best itself always
+// counts. `members` gets (warp, weight) pairs in warp order.
+void BlendMembers(const FullWarps& warps, int best, int x, int y, float front_depth,
+                  const StitchOptions& options, std::vector<std::pair<int, double>>* members) {
+  members->clear();
+  int lx, ly;
+  warps.layer(best).ToCrop(x, y, warps.width, &lx, &ly);
+  const float depth = warps.layer(best).depth_m.at(lx, ly);
+  for (int l = 0; l < static_cast<int>(warps.full.size()); ++l) {
+    const warp::WarpedLayer& other = warps.layer(l);
+    int ox, oy;
+    // The same tests the chosen photo passed (on the back layer, not in
+    // front of the front), then the depth agreement.
+    if (!warps.Usable(l, x, y, front_depth, &ox, &oy)) continue;
+    const float d = other.depth_m.at(ox, oy);
+    if (l != best && std::abs(d - depth) > options.blend_depth_tolerance * depth) continue;
+    members->emplace_back(l, std::exp(-kUpsampleStretchWeight * other.stretch.at(ox, oy)));
+  }
+}
+
+}  // namespace casual3d::stitch
