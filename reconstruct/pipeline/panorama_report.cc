@@ -32,6 +32,13 @@ std::string PanoramaReportJson(const PanoramaStageReport& report,
   j["front_fov"] = CoverageJson(report.front_fov);
   j["view"] = nlohmann::json::parse(SerializeViewHints(hints));
   j["front_gaps_filled"] = report.front_gaps_filled;
+  auto seam_json = [](const stitch::SeamBlendStats& st) {
+    return nlohmann::json{{"pairs_with_target", st.pairs_with_target},
+                          {"pairs_cut", st.pairs_cut},
+                          {"iterations", st.iterations},
+                          {"relative_residual", st.relative_residual}};
+  };
+  j["seam_blend"] = {{"front", seam_json(report.seam_blend_front)}, {"back", seam_json(report.seam_blend_back)}};
   j["front_footprint"] = CoverageJson(report.front_footprint);
   j["fuse"] = {{"front_nodes", report.fuse.front_nodes},
                {"back_nodes_in", report.fuse.back_nodes_in},

@@ -265,11 +265,13 @@ TwoLayerPanorama RunPanoramaStage(const std::string& sparse_dir, const std::stri
     util::Progress progress("panorama: stitching", options.back_layer ? 2 : 1);
     front = stitch::StitchFront(full, coarse, geometry, W, options.stitch);
     report.seconds_stitch_front = Seconds(t);
+    report.seam_blend_front = front.seam_blend;
     progress.Advance();
     if (options.back_layer) {
       t = Clock::now();
       back = stitch::StitchBack(full, coarse, geometry, front, options.stitch);
       report.seconds_stitch_back = Seconds(t);
+      report.seam_blend_back = back.seam_blend;
     } else {
       back.rgb = Image8(W, H, 3, 0);
       back.depth_m = ImageF(W, H, 1, 0.0f);

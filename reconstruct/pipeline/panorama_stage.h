@@ -29,6 +29,7 @@
 #include "reconstruct/pipeline/view_volume.h"
 #include "reconstruct/stitch/smooth_depth.h"
 #include "reconstruct/stitch/stitch.h"
+#include "reconstruct/stitch/stitch.h"
 #include "reconstruct/warp/warp.h"
 #include "reconstruct/util/options_fields.h"
 
@@ -107,6 +108,7 @@ struct PanoramaStageReport {
   fuse::FuseStats fuse;
   fuse::SealStats seal;
   normals::NormalStats normals;
+  stitch::SeamBlendStats seam_blend_front, seam_blend_back;
   double front_coverage = 0.0;  // Fraction of pixels with a front node.
   // The front layer inside the photos' field of view: coverage and holes
   // (coverage.h); the field of view comes from the stitched front layer

@@ -4,11 +4,6 @@
 
 namespace casual3d::stitch {
 
-// The warps blended into a pixel whose label is `best` (at crop coordinates
-// of best's warp): every warp usable there (for the back layer, not in front
-// of the front) whose depth lies within blend_depth_tolerance of best's, with
-// its weight exp(-6 s) against stretched fragments; best itself always
-// counts. `members` gets (warp, weight) pairs in warp order.
 void BlendMembers(const FullWarps& warps, int best, int x, int y, float front_depth,
                   const StitchOptions& options, std::vector<std::pair<int, double>>* members) {
   members->clear();

@@ -14,7 +14,8 @@ namespace {
 constexpr float kJacobiWeight = 0.7f;
 constexpr int kSmoothingSweeps = 2;
 constexpr int kCoarsestSweeps = 40;
-// Coarsening stops at this many pixels (or a height of 1).
+// Coarsening stops at this many pixels (a grid one pixel high coarsens in
+// blocks of 2x1).
 constexpr size_t kCoarsestPixels = 2048;
 
 // One level of the hierarchy: its grid (level 0 reads the caller's) and
@@ -23,6 +24,7 @@ struct Level {
   const PoissonGrid* grid = nullptr;
   PoissonGrid own;          // The coarser levels' grids.
   std::vector<float> diag;  // s_p plus the weights of p's edges; 0: not solved.
+  std::vector<float> inv_diag;  // 1 / diag, 0 where diag is 0.
   std::vector<float> x, b, r;  // Scratch of the V-cycle.
 };
 
@@ -45,6 +47,7 @@ void ForRows(const PoissonGrid& g, int threads, Body&& body) {
 void ComputeDiag(Level* level, int threads) {
   const PoissonGrid& g = *level->grid;
   level->diag.resize(g.screen.size());
+  level->inv_diag.resize(g.screen.size());
   ForRows(g, threads, [&](int y) {
     for (int x = 0; x < g.width; ++x) {
       const size_t p = g.index(x, y);
@@ -54,28 +57,44 @@ void ComputeDiag(Level* level, int threads) {
       if (y + 1 < g.height) d += g.down[p];
       if (y > 0) d += g.down[g.index(x, y - 1)];
       level->diag[p] = d;
+      level->inv_diag[p] = d > 0 ? 1.0f / d : 0.0f;
     }
   });
+}
+
+// Row y of A v on one level, into out[0 .. width). A pixel that takes no
+// part (diag 0, hence no edge) gets 0. Loops without branches, so that they
+// vectorise.
+void ApplyRow(const Level& level, const std::vector<float>& v, int y, float* out) {
+  const PoissonGrid& g = *level.grid;
+  const int w = g.width;
+  const size_t row = g.index(0, y);
+  const float* vp = v.data() + row;
+  const float* rt = g.right.data() + row;
+  const float* dg = level.diag.data() + row;
+  for (int x = 0; x < w; ++x) out[x] = dg[x] * vp[x];
+  for (int x = 0; x + 1 < w; ++x) out[x] -= rt[x] * vp[x + 1];
+  for (int x = 1; x < w; ++x) out[x] -= rt[x - 1] * vp[x - 1];
+  if (g.wrap_x && w > 1) {
+    out[w - 1] -= rt[w - 1] * vp[0];
+    out[0] -= rt[w - 1] * vp[w - 1];
+  }
+  if (y + 1 < g.height) {
+    const float* dn = g.down.data() + row;
+    const float* vn = vp + w;
+    for (int x = 0; x < w; ++x) out[x] -= dn[x] * vn[x];
+  }
+  if (y > 0) {
+    const float* up = g.down.data() + row - w;
+    const float* vu = vp - w;
+    for (int x = 0; x < w; ++x) out[x] -= up[x] * vu[x];
+  }
 }
 
 // out = A v on one level.
 void Apply(const Level& level, const std::vector<float>& v, std::vector<float>* out, int threads) {
   const PoissonGrid& g = *level.grid;
-  ForRows(g, threads, [&](int y) {
-    for (int x = 0; x < g.width; ++x) {
-      const size_t p = g.index(x, y);
-      if (!(level.diag[p] > 0)) {
-        (*out)[p] = 0.0f;
-        continue;
-      }
-      float sum = level.diag[p] * v[p];
-      if (const int r = Right(g, x); r >= 0) sum -= g.right[p] * v[g.index(r, y)];
-      if (const int l = Left(g, x); l >= 0) sum -= g.right[g.index(l, y)] * v[g.index(l, y)];
-      if (y + 1 < g.height) sum -= g.down[p] * v[p + g.width];
-      if (y > 0) sum -= g.down[p - g.width] * v[p - g.width];
-      (*out)[p] = sum;
-    }
-  });
+  ForRows(g, threads, [&](int y) { ApplyRow(level, v, y, out->data() + g.index(0, y)); });
 }
 
 // The next coarser level: 2x2 blocks, their screens and the weights between
@@ -108,38 +127,51 @@ void Coarsen(const Level& fine, Level* coarse, int threads) {
   ComputeDiag(coarse, threads);
 }
 
-void Jacobi(Level* level, int sweeps, int threads) {
+// `sweeps` damped Jacobi sweeps on level.x, each in one pass (into level.r,
+// then swapped); `from_zero`: x is 0, and the first sweep is x = w b / diag.
+void Jacobi(Level* level, int sweeps, bool from_zero, int threads) {
   const PoissonGrid& g = *level->grid;
+  const int w = g.width;
   for (int s = 0; s < sweeps; ++s) {
-    Apply(*level, level->x, &level->r, threads);
+    const bool zero = from_zero && s == 0;
     ForRows(g, threads, [&](int y) {
-      const size_t end = g.index(0, y) + g.width;
-      for (size_t p = g.index(0, y); p < end; ++p) {
-        if (level->diag[p] > 0) level->x[p] += kJacobiWeight * (level->b[p] - level->r[p]) / level->diag[p];
+      const size_t row = g.index(0, y);
+      float* next = level->r.data() + row;
+      const float* b = level->b.data() + row;
+      const float* inv = level->inv_diag.data() + row;
+      if (zero) {
+        for (int x = 0; x < w; ++x) next[x] = kJacobiWeight * inv[x] * b[x];
+        return;
       }
+      ApplyRow(*level, level->x, y, next);
+      const float* x0 = level->x.data() + row;
+      for (int x = 0; x < w; ++x) next[x] = x0[x] + kJacobiWeight * inv[x] * (b[x] - next[x]);
     });
+    level->x.swap(level->r);
   }
 }
 
 // levels[k].x = the V-cycle applied to levels[k].b.
 void VCycle(std::vector<Level>& levels, size_t k, int threads) {
   Level& L = levels[k];
-  std::fill(L.x.begin(), L.x.end(), 0.0f);
   if (k + 1 == levels.size()) {
-    Jacobi(&L, kCoarsestSweeps, threads);
+    Jacobi(&L, kCoarsestSweeps, /*from_zero=*/true, threads);
     return;
   }
-  Jacobi(&L, kSmoothingSweeps, threads);
-  Apply(L, L.x, &L.r, threads);
+  Jacobi(&L, kSmoothingSweeps, /*from_zero=*/true, threads);
   Level& C = levels[k + 1];
   const PoissonGrid& g = *L.grid;
   const PoissonGrid& c = *C.grid;
-  ForRows(c, threads, [&](int Y) {  // The residual, summed over each block.
-    for (int X = 0; X < c.width; ++X) {
-      float sum = 0.0f;
-      for (int y = 2 * Y; y < std::min(2 * Y + 2, g.height); ++y)
-        for (int x = 2 * X; x < std::min(2 * X + 2, g.width); ++x) sum += L.b[g.index(x, y)] - L.r[g.index(x, y)];
-      C.b[c.index(X, Y)] = sum;
+  // The residual b - A x (into L.r), summed over each block.
+  ForRows(c, threads, [&](int Y) {
+    float* cb = C.b.data() + c.index(0, Y);
+    std::fill(cb, cb + c.width, 0.0f);
+    for (int y = 2 * Y; y < std::min(2 * Y + 2, g.height); ++y) {
+      const size_t row = g.index(0, y);
+      float* res = L.r.data() + row;
+      ApplyRow(L, L.x, y, res);
+      const float* b = L.b.data() + row;
+      for (int x = 0; x < g.width; ++x) cb[x / 2] += b[x] - res[x];
     }
   });
   VCycle(levels, k + 1, threads);
@@ -149,7 +181,7 @@ void VCycle(std::vector<Level>& levels, size_t k, int threads) {
       if (L.diag[p] > 0) L.x[p] += C.x[c.index(x / 2, y / 2)];
     }
   });
-  Jacobi(&L, kSmoothingSweeps, threads);
+  Jacobi(&L, kSmoothingSweeps, /*from_zero=*/false, threads);
 }
 
 // The sum of a[i] * b[i], by rows, in a fixed order.
@@ -187,7 +219,7 @@ ScreenedPoissonSolver::ScreenedPoissonSolver(const PoissonGrid& grid, const Pois
   ComputeDiag(&levels[0], threads_);
   for (;;) {
     const PoissonGrid& last = *levels.back().grid;
-    if (last.height <= 1 || static_cast<size_t>(last.width) * last.height <= kCoarsestPixels) break;
+    if (static_cast<size_t>(last.width) * last.height <= kCoarsestPixels) break;
     levels.emplace_back();
     Coarsen(levels[levels.size() - 2], &levels.back(), threads_);
   }

@@ -21,7 +21,7 @@ namespace casual3d::stitch {
 
 struct PoissonGrid {
   int width = 0, height = 0;
-  bool wrap_x = true;
+  bool wrap_x = false;
   std::vector<float> right;   // Weight of edge (x, y)-(x + 1, y); the last column's wraps (or is 0).
   std::vector<float> down;    // Weight of edge (x, y)-(x, y + 1); the last row's are 0.
   std::vector<float> screen;  // s_p >= 0.

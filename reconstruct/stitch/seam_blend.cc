@@ -28,28 +28,31 @@ constexpr double kWarpEdgeStep = 0.03;
 
 using Members = std::vector<std::pair<int, double>>;
 
-// The part of the panorama that is solved: rows y0 .. y0 + height - 1 and
-// columns x0, x0 + 1, ... (mod the panorama's width), width of them.
-struct Window {
-  int x0 = 0, y0 = 0, width = 0, height = 0;
-  bool wrap = false;
-};
+uint64_t KeyOf(const Members& m) {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a over the warps' numbers.
+  for (const auto& e : m) {
+    h ^= static_cast<uint64_t>(e.first) + 1;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
 
-// The rows and columns that hold labelled pixels: every column but the
-// longest run (cyclically) of columns without any.
-bool FindWindow(const StitchedLayer& layer, Window* win) {
-  const int W = layer.label.width(), H = layer.label.height();
+}  // namespace
+
+bool FindSeamWindow(const Image<int16_t>& label, SeamWindow* win) {
+  const int W = label.width(), H = label.height();
   std::vector<char> used(W, 0);
   int y0 = H, y1 = -1;
   for (int y = 0; y < H; ++y) {
     for (int x = 0; x < W; ++x) {
-      if (layer.label.at(x, y) < 0) continue;
+      if (label.at(x, y) < 0) continue;
       used[x] = 1;
       y0 = std::min(y0, y);
       y1 = std::max(y1, y);
     }
   }
   if (y1 < 0) return false;
+  // The longest run of unused columns, cyclically (the first such run).
   int gap = 0, start = 0, run = 0;
   for (int i = 0; i < 2 * W; ++i) {
     const int x = i % W;
@@ -67,21 +70,10 @@ bool FindWindow(const StitchedLayer& layer, Window* win) {
   return true;
 }
 
-uint64_t KeyOf(const Members& m) {
-  uint64_t h = 1469598103934665603ull;  // FNV-1a over the warps' numbers.
-  for (const auto& e : m) {
-    h ^= static_cast<uint64_t>(e.first) + 1;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
-}  // namespace
-
 void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const StitchOptions& options,
                 StitchedLayer* out) {
-  Window win;
-  if (!FindWindow(*out, &win)) return;
+  SeamWindow win;
+  if (!FindSeamWindow(out->label, &win)) return;
   const int W = out->label.width();
   const int threads = base::ResolveThreads(0);
   const size_t n = static_cast<size_t>(win.width) * win.height;
@@ -107,15 +99,17 @@ void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const Stitch
     }
   });
 
-  // Each pair's weight and target: target[2 * (3 p + c)] for the pair to the
-  // right, + 1 for the pair below.
-  std::vector<float> target(6 * n, 0.0f);
-  base::ParallelFor(0, win.height, threads, [&](int64_t gy64) {
-    const int gy = static_cast<int>(gy64);
+  // Each pair's weight, and its target added to b (AddEdgeTarget, three
+  // channels per pixel). A pair reaches into the next row: rows of one
+  // parity at a time, so that no two threads write the same row.
+  std::vector<float> b3(3 * n, 0.0f);
+  std::vector<int64_t> with_target(win.height, 0), cut(win.height, 0);
+  auto join_row = [&](int gy) {
     Members mp, mq;
     for (int gx = 0; gx < win.width; ++gx) {
       const size_t p = grid.index(gx, gy);
       if (!(grid.screen[p] > 0)) continue;
+      mp.clear();
       for (int dir = 0; dir < 2; ++dir) {
         int qx = gx, qy = gy;
         if (dir == 0) {
@@ -134,7 +128,7 @@ void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const Stitch
           continue;
         }
         const int xp = pano_x(gx), yp = win.y0 + gy, xq = pano_x(qx), yq = win.y0 + qy;
-        members_at(gx, gy, &mp);
+        if (mp.empty()) members_at(gx, gy, &mp);  // Never empty: the label counts.
         members_at(qx, qy, &mq);
         // The unstretched warps both sets hold (both are in warp order).
         double diff[3] = {0, 0, 0}, sum_w = 0;
@@ -146,51 +140,57 @@ void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const Stitch
           w.ToCrop(xp, yp, W, &ax, &ay);
           w.ToCrop(xq, yq, W, &bx, &by);
           const float da = w.depth_m.at(ax, ay), db = w.depth_m.at(bx, by);
-          if (w.stretch.at(ax, ay) > kMaxSupportStretch || w.stretch.at(bx, by) > kMaxSupportStretch ||
-              std::abs(da - db) > kWarpEdgeStep * std::min(da, db)) {
-            ++i;
-            ++j;
-            continue;
+          const bool one_surface = w.stretch.at(ax, ay) <= kMaxSupportStretch &&
+                                   w.stretch.at(bx, by) <= kMaxSupportStretch &&
+                                   std::abs(da - db) <= kWarpEdgeStep * std::min(da, db);
+          if (one_surface) {
+            const double wt = 0.5 * (mp[i].second + mq[j].second);
+            for (int c = 0; c < 3; ++c) diff[c] += wt * (w.rgb.at(bx, by, c) - w.rgb.at(ax, ay, c));
+            sum_w += wt;
           }
-          const double wt = 0.5 * (mp[i].second + mq[j].second);
-          for (int c = 0; c < 3; ++c) diff[c] += wt * (w.rgb.at(bx, by, c) - w.rgb.at(ax, ay, c));
-          sum_w += wt;
           ++i;
           ++j;
         }
-        if (!(sum_w > 0)) continue;  // No warp sees both alike: not joined.
+        if (!(sum_w > 0)) {  // No warp sees both alike: not joined.
+          ++cut[gy];
+          continue;
+        }
         weight = 1.0f;
         bool smooth = true;
         for (int c = 0; c < 3; ++c) smooth = smooth && std::abs(diff[c] / sum_w) <= kSmoothStep;
         if (!smooth) continue;  // Texture or an edge: the blend's own step is kept.
+        ++with_target[gy];
         for (int c = 0; c < 3; ++c) {
           const double f_step = out->rgb.at(xq, yq, c) - out->rgb.at(xp, yp, c);
-          target[2 * (3 * p + c) + dir] = static_cast<float>(diff[c] / sum_w - f_step);
+          AddEdgeTarget(3 * p + c, 3 * q + c, 1.0f, static_cast<float>(diff[c] / sum_w - f_step), &b3);
         }
       }
     }
-  });
+  };
+  for (int parity = 0; parity < 2; ++parity) {
+    base::ParallelFor(0, (win.height + 1 - parity) / 2, threads,
+                      [&](int64_t i) { join_row(static_cast<int>(2 * i + parity)); });
+  }
+  std::vector<uint64_t>().swap(key);
+  SeamBlendStats& stats = out->seam_blend;
+  stats = SeamBlendStats();
+  for (int gy = 0; gy < win.height; ++gy) {
+    stats.pairs_with_target += with_target[gy];
+    stats.pairs_cut += cut[gy];
+  }
 
-  // Per channel: b from the targets (AddEdgeTarget, gathered per pixel so
-  // that rows are independent), the correction, and the colours moved by it.
+  // Per channel: the correction, and the colours moved by it.
   PoissonSolveOptions solve;
   solve.relative_tolerance = kRelativeTolerance;
   solve.max_iterations = kMaxIterations;
   ScreenedPoissonSolver solver(grid, solve);
   std::vector<float> b(n);
   for (int c = 0; c < 3; ++c) {
-    base::ParallelFor(0, win.height, threads, [&](int64_t gy64) {
-      const int gy = static_cast<int>(gy64);
-      for (int gx = 0; gx < win.width; ++gx) {
-        const size_t p = grid.index(gx, gy);
-        float v = -target[2 * (3 * p + c)] - target[2 * (3 * p + c) + 1];
-        const int lx = gx > 0 ? gx - 1 : (win.wrap && win.width > 1 ? win.width - 1 : -1);
-        if (lx >= 0) v += target[2 * (3 * grid.index(lx, gy) + c)];
-        if (gy > 0) v += target[2 * (3 * grid.index(gx, gy - 1) + c) + 1];
-        b[p] = v;
-      }
-    });
-    const std::vector<float> d = solver.Solve(b);
+    for (size_t p = 0; p < n; ++p) b[p] = b3[3 * p + c];
+    PoissonSolveReport report;
+    const std::vector<float> d = solver.Solve(b, &report);
+    stats.iterations = std::max(stats.iterations, report.iterations);
+    stats.relative_residual = std::max(stats.relative_residual, report.relative_residual);
     base::ParallelFor(0, win.height, threads, [&](int64_t gy64) {
       const int gy = static_cast<int>(gy64);
       for (int gx = 0; gx < win.width; ++gx) {

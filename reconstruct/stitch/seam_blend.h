@@ -22,8 +22,12 @@
 //   in every channel (a smooth surface: sky, a wall) is it taken; in texture
 //   a jump hides, and the warps' differences, off by their registration,
 //   would spread noise: r_pq = 0 there;
-// - where no warp sees both sides alike (a depth edge), the pair is not
-//   joined, and no correction crosses it.
+// - where the sets differ and no warp they share sees both sides alike (a
+//   depth edge), the pair is not joined, and no correction crosses it. A
+//   depth edge inside one set (the same photos on both sides) stays joined,
+//   with r_pq = 0.
+// Sets are compared by a 64-bit hash of their photos' numbers; two sets that
+// collide would count as one (their pair keeps f's step).
 // The last term keeps d small, so a jump fades over about l on both sides
 // and colours far from any seam keep their values. Pixels without a label
 // take no part. Only the rows and columns that hold labelled pixels are
@@ -34,8 +38,20 @@
 
 namespace casual3d::stitch {
 
-// Evens out the seams of `out` (its rgb, label and depth_m as the stitch
-// wrote them), a layer of `warps`; `front` is the front layer for the back
+// The part of a layer that is solved: rows y0 .. y0 + height - 1 and the
+// width columns from x0 on (mod the layer's width).
+struct SeamWindow {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+  bool wrap = false;  // Every column is in it, and the last joins the first.
+};
+
+// The rows and columns that hold labelled pixels (label >= 0): every column
+// but the longest run, cyclically, of columns without any. False if no pixel
+// is labelled.
+bool FindSeamWindow(const Image<int16_t>& label, SeamWindow* win);
+
+// Evens out the seams of `out` (its rgb and label as the stitch wrote them,
+// with blend_depth_tolerance > 0), a layer of `warps`; `front` is the front layer for the back
 // layer's usability test (nullptr for the front layer).
 void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const StitchOptions& options,
                 StitchedLayer* out);

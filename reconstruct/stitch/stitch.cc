@@ -333,7 +333,8 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
   });
 
   // 3. Seams between the sets of blended photos evened out (BlendSeams).
-  if (options.seam_blend_length > 0) BlendSeams(warps, front, options, &out);
+  // Without blending every set is one photo, and no pair of two is joined.
+  if (options.seam_blend_length > 0 && options.blend_depth_tolerance > 0) BlendSeams(warps, front, options, &out);
   return out;
 }
 

@@ -26,6 +26,7 @@
 // + lambda_seam_depth * min(1, (|log(d_a(p) / d_b(p))| + |log(d_a(q) / d_b(q))|) / (2 seam_depth_scale))
 //   and lambda_seam_invalid instead where a or b has no warp at p or q.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -79,7 +80,8 @@ struct StitchOptions {
   // may jump by the photos' exposure difference. The jumps are evened out by
   // a correction that keeps every other colour difference and stays near the
   // blended colours (a screened Poisson problem, seam_blend.h); a jump fades
-  // over about this fraction of the panorama width on both sides. 0: off.
+  // over about this fraction of the panorama width on both sides. 0: off;
+  // off too with blend_depth_tolerance 0 (every set is then one photo).
   double seam_blend_length = 1.0 / 32;
 
   AlphaExpansionOptions solver;
@@ -108,12 +110,21 @@ struct StitchOptions {
             "Front pixels take the nearest surface this many unstretched warps agree on (within the blend "
             "tolerance, so off with it); 0: the label's");
     v.Field("seam_blend_length", o.seam_blend_length, R::Closed(0, 1),
-            "Colour jumps between the sets of blended photos fade over this fraction of the width; 0: off");
+            "Colour jumps between the sets of blended photos fade over this fraction of the width (with the "
+            "blend tolerance, so off with it); 0: off");
     v.Struct("solver", o.solver);
     v.Require(o.solve_width == 2 * o.solve_height, "solve_width", "must be 2 * solve_height");
     v.Require(o.front_support != 1, "front_support", "must be 0 (off) or at least 2: one warp alone is a floater");
   }
   Status Check() const { return util::CheckFields(*this); }
+};
+
+// What the seam blend did to one layer (seam_blend.h).
+struct SeamBlendStats {
+  int64_t pairs_with_target = 0;  // Neighbour pairs whose jump was evened out.
+  int64_t pairs_cut = 0;          // Pairs whose sets differ and share no warp that sees one surface.
+  int iterations = 0;             // Of the solve, the largest of the three channels'.
+  double relative_residual = 0.0; // Of the solve, the largest of the three channels'.
 };
 
 // One stitched layer at full resolution.
@@ -125,6 +136,7 @@ struct StitchedLayer {
   Image<int16_t> solve_label;
   ImageF solve_depth_m;  // Depth of the labelling at the solve resolution.
   double energy = 0.0;
+  SeamBlendStats seam_blend;
 };
 
 // Where each photo's camera is, in the panorama frame.
