@@ -56,6 +56,25 @@ StitchOptions SmallSolve() {
   return options;
 }
 
+// The front layer (1024x512) stitched from the same warps twice: with
+// `change` made to the options (SmallSolve), then without.
+struct TwoFronts {
+  std::vector<warp::WarpedView> full;  // The warps at 1024x512.
+  StitchedLayer changed, plain;
+};
+template <typename Change>
+TwoFronts StitchFrontTwice(const Capture& cap, Change&& change) {
+  const int W = 1024;
+  StitchOptions options = SmallSolve();
+  const auto coarse = Warp(cap, options.solve_width);
+  TwoFronts out;
+  out.full = Warp(cap, W);
+  out.plain = StitchFront(out.full, coarse, cap.geometry, W, options);
+  change(&options);
+  out.changed = StitchFront(out.full, coarse, cap.geometry, W, options);
+  return out;
+}
+
 TEST(StitchTest, FrontAndBackLayersMatchTheScene) {
   wt::SquareScene scene;
   Capture cap = MakeCapture(scene);
@@ -128,14 +147,10 @@ TEST(StitchTest, BlendingAveragesTheWarpsThatAgreeInDepth) {
       cap.rgb[0].at(x, y, 0) = 250;
     }
   }
-  StitchOptions options = SmallSolve();
   const int W = 1024;
-  const auto full = Warp(cap, W);
-  const auto coarse = Warp(cap, options.solve_width);
-  options.blend_depth_tolerance = 0;
-  const StitchedLayer single = StitchFront(full, coarse, cap.geometry, W, options);
-  options.blend_depth_tolerance = 0.03;
-  const StitchedLayer blended = StitchFront(full, coarse, cap.geometry, W, options);
+  const TwoFronts fronts = StitchFrontTwice(cap, [](StitchOptions* o) { o->blend_depth_tolerance = 0; });
+  const StitchedLayer& single = fronts.changed;
+  const StitchedLayer& blended = fronts.plain;
 
   // On the background plane seen by all four photos, away from the square and
   // the floater, the depth is the plane's and the blended red is the plain scene's (10) plus the mean
@@ -151,7 +166,7 @@ TEST(StitchTest, BlendingAveragesTheWarpsThatAgreeInDepth) {
       single_sq += std::pow(single.depth_m.at(x, y) / truth - 1, 2);
       blended_sq += std::pow(blended.depth_m.at(x, y) / truth - 1, 2);
       int seen = 0;
-      for (const warp::WarpedView& v : full) {
+      for (const warp::WarpedView& v : fronts.full) {
         int cx, cy;
         seen += v.front.ToCrop(x, y, W, &cx, &cy) && v.front.depth_m.at(cx, cy) > 0;
       }
@@ -289,14 +304,10 @@ TEST(StitchTest, SeamsBetweenPhotosOfDifferentExposureFade) {
       }
     }
   }
-  StitchOptions options = SmallSolve();
   const int W = 1024;
-  const auto full = Warp(cap, W);
-  const auto coarse = Warp(cap, options.solve_width);
-  options.seam_blend_length = 0;
-  const StitchedLayer plain = StitchFront(full, coarse, cap.geometry, W, options);
-  options.seam_blend_length = StitchOptions().seam_blend_length;
-  const StitchedLayer blended = StitchFront(full, coarse, cap.geometry, W, options);
+  const TwoFronts fronts = StitchFrontTwice(cap, [](StitchOptions* o) { o->seam_blend_length = 0; });
+  const StitchedLayer& plain = fronts.changed;
+  const StitchedLayer& blended = fronts.plain;
 
   // Steps of more than 2 levels between labelled neighbours, in any channel.
   auto jumps = [&](const StitchedLayer& layer) {
