@@ -1,5 +1,9 @@
 #include "reconstruct/stitch/seam_blend.h"
 
+#include <algorithm>
+#include <cstdlib>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 namespace casual3d::stitch {
@@ -47,6 +51,54 @@ TEST(SeamWindowTest, OneColumn) {
   Image<int16_t> label = Labels(8, 5);
   label.at(7, 4) = 0;
   ExpectWindow(label, /*x0=*/7, /*y0=*/4, /*width=*/1, /*height=*/1, /*wrap=*/false);
+}
+
+// A band all round the panorama, so that its columns wrap: photo 0 at level
+// 100 everywhere, photo 1 at 140 on the right half only, one surface 2 m
+// away. The blend is photo 0 alone on the left and the mean, 120, on the
+// right: jumps of 20 at the middle and across the wrap. The seam blend
+// evens both out and leaves the halves' middles (8 fading lengths away) as
+// they were.
+TEST(BlendSeamsTest, JumpsFadeAcrossTheWrap) {
+  const int W = 256, H = 128, y0 = 40, h = 48;
+  auto photo = [&](uint8_t level, int from) {
+    warp::WarpedView v;
+    v.front.y0 = y0;
+    v.front.rgb = Image8(W, h, 3, level);
+    v.front.depth_m = ImageF(W, h, 1, 0.0f);
+    v.front.stretch = ImageF(W, h, 1, 0.0f);
+    for (int y = 0; y < h; ++y)
+      for (int x = from; x < W; ++x) v.front.depth_m.at(x, y) = 2.0f;
+    return v;
+  };
+  const std::vector<warp::WarpedView> full = {photo(100, 0), photo(140, W / 2)};
+  const FullWarps warps{false, full, W, 0.02};
+  StitchOptions options;
+  StitchedLayer layer;
+  layer.rgb = Image8(W, H, 3, 0);
+  layer.depth_m = ImageF(W, H, 1, 0.0f);
+  layer.label = Image<int16_t>(W, H, 1, -1);
+  for (int y = y0; y < y0 + h; ++y) {
+    for (int x = 0; x < W; ++x) {
+      layer.label.at(x, y) = 0;
+      layer.depth_m.at(x, y) = 2.0f;
+      for (int c = 0; c < 3; ++c) layer.rgb.at(x, y, c) = x < W / 2 ? 100 : 120;
+    }
+  }
+  BlendSeams(warps, nullptr, options, &layer);
+  EXPECT_GT(layer.seam_blend.pairs_with_target, 0);
+  for (int y = y0; y < y0 + h; ++y) {
+    int largest = 0;
+    for (int x = 0; x < W; ++x) {
+      const int next = (x + 1) % W;  // The last column's step is across the wrap.
+      largest = std::max(largest, std::abs(layer.rgb.at(next, y, 0) - layer.rgb.at(x, y, 0)));
+    }
+    EXPECT_LE(largest, 2) << "row " << y;
+    EXPECT_NEAR(layer.rgb.at(W / 4, y, 1), 100, 1);
+    EXPECT_NEAR(layer.rgb.at(3 * W / 4, y, 2), 120, 1);
+    EXPECT_NEAR(layer.rgb.at(W / 2, y, 0), 110, 3);
+    EXPECT_NEAR(layer.rgb.at(0, y, 0), 110, 3);
+  }
 }
 
 }  // namespace
