@@ -191,21 +191,20 @@ TEST(BackdropTest, AFewFarOutliersDoNotColourTheirWindow) {
 TEST(BackdropTest, TheBackgroundSpreadsBehindTheForeground) {
   // Reach: 1 + 2 cells; colour from 1 cell around.
   const Mesh m = Backdrop(WallWithPatch(32, 96, 8, 56, 1.0f, 1), 8);
-  auto vertex_at = [&](int x, int y) { return VertexAt(m, x, y); };
   // On the square's edge: the wall's depth, and its colour with at most a
   // twentieth of the square's (a wall cell weighs (4 / 1)^4 times more).
-  size_t v = vertex_at(32, 32);
+  size_t v = VertexAt(m, 32, 32);
   EXPECT_NEAR(Norm(&m.positions[3 * v]), 4.0 * 1.02, 1e-4);
   EXPECT_GE(m.colors[3 * v], 190);
   EXPECT_LE(m.colors[3 * v + 1], 10);
   // Inside the square by 8 pixels (2 cells, within reach): the wall's depth,
   // the square's colour.
-  v = vertex_at(40, 32);
+  v = VertexAt(m, 40, 32);
   EXPECT_NEAR(Norm(&m.positions[3 * v]), 4.0 * 1.02, 1e-4);
   EXPECT_EQ(m.colors[3 * v], 0);
   EXPECT_EQ(m.colors[3 * v + 1], 200);
   // 16 pixels inside (4 cells, beyond reach): the square itself.
-  v = vertex_at(48, 32);
+  v = VertexAt(m, 48, 32);
   EXPECT_NEAR(Norm(&m.positions[3 * v]), 1.0 * 1.02, 1e-5);
   EXPECT_EQ(m.colors[3 * v], 0);
   EXPECT_EQ(m.colors[3 * v + 1], 200);

@@ -29,7 +29,6 @@
 #include "reconstruct/pipeline/view_volume.h"
 #include "reconstruct/stitch/smooth_depth.h"
 #include "reconstruct/stitch/stitch.h"
-#include "reconstruct/stitch/stitch.h"
 #include "reconstruct/warp/warp.h"
 #include "reconstruct/util/options_fields.h"
 

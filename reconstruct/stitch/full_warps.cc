@@ -22,4 +22,13 @@ void BlendMembers(const FullWarps& warps, int best, int x, int y, float front_de
   }
 }
 
+uint64_t BlendKey(const std::vector<std::pair<int, double>>& members) {
+  uint64_t h = 1469598103934665603ull;
+  for (const auto& e : members) {
+    h ^= static_cast<uint64_t>(e.first) + 1;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
 }  // namespace casual3d::stitch

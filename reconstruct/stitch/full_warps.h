@@ -3,6 +3,7 @@
 // The full-resolution warps of one layer as the stitch reads them after the
 // labelling: which warps a pixel may take, and which are blended into it.
 
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -50,5 +51,9 @@ struct FullWarps {
 // counts. `members` gets (warp, weight) pairs in warp order.
 void BlendMembers(const FullWarps& warps, int best, int x, int y, float front_depth,
                   const StitchOptions& options, std::vector<std::pair<int, double>>* members);
+
+// A 64-bit hash (FNV-1a) of the warps' numbers in `members`: equal sets give
+// equal keys (two sets that collide would count as one).
+uint64_t BlendKey(const std::vector<std::pair<int, double>>& members);
 
 }  // namespace casual3d::stitch

@@ -1,7 +1,7 @@
 #include "reconstruct/stitch/screened_poisson.h"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "base/parallel_for.h"
@@ -28,16 +28,6 @@ struct Level {
   std::vector<float> x, b, r;  // Scratch of the V-cycle.
 };
 
-// Column x's neighbour to the left or right, or -1 (none, or itself).
-int Left(const PoissonGrid& g, int x) {
-  const int l = x > 0 ? x - 1 : (g.wrap_x ? g.width - 1 : -1);
-  return l == x ? -1 : l;
-}
-int Right(const PoissonGrid& g, int x) {
-  const int r = x + 1 < g.width ? x + 1 : (g.wrap_x ? 0 : -1);
-  return r == x ? -1 : r;
-}
-
 // Calls body(y) for every row of g.
 template <typename Body>
 void ForRows(const PoissonGrid& g, int threads, Body&& body) {
@@ -52,8 +42,8 @@ void ComputeDiag(Level* level, int threads) {
     for (int x = 0; x < g.width; ++x) {
       const size_t p = g.index(x, y);
       float d = g.screen[p];
-      if (Right(g, x) >= 0) d += g.right[p];
-      if (const int l = Left(g, x); l >= 0) d += g.right[g.index(l, y)];
+      if (g.Right(x) >= 0) d += g.right[p];
+      if (const int l = g.Left(x); l >= 0) d += g.right[g.index(l, y)];
       if (y + 1 < g.height) d += g.down[p];
       if (y > 0) d += g.down[g.index(x, y - 1)];
       level->diag[p] = d;
@@ -114,7 +104,7 @@ void Coarsen(const Level& fine, Level* coarse, int threads) {
         for (int x = 2 * X; x < std::min(2 * X + 2, f.width); ++x) c.screen[P] += f.screen[f.index(x, y)];
         // The edge leaving the block's right column to the next block.
         const int xr = std::min(2 * X + 1, f.width - 1);
-        if (Right(f, xr) >= 0 && (Right(c, X) >= 0) && Right(f, xr) / 2 == Right(c, X))
+        if (f.Right(xr) >= 0 && (c.Right(X) >= 0) && f.Right(xr) / 2 == c.Right(X))
           c.right[P] += f.right[f.index(xr, y)];
       }
       // The edges leaving the block's bottom row to the next block.
@@ -251,9 +241,14 @@ std::vector<float> ScreenedPoissonSolver::Solve(const std::vector<float>& b, Poi
     if (report) *report = local;
     return d;
   }
+  // The top level's V-cycle reads r as its b (swapped in and out, not copied).
   Level& top = levels[0];
-  top.b = r;
-  VCycle(levels, 0, threads);
+  auto precondition = [&]() {
+    top.b.swap(r);
+    VCycle(levels, 0, threads);
+    top.b.swap(r);
+  };
+  precondition();
   p = top.x;
   double rz = Dot(grid, r, top.x, threads);
   double r_norm = b_norm;
@@ -272,8 +267,8 @@ std::vector<float> ScreenedPoissonSolver::Solve(const std::vector<float>& b, Poi
     });
     ++it;
     r_norm = std::sqrt(Dot(grid, r, r, threads));
-    top.b = r;
-    VCycle(levels, 0, threads);
+    if (r_norm <= options_.relative_tolerance * b_norm) break;  // No V-cycle for a direction not taken.
+    precondition();
     const double rz_next = Dot(grid, r, top.x, threads);
     const double beta = rz_next / rz;
     rz = rz_next;

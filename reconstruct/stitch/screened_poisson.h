@@ -33,6 +33,15 @@ struct PoissonGrid {
         down(static_cast<size_t>(w) * h, 0.0f),
         screen(static_cast<size_t>(w) * h, 0.0f) {}
   size_t index(int x, int y) const { return static_cast<size_t>(y) * width + x; }
+  // Column x's neighbour to the left or right, or -1 (none, or x itself).
+  int Left(int x) const {
+    const int l = x > 0 ? x - 1 : (wrap_x ? width - 1 : -1);
+    return l == x ? -1 : l;
+  }
+  int Right(int x) const {
+    const int r = x + 1 < width ? x + 1 : (wrap_x ? 0 : -1);
+    return r == x ? -1 : r;
+  }
 };
 
 // Adds the target r of edge (p, q), oriented from p to q, to the right-hand

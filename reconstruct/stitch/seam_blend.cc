@@ -28,15 +28,6 @@ constexpr double kWarpEdgeStep = 0.03;
 
 using Members = std::vector<std::pair<int, double>>;
 
-uint64_t KeyOf(const Members& m) {
-  uint64_t h = 1469598103934665603ull;  // FNV-1a over the warps' numbers.
-  for (const auto& e : m) {
-    h ^= static_cast<uint64_t>(e.first) + 1;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 }  // namespace
 
 bool FindSeamWindow(const Image<int16_t>& label, SeamWindow* win) {
@@ -71,7 +62,7 @@ bool FindSeamWindow(const Image<int16_t>& label, SeamWindow* win) {
 }
 
 void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const StitchOptions& options,
-                StitchedLayer* out) {
+                const Image<uint64_t>& keys, StitchedLayer* out) {
   SeamWindow win;
   if (!FindSeamWindow(out->label, &win)) return;
   const int W = out->label.width();
@@ -84,18 +75,13 @@ void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const Stitch
     BlendMembers(warps, out->label.at(x, y), x, y, front_depth, options, m);
   };
 
-  // Each labelled pixel's set of blended warps, as a key.
+  // Every labelled pixel takes part, screened alike.
   PoissonGrid grid(win.width, win.height, win.wrap);
-  std::vector<uint64_t> key(n, 0);
   const float screen = static_cast<float>(1.0 / std::pow(options.seam_blend_length * W, 2));
   base::ParallelFor(0, win.height, threads, [&](int64_t gy64) {
     const int gy = static_cast<int>(gy64);
-    Members m;
     for (int gx = 0; gx < win.width; ++gx) {
-      if (out->label.at(pano_x(gx), win.y0 + gy) < 0) continue;
-      members_at(gx, gy, &m);
-      key[grid.index(gx, gy)] = KeyOf(m);
-      grid.screen[grid.index(gx, gy)] = screen;
+      if (out->label.at(pano_x(gx), win.y0 + gy) >= 0) grid.screen[grid.index(gx, gy)] = screen;
     }
   });
 
@@ -113,9 +99,8 @@ void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const Stitch
       for (int dir = 0; dir < 2; ++dir) {
         int qx = gx, qy = gy;
         if (dir == 0) {
-          if (gx + 1 < win.width) qx = gx + 1;
-          else if (win.wrap && win.width > 1) qx = 0;
-          else continue;
+          qx = grid.Right(gx);
+          if (qx < 0) continue;
         } else {
           if (gy + 1 >= win.height) continue;
           qy = gy + 1;
@@ -123,11 +108,11 @@ void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const Stitch
         const size_t q = grid.index(qx, qy);
         if (!(grid.screen[q] > 0)) continue;
         float& weight = dir == 0 ? grid.right[p] : grid.down[p];
-        if (key[p] == key[q]) {
+        const int xp = pano_x(gx), yp = win.y0 + gy, xq = pano_x(qx), yq = win.y0 + qy;
+        if (keys.at(xp, yp) == keys.at(xq, yq)) {
           weight = 1.0f;
           continue;
         }
-        const int xp = pano_x(gx), yp = win.y0 + gy, xq = pano_x(qx), yq = win.y0 + qy;
         if (mp.empty()) members_at(gx, gy, &mp);  // Never empty: the label counts.
         members_at(qx, qy, &mq);
         // The unstretched warps both sets hold (both are in warp order).
@@ -171,7 +156,6 @@ void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const Stitch
     base::ParallelFor(0, (win.height + 1 - parity) / 2, threads,
                       [&](int64_t i) { join_row(static_cast<int>(2 * i + parity)); });
   }
-  std::vector<uint64_t>().swap(key);
   SeamBlendStats& stats = out->seam_blend;
   stats = SeamBlendStats();
   for (int gy = 0; gy < win.height; ++gy) {

@@ -85,7 +85,15 @@ TEST(BlendSeamsTest, JumpsFadeAcrossTheWrap) {
       for (int c = 0; c < 3; ++c) layer.rgb.at(x, y, c) = x < W / 2 ? 100 : 120;
     }
   }
-  BlendSeams(warps, nullptr, options, &layer);
+  Image<uint64_t> keys(W, H, 1, 0);  // As the stitch records them.
+  std::vector<std::pair<int, double>> members;
+  for (int y = y0; y < y0 + h; ++y) {
+    for (int x = 0; x < W; ++x) {
+      BlendMembers(warps, 0, x, y, 0.0f, options, &members);
+      keys.at(x, y) = BlendKey(members);
+    }
+  }
+  BlendSeams(warps, nullptr, options, keys, &layer);
   EXPECT_GT(layer.seam_blend.pairs_with_target, 0);
   for (int y = y0; y < y0 + h; ++y) {
     int largest = 0;

@@ -129,7 +129,6 @@ float SeamCost(const CoarseStack& stack, const StitchOptions& options, float inv
          static_cast<float>(options.lambda_seam_depth) * std::min(1.0f, 0.5f * depth * inv_scale);
 }
 
-
 // Edge-aware label upsampling of pixel (x, y): among the labels of the nearby
 // solve-resolution pixels, the one whose full-resolution warp best matches
 // the colours those pixels show, weighted by distance; where none reaches the
@@ -200,7 +199,6 @@ int UpsampleLabel(const FullWarps& warps, const StitchedLayer& out, const Image8
   return best;
 }
 
-
 // The front layer's label at (x, y): `best`, unless a surface nearer than
 // best's by more than blend_depth_tolerance has the support of at least
 // front_support unstretched warps (itself included); then the warp of the
@@ -242,9 +240,10 @@ int NearestSupported(const FullWarps& warps, int best, int x, int y, const Stitc
 // moved to the nearest supported surface, NearestSupported): its depth and
 // colour, or with blend_depth_tolerance > 0 the mean colour and the geometric
 // mean depth of the warps that agree with it (BlendMembers).
+// `keys` (when not null) gets the BlendKey of the blended warps.
 void WritePixel(const FullWarps& warps, int best, int x, int y, float front_depth,
                 const StitchOptions& options, std::vector<std::pair<float, int>>* scratch,
-                std::vector<std::pair<int, double>>* members, StitchedLayer* out) {
+                std::vector<std::pair<int, double>>* members, Image<uint64_t>* keys, StitchedLayer* out) {
   if (!warps.back && options.front_support > 0 && options.blend_depth_tolerance > 0)
     best = NearestSupported(warps, best, x, y, options, scratch);
   const warp::WarpedLayer& layer = warps.layer(best);
@@ -257,6 +256,7 @@ void WritePixel(const FullWarps& warps, int best, int x, int y, float front_dept
     return;
   }
   BlendMembers(warps, best, x, y, front_depth, options, members);
+  if (keys) keys->at(x, y) = BlendKey(*members);
   double sum[3] = {0, 0, 0}, weight = 0, dsum = 0;
   for (const auto& [l, w] : *members) {
     const warp::WarpedLayer& other = warps.layer(l);
@@ -319,6 +319,10 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
   out.depth_m = ImageF(W, H, 1, 0.0f);
   out.label = Image<int16_t>(W, H, 1, -1);
   const FullWarps warps{back, full, W, options.back_tolerance};
+  // Without blending every set is one photo, and no pair of two is joined.
+  const bool seam_blend = options.seam_blend_length > 0 && options.blend_depth_tolerance > 0;
+  Image<uint64_t> keys;
+  if (seam_blend) keys = Image<uint64_t>(W, H, 1, 0);
   base::ParallelFor(0, H, base::ResolveThreads(0), [&](int64_t y64) {
     const int y = static_cast<int>(y64);
     std::vector<int> candidates;
@@ -328,13 +332,12 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
     for (int x = 0; x < W; ++x) {
       const float front_depth = front ? front->depth_m.at(x, y) : 0.0f;
       const int best = UpsampleLabel(warps, out, solve_rgb, x, y, front_depth, options, &candidates, &scores);
-      if (best >= 0) WritePixel(warps, best, x, y, front_depth, options, &scratch, &members, &out);
+      if (best >= 0) WritePixel(warps, best, x, y, front_depth, options, &scratch, &members, seam_blend ? &keys : nullptr, &out);
     }
   });
 
   // 3. Seams between the sets of blended photos evened out (BlendSeams).
-  // Without blending every set is one photo, and no pair of two is joined.
-  if (options.seam_blend_length > 0 && options.blend_depth_tolerance > 0) BlendSeams(warps, front, options, &out);
+  if (seam_blend) BlendSeams(warps, front, options, keys, &out);
   return out;
 }
 
