@@ -16,7 +16,7 @@ namespace casual3d::depth {
 // (width * height * num_labels, as CostVolume::cost), into the data term,
 // and sets the smoothness weights:
 //   unary:  w_photo E_photo(k), plus far_bias * (1 - w_photo) * (1 - k / (L - 1))
-//           where no flat-region prior applies, plus lambda_flat * (1 - w_photo)
+//           where no flat-region prior applies (far_bias 0 by default), plus lambda_flat * (1 - w_photo)
 //           * min(|k - prior|, T_flat) / T_flat where one does (flat_regions.h;
 //           NaN = none), plus lambda_near on labels nearer than `envelope`'s
 //           (Eq. 4) when `envelope` is not empty;

@@ -55,13 +55,15 @@ struct MrfTermOptions {
   double lambda_near = 1.0;     // Sec. 4.3.2: lambda_near (Eq. 4). [0, 100].
   double sigma_color = 0.04;    // w_color = exp(-|c_i - c_j|^2 / (2 sigma^2)), colour in [0, 1]. (0, 10].
   double color_floor = 0.02;    // Lower bound of w_color, so strong edges still regularise a little. [0, 1].
-  // Our addition (spec/stage-dense.md): textureless pixels (sky, blank walls)
-  // carry no photo-consistency evidence; a small cost far_bias * (1 - w_photo)
-  // * (1 - k / (L - 1)) on label k leans them away from the camera rather than
-  // letting the smoothness term extend nearby near objects over them; 0 turns
-  // it off (docs/DECISIONS.md, "Dense: 7x7 ZNCC window, far bias 0.02,
-  // colour-weighted texture measure"). [0, 1].
-  double far_bias = 0.02;
+  // A cost far_bias * (1 - w_photo) * (1 - k / (L - 1)) on label k that leans
+  // textureless pixels away from the camera, towards the sweep's far plane
+  // (spec/stage-dense.md). Off by default: a weakly textured ceiling or wall
+  // has too little evidence to resist it and went to the far plane, 100 times
+  // the near depth, in patches that tore from off the centre; the free-space
+  // check, the flat-region priors and the panorama's front support keep the
+  // floaters it was for in check (synthetic near floaters 0.47% -> 0.50%;
+  // docs/DECISIONS.md, "Dense: no far bias"). [0, 1].
+  double far_bias = 0.0;
   int truncation_labels = 8;    // w_depth = min(|k_i - k_j|, T) / T, labels (inverse depth). [1, 4096].
   // TRW-S passes (docs/DECISIONS.md, "Dense: 6 TRW-S passes"). [1, 1000].
   int max_iterations = 6;

@@ -43,7 +43,7 @@ TEST_F(DenseStageTest, ReconstructsTheToySceneAccurately) {
   ASSERT_TRUE(r.evaluated);
   std::printf("toy: median rel %.4f within3 %.4f floaters %.4f cross-view %.4f\n", r.median_rel_error,
               r.within_3pct, r.near_floaters, r.cross_view_consistency);
-  // Measured: median 0.05%, 93.1% within 3%, 0.16% near floaters (what is
+  // Measured: median 0.05%, 94.6% within 3%, 0.15% near floaters (what is
   // left of the window fattening at the board's and the pole's edges at this
   // tiny 120x90 working size after the edge-aware median, the colour-weighted
   // texture measure and the free-space check; see below without the check).
@@ -51,8 +51,10 @@ TEST_F(DenseStageTest, ReconstructsTheToySceneAccurately) {
   EXPECT_GE(r.within_3pct, 0.91);
   EXPECT_LE(r.near_floaters, 0.005);
   // Consistent depth maps agree across views without any ground truth
-  // (measured 91.0%).
-  EXPECT_GE(r.cross_view_consistency, 0.88);
+  // (measured 87.2%; 91.0% with the far bias of 0.02 that the dense stage no
+  // longer applies by default, when the toy's sky went to the far plane,
+  // where the views agree trivially; the real captures rose without it).
+  EXPECT_GE(r.cross_view_consistency, 0.85);
   for (const PhotoReport& p : r.photos) EXPECT_GT(p.cross_view_consistency, 0.0) << p.name;
   // Outputs exist at full resolution; the cost cache is gone.
   const ImageF d = io::ReadExrChannels((out / "depth" / "0005.exr").string(), {"Z"});
