@@ -38,7 +38,8 @@ std::string PanoramaReportJson(const PanoramaStageReport& report,
                           {"iterations", st.iterations},
                           {"relative_residual", st.relative_residual}};
   };
-  j["seam_blend"] = {{"front", seam_json(report.seam_blend_front)}, {"back", seam_json(report.seam_blend_back)}};
+  j["seam_blend"] = {{"front", seam_json(report.seam_blend_front)},
+                     {"back", seam_json(report.seam_blend_back)}};
   j["front_footprint"] = CoverageJson(report.front_footprint);
   j["fuse"] = {{"front_nodes", report.fuse.front_nodes},
                {"back_nodes_in", report.fuse.back_nodes_in},

@@ -111,7 +111,8 @@ TEST(ScreenedPoissonTest, MatchesADirectSolution) {
     double max_want = 0.0;
     for (double v : want) max_want = std::max(max_want, std::abs(v));
     ASSERT_GT(max_want, 0.5);
-    for (size_t p = 0; p < d.size(); ++p) ASSERT_NEAR(d[p], want[p], 1e-4 * max_want) << W << "x" << H << " " << p;
+    for (size_t p = 0; p < d.size(); ++p)
+      ASSERT_NEAR(d[p], want[p], 1e-4 * max_want) << W << "x" << H << " " << p;
     EXPECT_EQ(d[hole], 0.0f);
     EXPECT_LE(report.relative_residual, 1e-6) << W << "x" << H;
     EXPECT_LT(report.iterations, 60) << "the preconditioner does not act";

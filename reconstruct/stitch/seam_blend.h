@@ -52,8 +52,9 @@ bool FindSeamWindow(const Image<int16_t>& label, SeamWindow* win);
 
 // Evens out the seams of `out` (its rgb and label as the stitch wrote them,
 // with blend_depth_tolerance > 0), a layer of `warps`; `keys` holds, for each
-// labelled pixel, the BlendKey of its BlendMembers (as the stitch blended it); `front` is the front layer for the back
-// layer's usability test (nullptr for the front layer).
+// labelled pixel, the BlendKey of its BlendMembers (as the stitch blended
+// it); `front` is the front layer for the back layer's usability test
+// (nullptr for the front layer).
 void BlendSeams(const FullWarps& warps, const StitchedLayer* front, const StitchOptions& options,
                 const Image<uint64_t>& keys, StitchedLayer* out);
 

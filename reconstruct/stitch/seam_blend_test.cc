@@ -12,19 +12,13 @@ namespace {
 Image<int16_t> Labels(int w, int h) { return Image<int16_t>(w, h, 1, -1); }
 
 void ExpectWindow(const Image<int16_t>& label, int x0, int y0, int width, int height, bool wrap) {
-  SeamWindow want;
-  want.x0 = x0;
-  want.y0 = y0;
-  want.width = width;
-  want.height = height;
-  want.wrap = wrap;
   SeamWindow win;
   ASSERT_TRUE(FindSeamWindow(label, &win));
-  EXPECT_EQ(win.x0, want.x0);
-  EXPECT_EQ(win.width, want.width);
-  EXPECT_EQ(win.wrap, want.wrap);
-  EXPECT_EQ(win.y0, want.y0);
-  EXPECT_EQ(win.height, want.height);
+  EXPECT_EQ(win.x0, x0);
+  EXPECT_EQ(win.width, width);
+  EXPECT_EQ(win.wrap, wrap);
+  EXPECT_EQ(win.y0, y0);
+  EXPECT_EQ(win.height, height);
 }
 
 TEST(SeamWindowTest, NoLabelNoWindow) {

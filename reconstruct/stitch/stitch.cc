@@ -243,7 +243,8 @@ int NearestSupported(const FullWarps& warps, int best, int x, int y, const Stitc
 // `keys` (when not null) gets the BlendKey of the blended warps.
 void WritePixel(const FullWarps& warps, int best, int x, int y, float front_depth,
                 const StitchOptions& options, std::vector<std::pair<float, int>>* scratch,
-                std::vector<std::pair<int, double>>* members, Image<uint64_t>* keys, StitchedLayer* out) {
+                std::vector<std::pair<int, double>>* members, Image<uint64_t>* keys,
+                StitchedLayer* out) {
   if (!warps.back && options.front_support > 0 && options.blend_depth_tolerance > 0)
     best = NearestSupported(warps, best, x, y, options, scratch);
   const warp::WarpedLayer& layer = warps.layer(best);
@@ -332,7 +333,9 @@ StitchedLayer StitchLayer(bool back, const std::vector<warp::WarpedView>& full,
     for (int x = 0; x < W; ++x) {
       const float front_depth = front ? front->depth_m.at(x, y) : 0.0f;
       const int best = UpsampleLabel(warps, out, solve_rgb, x, y, front_depth, options, &candidates, &scores);
-      if (best >= 0) WritePixel(warps, best, x, y, front_depth, options, &scratch, &members, seam_blend ? &keys : nullptr, &out);
+      if (best < 0) continue;
+      WritePixel(warps, best, x, y, front_depth, options, &scratch, &members,
+                 seam_blend ? &keys : nullptr, &out);
     }
   });
 

@@ -56,11 +56,11 @@ StitchOptions SmallSolve() {
   return options;
 }
 
-// The front layer (1024x512) stitched from the same warps twice: with
-// `change` made to the options (SmallSolve), then without.
+// The front layer (1024x512) stitched from the same warps twice: with the
+// options of SmallSolve, and with `change` made to them.
 struct TwoFronts {
   std::vector<warp::WarpedView> full;  // The warps at 1024x512.
-  StitchedLayer changed, plain;
+  StitchedLayer defaults, changed;
 };
 template <typename Change>
 TwoFronts StitchFrontTwice(const Capture& cap, Change&& change) {
@@ -69,7 +69,7 @@ TwoFronts StitchFrontTwice(const Capture& cap, Change&& change) {
   const auto coarse = Warp(cap, options.solve_width);
   TwoFronts out;
   out.full = Warp(cap, W);
-  out.plain = StitchFront(out.full, coarse, cap.geometry, W, options);
+  out.defaults = StitchFront(out.full, coarse, cap.geometry, W, options);
   change(&options);
   out.changed = StitchFront(out.full, coarse, cap.geometry, W, options);
   return out;
@@ -150,7 +150,7 @@ TEST(StitchTest, BlendingAveragesTheWarpsThatAgreeInDepth) {
   const int W = 1024;
   const TwoFronts fronts = StitchFrontTwice(cap, [](StitchOptions* o) { o->blend_depth_tolerance = 0; });
   const StitchedLayer& single = fronts.changed;
-  const StitchedLayer& blended = fronts.plain;
+  const StitchedLayer& blended = fronts.defaults;
 
   // On the background plane seen by all four photos, away from the square and
   // the floater, the depth is the plane's and the blended red is the plain scene's (10) plus the mean
@@ -185,9 +185,13 @@ TEST(StitchTest, BlendingAveragesTheWarpsThatAgreeInDepth) {
   EXPECT_LT(std::sqrt(blended_sq / checked), 0.7 * std::sqrt(single_sq / checked));
   // The floater's colour never reaches the blended background: photo 0's
   // warp there is at half the depth, outside the tolerance.
-  for (int y = 0; y < W / 2; ++y)
-    for (int x = 0; x < W; ++x)
-      if (blended.depth_m.at(x, y) > 3.0f) ASSERT_LT(blended.rgb.at(x, y, 0), 60) << x << "," << y;
+  for (int y = 0; y < W / 2; ++y) {
+    for (int x = 0; x < W; ++x) {
+      if (blended.depth_m.at(x, y) > 3.0f) {
+        ASSERT_LT(blended.rgb.at(x, y, 0), 60) << x << "," << y;
+      }
+    }
+  }
 }
 
 // Photos 2 and 3 miss the square (their depth maps and colours show the
@@ -307,7 +311,7 @@ TEST(StitchTest, SeamsBetweenPhotosOfDifferentExposureFade) {
   const int W = 1024;
   const TwoFronts fronts = StitchFrontTwice(cap, [](StitchOptions* o) { o->seam_blend_length = 0; });
   const StitchedLayer& plain = fronts.changed;
-  const StitchedLayer& blended = fronts.plain;
+  const StitchedLayer& blended = fronts.defaults;
 
   // Steps of more than 2 levels between labelled neighbours, in any channel.
   auto jumps = [&](const StitchedLayer& layer) {
